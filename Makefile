@@ -1,0 +1,132 @@
+# ringside: `make` builds build/ringside.  See README.md.
+#
+#   make            build (installs missing Debian packages first)
+#   make test       build and run every test; ends with "N passed, N failed, N skipped"
+#   make asan       the test suite again under AddressSanitizer + UBSan (build-asan/)
+#   make debug      -O0 build with GL error checks in build-debug/
+#   make demo       the main job on the bundled default (see README)
+#   make bench      benchmarks
+#   make install PREFIX=/usr/local
+#   make clean
+#
+# Variables: BUILD (output dir), OPT, SAN=1, DEBUG=1, WERROR=1 (on when CI=true),
+# T=name (make test T=shader runs tests/test_shader only).
+
+BUILD   ?= build
+PREFIX  ?= /usr/local
+CC      ?= cc
+OPT     ?= -O2
+T       ?=
+
+ifeq ($(CI),true)
+WERROR ?= 1
+endif
+
+# Determinism (see the runtime docs): no fused multiply-add, no fast-math.
+# Messages go into fixed buffers and are cut on purpose: no truncation warning.
+CFLAGS_BASE := -std=c11 -D_POSIX_C_SOURCE=200809L -Wall -Wextra -Wshadow -Wstrict-prototypes \
+               -Wno-format-truncation -ffp-contract=off -fno-fast-math -g -MMD -MP
+ifeq ($(WERROR),1)
+CFLAGS_BASE += -Werror
+endif
+ifeq ($(SAN),1)
+CFLAGS_BASE += -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+LDFLAGS_SAN := -fsanitize=address,undefined
+OPT := -O1
+endif
+ifeq ($(DEBUG),1)
+CFLAGS_BASE += -DRS_DEBUG
+OPT := -O0
+endif
+
+STAMPS := build/deps
+ifeq ($(filter clean help,$(MAKECMDGOALS)),)
+-include $(BUILD)/config.mk
+endif
+
+CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
+LDLIBS  = $(CONF_LIBS) -lm -lpthread -ldl
+LDFLAGS += $(LDFLAGS_SAN)
+
+LIB_SRC := $(wildcard runtime/util/*.c runtime/gl/*.c runtime/platform/*.c runtime/render/*.c) \
+           $(filter-out runtime/main.c,$(wildcard runtime/*.c))
+MAIN_SRC := runtime/main.c
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+
+LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
+
+.PHONY: all test asan debug demo bench install uninstall clean help deps
+.DEFAULT_GOAL := all
+
+all: $(BUILD)/ringside
+
+# --- dependencies: stamped per group, so a second run is a file compare ---
+$(STAMPS)/build: tools/deps.sh
+	@tools/deps.sh build
+$(STAMPS)/test: tools/deps.sh
+	@tools/deps.sh test
+deps: $(STAMPS)/build $(STAMPS)/test
+
+$(BUILD)/config.mk: tools/configure.sh $(STAMPS)/build
+	@mkdir -p $(BUILD)
+	@tools/configure.sh > $@.tmp && mv $@.tmp $@
+
+# --- build ---
+$(BUILD)/obj/%.o: %.c $(BUILD)/config.mk
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/libringside.a: $(LIB_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/ringside: $(MAIN_OBJ) $(BUILD)/libringside.a
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/obj/tests/%.o: tests/%.c $(BUILD)/config.mk
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -DRS_SOURCE_DIR='"$(CURDIR)"' -c $< -o $@
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(BUILD)/obj/tests/t.o $(BUILD)/libringside.a
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+# --- tests ---
+test: $(STAMPS)/test $(BUILD)/ringside $(TEST_BIN)
+	@tests/run.sh $(BUILD) $(T)
+
+asan:
+	@$(MAKE) --no-print-directory BUILD=build-asan SAN=1 test
+
+debug:
+	@$(MAKE) --no-print-directory BUILD=build-debug DEBUG=1 all
+
+# --- the main job and benchmarks ---
+demo: $(BUILD)/ringside
+	@mkdir -p out
+	$(BUILD)/ringside smoke -o out/demo.png
+	@echo "demo: out/demo.png (the smoke scene; the game renderer replaces it once it lands)"
+
+bench: $(BUILD)/ringside
+	@mkdir -p out
+	$(BUILD)/ringside bench platform --csv out/bench-platform.csv
+
+# --- install ---
+install: $(BUILD)/ringside
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/ringside/shaders
+	install -m 755 $(BUILD)/ringside $(DESTDIR)$(PREFIX)/bin/ringside
+	install -m 644 shaders/* $(DESTDIR)$(PREFIX)/share/ringside/shaders/
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/ringside
+	rm -rf $(DESTDIR)$(PREFIX)/share/ringside
+
+clean:
+	rm -rf build build-asan build-debug out
+
+help:
+	@sed -n '1,/^$$/p' Makefile | sed 's/^# \{0,1\}//'
+
+-include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)

@@ -1,0 +1,55 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+void cli_error(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "ringside %s: ", cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+int cli_usage_error(const char *cmd)
+{
+    fprintf(stderr, "ringside %s: see 'ringside %s --help'\n", cmd, cmd);
+    return RS_EXIT_USAGE;
+}
+
+bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(arg, &end, 10);
+    if (errno || end == arg || *end || v < lo || v > hi) {
+        fprintf(stderr, "ringside: %s '%s': expected a whole number from %ld to %ld\n", opt, arg, lo, hi);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
+{
+    char *x;
+    errno = 0;
+    long a = strtol(arg, &x, 10), b = 0;
+    bool ok = !errno && x != arg && (*x == 'x' || *x == 'X');
+    if (ok) {
+        char *end;
+        b = strtol(x + 1, &end, 10);
+        ok = !errno && end != x + 1 && !*end;
+    }
+    if (!ok || a < 1 || b < 1 || a > max || b > max) {
+        fprintf(stderr, "ringside: %s '%s': expected WIDTHxHEIGHT, each from 1 to %d (e.g. 1280x720)\n", opt, arg, max);
+        return false;
+    }
+    *w = (int)a;
+    *h = (int)b;
+    return true;
+}

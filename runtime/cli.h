@@ -1,0 +1,31 @@
+/* Shared pieces of the command-line front end. */
+#ifndef CLI_H
+#define CLI_H
+
+#include <stdbool.h>
+
+#define RS_VERSION "0.1.0"
+
+enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2 };
+
+typedef struct cli_cmd {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} cli_cmd;
+
+/* Parses "WxH" with 1 <= W,H <= max; prints a usage error naming opt. */
+bool cli_size(const char *opt, const char *arg, int max, int *w, int *h);
+/* Parses an integer in [lo, hi]; prints a usage error naming opt. */
+bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out);
+/* "ringside CMD: message" on stderr. */
+void cli_error(const char *cmd, const char *fmt, ...);
+/* Unknown option or missing argument: prints the hint to --help; returns RS_EXIT_USAGE. */
+int cli_usage_error(const char *cmd);
+
+int cmd_info(int argc, char **argv);
+int cmd_smoke(int argc, char **argv);
+int cmd_shaders(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
+
+#endif

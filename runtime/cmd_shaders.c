@@ -1,0 +1,101 @@
+/* ringside shaders: compile every stage file in shaders/ on this driver. */
+#include <dirent.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "platform/plat.h"
+#include "render/r_shader.h"
+#include "util/rs_file.h"
+
+static void help(void)
+{
+    printf("usage: ringside shaders [--backend egl|osmesa|glfw] [--quiet]\n\n"
+           "Compiles every .vert, .frag, .geom and .comp file in the shaders directory\n"
+           "(found through RINGSIDE_DATA, the source tree or the install prefix) and\n"
+           "prints each error as shaders/FILE:LINE: message.  .glsl files are include\n"
+           "files and are compiled as part of the stages that include them.\n"
+           "Exit status 1 if any shader fails.\n\n"
+           "  --backend B   GL backend (default egl, falling back to osmesa)\n"
+           "  --quiet       print only failures\n");
+}
+
+static int by_name(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+int cmd_shaders(int argc, char **argv)
+{
+    static const struct option opts[] = {{"backend", required_argument, 0, 'b'},
+                                         {"quiet", no_argument, 0, 'q'},
+                                         {"help", no_argument, 0, 'h'},
+                                         {0}};
+    plat_desc d = {.hidden = true};
+    bool quiet = false;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'b': d.backend = optarg; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default:
+            cli_error("shaders", "bad option or missing value '%s'", argv[optind - 1]);
+            return cli_usage_error("shaders");
+        }
+    }
+    rs_err err = {0};
+    const char *root = rs_data_dir(&err);
+    if (!root) {
+        cli_error("shaders", "%s", err.msg);
+        return RS_EXIT_FAIL;
+    }
+    char dir[1100];
+    snprintf(dir, sizeof dir, "%s/shaders", root);
+    DIR *dp = opendir(dir);
+    if (!dp) {
+        cli_error("shaders", "%s: cannot open", dir);
+        return RS_EXIT_FAIL;
+    }
+    char *names[512];
+    int n = 0;
+    struct dirent *de;
+    while ((de = readdir(dp)) != NULL && n < 512)
+        if (r_shader_stage(de->d_name))
+            names[n++] = strdup(de->d_name);
+    closedir(dp);
+    qsort(names, (size_t)n, sizeof names[0], by_name);
+
+    plat *p = plat_create(&d, &err);
+    if (!p) {
+        cli_error("shaders", "%s", err.msg);
+        for (int i = 0; i < n; i++)
+            free(names[i]);
+        return RS_EXIT_FAIL;
+    }
+    int failed = 0;
+    for (int i = 0; i < n; i++) {
+        char *log = NULL, shown[1200];
+        rs_data_path(root, "shaders", shown, sizeof shown);
+        GLuint sh = r_shader_compile(names[i], NULL, &log, &err);
+        if (sh) {
+            if (!quiet)
+                printf("ok      %s/%s\n", shown, names[i]);
+            gl.DeleteShader(sh);
+        } else {
+            failed++;
+            printf("FAILED  %s/%s\n%s", shown, names[i], log ? log : err.msg);
+            if (!log)
+                putchar('\n');
+        }
+        free(log);
+        free(names[i]);
+    }
+    printf("%d shader files, %d failed (%s, GL %d.%d)\n", n, failed, plat_backend_name(p), glcaps.major, glcaps.minor);
+    plat_destroy(p);
+    return failed ? RS_EXIT_FAIL : RS_EXIT_OK;
+}

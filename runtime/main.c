@@ -1,0 +1,61 @@
+/* ringside: one binary, one subcommand per job.  Commands live in
+ * cmd_*.c; each parses its own options, prints its own --help and returns
+ * an exit status (0 ok, 1 failure, 2 usage).  Only this layer exits. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+#include "platform/plat.h"
+
+static const cli_cmd commands[] = {
+    {"info", cmd_info, "print the GL backend, driver and capabilities"},
+    {"smoke", cmd_smoke, "render the smoke test scene headless to an image"},
+    {"shaders", cmd_shaders, "compile every shader in shaders/ and report errors"},
+    {"bench", cmd_bench, "run a benchmark (bench platform)"},
+};
+
+static void usage(FILE *f)
+{
+    fprintf(f, "ringside %s: arcade fighting-game runtime with replay capture\n\n"
+               "usage: ringside COMMAND [OPTIONS]\n\ncommands:\n",
+            RS_VERSION);
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "  %-9s %s\n", "help", "this text; 'ringside COMMAND --help' for one command");
+    fprintf(f, "  %-9s %s\n", "version", "print the version");
+    fprintf(f, "\nGL backends built in: %s (headless default: egl, then osmesa)\n"
+               "environment: RINGSIDE_DATA (directory holding shaders/), RINGSIDE_GL_DEBUG=1,\n"
+               "             RINGSIDE_EGL_DEVICE=N\n"
+               "exit status: 0 success, 1 failure, 2 bad usage\n"
+               "docs: README.md and docs/ in the source tree\n",
+            plat_built_backends());
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return RS_EXIT_USAGE;
+    }
+    const char *name = argv[1];
+    if (!strcmp(name, "help") || !strcmp(name, "--help") || !strcmp(name, "-h")) {
+        if (argc > 2 && strcmp(name, "help") == 0) {
+            for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+                if (!strcmp(commands[i].name, argv[2])) {
+                    char *args[] = {argv[2], "--help", NULL};
+                    return commands[i].run(2, args);
+                }
+        }
+        usage(stdout);
+        return RS_EXIT_OK;
+    }
+    if (!strcmp(name, "version") || !strcmp(name, "--version")) {
+        printf("ringside %s\n", RS_VERSION);
+        return RS_EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(commands[i].name, name))
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "ringside: unknown command '%s' (see 'ringside --help')\n", name);
+    return RS_EXIT_USAGE;
+}

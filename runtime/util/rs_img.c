@@ -1,0 +1,257 @@
+#include "rs_img.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rs_file.h"
+
+/* Largest image we accept from a file: 16384 x 16384 x 4. */
+#define RS_IMG_MAX_DIM 16384
+
+uint32_t rs_crc32(uint32_t crc, const void *data, size_t n)
+{
+    static uint32_t table[256];
+    if (!table[1]) {
+        for (uint32_t i = 0; i < 256; i++) {
+            uint32_t c = i;
+            for (int k = 0; k < 8; k++)
+                c = (c & 1) ? 0xedb88320u ^ (c >> 1) : c >> 1;
+            table[i] = c;
+        }
+    }
+    const uint8_t *p = data;
+    crc = ~crc;
+    while (n--)
+        crc = table[(crc ^ *p++) & 0xff] ^ (crc >> 8);
+    return ~crc;
+}
+
+static void be32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v >> 24);
+    p[1] = (uint8_t)(v >> 16);
+    p[2] = (uint8_t)(v >> 8);
+    p[3] = (uint8_t)v;
+}
+
+static bool png_chunk(FILE *f, const char *type, const uint8_t *data, uint32_t n)
+{
+    uint8_t hdr[8];
+    be32(hdr, n);
+    memcpy(hdr + 4, type, 4);
+    uint32_t crc = rs_crc32(0, hdr + 4, 4);
+    crc = rs_crc32(crc, data, n);
+    uint8_t tail[4];
+    be32(tail, crc);
+    return fwrite(hdr, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) && fwrite(tail, 1, 4, f) == 4;
+}
+
+static bool check_args(const char *path, int w, int h, int channels, rs_err *err)
+{
+    if (w <= 0 || h <= 0 || w > RS_IMG_MAX_DIM || h > RS_IMG_MAX_DIM || channels < 1 || channels > 4 || channels == 2)
+        return rs_fail(err, RS_IMG_ERR_ARG, "%s: cannot write a %dx%d image with %d channels", path, w, h, channels);
+    return true;
+}
+
+bool rs_png_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err)
+{
+    if (!check_args(path, w, h, channels, err))
+        return false;
+    /* zlib stream of stored blocks: each row is a filter byte (0) + pixels */
+    size_t row = (size_t)w * channels + 1, raw = row * h;
+    size_t nblocks = (raw + 65534) / 65535;
+    size_t zlen = 2 + raw + nblocks * 5 + 4;
+    if (zlen > 0x7fffffffu)
+        return rs_fail(err, RS_IMG_ERR_ARG, "%s: image too large for one PNG chunk", path);
+    uint8_t *z = malloc(zlen), *rawbuf = malloc(raw);
+    if (!z || !rawbuf) {
+        free(z);
+        free(rawbuf);
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: out of memory", path);
+    }
+    for (int y = 0; y < h; y++) {
+        rawbuf[y * row] = 0;
+        memcpy(rawbuf + y * row + 1, px + (size_t)y * w * channels, row - 1);
+    }
+    size_t o = 0;
+    z[o++] = 0x78; /* deflate, 32K window */
+    z[o++] = 0x01; /* no preset dictionary, fastest; (0x7801 % 31 == 0) */
+    uint32_t a = 1, b = 0;
+    for (size_t off = 0; off < raw || (raw == 0 && off == 0);) {
+        size_t n = raw - off > 65535 ? 65535 : raw - off;
+        z[o++] = off + n == raw ? 1 : 0; /* BFINAL, BTYPE=00 */
+        z[o++] = (uint8_t)n;
+        z[o++] = (uint8_t)(n >> 8);
+        z[o++] = (uint8_t)~n;
+        z[o++] = (uint8_t)(~n >> 8);
+        memcpy(z + o, rawbuf + off, n);
+        for (size_t i = 0; i < n; i++) {
+            a = (a + rawbuf[off + i]) % 65521;
+            b = (b + a) % 65521;
+        }
+        o += n;
+        off += n;
+        if (n == 0)
+            break;
+    }
+    be32(z + o, (b << 16) | a);
+    o += 4;
+    free(rawbuf);
+
+    static const uint8_t colour_type[5] = {0, 0, 0, 2, 6};
+    uint8_t ihdr[13];
+    be32(ihdr, (uint32_t)w);
+    be32(ihdr + 4, (uint32_t)h);
+    ihdr[8] = 8;
+    ihdr[9] = colour_type[channels];
+    ihdr[10] = ihdr[11] = ihdr[12] = 0;
+
+    char part[PATH_MAX + 8];
+    rs_part_path(path, part, sizeof part);
+    FILE *f = fopen(part, "wb");
+    if (!f) {
+        free(z);
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
+    }
+    static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    bool ok = fwrite(sig, 1, 8, f) == 8 && png_chunk(f, "IHDR", ihdr, 13) && png_chunk(f, "IDAT", z, (uint32_t)o) &&
+              png_chunk(f, "IEND", NULL, 0);
+    int saved = errno;
+    ok = (fclose(f) == 0) && ok;
+    free(z);
+    if (!ok) {
+        remove(part);
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : errno));
+    }
+    return rs_commit_file(path, err);
+}
+
+bool rs_pnm_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err)
+{
+    if (!check_args(path, w, h, channels, err))
+        return false;
+    char part[PATH_MAX + 8];
+    rs_part_path(path, part, sizeof part);
+    FILE *f = fopen(part, "wb");
+    if (!f)
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
+    int out_ch = channels == 1 ? 1 : 3;
+    bool ok = fprintf(f, "P%d\n%d %d\n255\n", out_ch == 1 ? 5 : 6, w, h) > 0;
+    for (size_t i = 0; ok && i < (size_t)w * h; i++)
+        ok = fwrite(px + i * channels, 1, out_ch, f) == (size_t)out_ch;
+    int saved = errno;
+    ok = (fclose(f) == 0) && ok;
+    if (!ok) {
+        remove(part);
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : errno));
+    }
+    return rs_commit_file(path, err);
+}
+
+/* Reads the next header integer, skipping whitespace and # comments. */
+static bool pnm_int(const uint8_t *d, size_t n, size_t *o, int *v)
+{
+    for (;;) {
+        while (*o < n && (d[*o] == ' ' || d[*o] == '\t' || d[*o] == '\r' || d[*o] == '\n'))
+            (*o)++;
+        if (*o < n && d[*o] == '#') {
+            while (*o < n && d[*o] != '\n')
+                (*o)++;
+            continue;
+        }
+        break;
+    }
+    long x = 0;
+    size_t start = *o;
+    while (*o < n && d[*o] >= '0' && d[*o] <= '9' && x <= 100000)
+        x = x * 10 + (d[(*o)++] - '0');
+    if (*o == start || x > 100000)
+        return false;
+    *v = (int)x;
+    return true;
+}
+
+bool rs_pnm_read(const char *path, rs_image *img, rs_err *err)
+{
+    memset(img, 0, sizeof *img);
+    size_t n;
+    uint8_t *d = (uint8_t *)rs_read_file(path, (size_t)RS_IMG_MAX_DIM * RS_IMG_MAX_DIM * 3 + 64, &n, err);
+    if (!d)
+        return false;
+    size_t o = 2;
+    int w, h, maxv, ch;
+    if (n < 2 || d[0] != 'P' || (d[1] != '5' && d[1] != '6')) {
+        rs_fail(err, RS_IMG_ERR_FORMAT, "%s: not a binary PPM/PGM (expected P5 or P6 at byte 0)", path);
+        goto fail;
+    }
+    ch = d[1] == '6' ? 3 : 1;
+    if (!pnm_int(d, n, &o, &w) || !pnm_int(d, n, &o, &h) || !pnm_int(d, n, &o, &maxv)) {
+        rs_fail(err, RS_IMG_ERR_FORMAT, "%s: bad header near byte %zu (expected width height maxval)", path, o);
+        goto fail;
+    }
+    if (w <= 0 || h <= 0 || w > RS_IMG_MAX_DIM || h > RS_IMG_MAX_DIM || maxv != 255) {
+        rs_fail(err, RS_IMG_ERR_FORMAT, "%s: unsupported size %dx%d or maxval %d (expected 1..%d, maxval 255)", path, w,
+                h, maxv, RS_IMG_MAX_DIM);
+        goto fail;
+    }
+    o++; /* the single whitespace byte after maxval */
+    size_t need = (size_t)w * h * ch;
+    if (o > n || n - o < need) {
+        rs_fail(err, RS_IMG_ERR_FORMAT, "%s: truncated: %zu pixel bytes at offset %zu, expected %zu", path,
+                o > n ? 0 : n - o, o, need);
+        goto fail;
+    }
+    img->px = malloc(need);
+    if (!img->px) {
+        rs_fail(err, RS_IMG_ERR_IO, "%s: out of memory", path);
+        goto fail;
+    }
+    memcpy(img->px, d + o, need);
+    img->w = w;
+    img->h = h;
+    img->channels = ch;
+    free(d);
+    return true;
+fail:
+    free(d);
+    return false;
+}
+
+static bool ends_with(const char *s, const char *suf)
+{
+    size_t a = strlen(s), b = strlen(suf);
+    return a >= b && strcmp(s + a - b, suf) == 0;
+}
+
+bool rs_image_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err)
+{
+    if (ends_with(path, ".png"))
+        return rs_png_write(path, w, h, channels, px, err);
+    if (ends_with(path, ".ppm") || ends_with(path, ".pgm"))
+        return rs_pnm_write(path, w, h, channels, px, err);
+    return rs_fail(err, RS_IMG_ERR_ARG, "%s: unknown image extension (expected .png, .ppm or .pgm)", path);
+}
+
+void rs_image_free(rs_image *img)
+{
+    free(img->px);
+    img->px = NULL;
+}
+
+void rs_flip_rows(uint8_t *px, int w, int h, int channels)
+{
+    size_t row = (size_t)w * channels;
+    uint8_t tmp[4096];
+    for (int y = 0; y < h / 2; y++) {
+        uint8_t *a = px + y * row, *b = px + (size_t)(h - 1 - y) * row;
+        for (size_t o = 0; o < row; o += sizeof tmp) {
+            size_t k = row - o < sizeof tmp ? row - o : sizeof tmp;
+            memcpy(tmp, a + o, k);
+            memcpy(a + o, b + o, k);
+            memcpy(b + o, tmp, k);
+        }
+    }
+}

@@ -1,0 +1,38 @@
+/* Dependency-free image files for tests, goldens and the smoke render.
+ *
+ * PNG is written with stored (uncompressed) deflate blocks: valid for every
+ * reader, no zlib needed.  Binary PPM/PGM (P6/P5) is read and written for
+ * golden images.  General image formats (EXR, TIFF, compressed PNG) belong
+ * to capture's OpenImageIO sink, not here.
+ *
+ * Pixels are 8-bit, rows top-down, `channels` of 1 (grey), 3 (RGB) or
+ * 4 (RGBA), tightly packed. */
+#ifndef RS_IMG_H
+#define RS_IMG_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rs_err.h"
+
+enum { RS_IMG_ERR_IO = 1, RS_IMG_ERR_FORMAT, RS_IMG_ERR_ARG };
+
+typedef struct rs_image {
+    int w, h, channels;
+    uint8_t *px;
+} rs_image;
+
+uint32_t rs_crc32(uint32_t crc, const void *data, size_t n);
+
+bool rs_png_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err);
+/* PPM (channels 3) or PGM (channels 1); RGBA is written as PPM without alpha. */
+bool rs_pnm_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err);
+bool rs_pnm_read(const char *path, rs_image *img, rs_err *err);
+/* Chooses PNG or PPM/PGM from the extension (.png, .ppm, .pgm). */
+bool rs_image_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err);
+void rs_image_free(rs_image *img);
+
+/* Reverses the row order in place (GL reads bottom-up). */
+void rs_flip_rows(uint8_t *px, int w, int h, int channels);
+
+#endif

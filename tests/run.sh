@@ -1,0 +1,39 @@
+#!/bin/sh
+# Runs every test binary in BUILD/tests and every tests/test_*.sh, and sums
+# their "N passed, N failed, N skipped" lines into one final line.
+#   tests/run.sh BUILD [NAME]    NAME: run only tests/test_NAME*
+set -u
+build=${1:-build}
+only=${2:-}
+here=$(cd "$(dirname "$0")" && pwd)
+export RS_BIN="$(cd "$build" && pwd)/ringside"
+# Leaks inside Mesa/LLVM are not ours: suppress them by library, keep ours.
+export LSAN_OPTIONS="suppressions=$here/lsan.supp:print_suppressions=0"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+
+pass=0 fail=0 skip=0
+start=$(date +%s)
+for t in "$build"/tests/test_* "$here"/test_*.sh; do
+    [ -e "$t" ] || continue
+    name=$(basename "$t" .sh)
+    case "$name" in *.d|*.o) continue ;; esac
+    [ -z "$only" ] || case "$name" in test_"$only"*) ;; *) continue ;; esac
+    echo "== $name"
+    log=$(mktemp)
+    if [ "${t%.sh}" != "$t" ]; then sh "$t" >"$log" 2>&1; else "$t" >"$log" 2>&1; fi
+    cat "$log"
+    line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$log" | tail -1)
+    rm -f "$log"
+    if [ -z "$line" ]; then
+        echo "FAIL $name: ended without a summary line (crashed?)"
+        fail=$((fail + 1))
+        continue
+    fi
+    set -- $line
+    pass=$((pass + $1)) fail=$((fail + $3))
+    [ "$#" -ge 6 ] && skip=$((skip + $5))
+done
+echo "tests took $(( $(date +%s) - start )) s"
+echo "$pass passed, $fail failed, $skip skipped"
+[ "$fail" = 0 ]

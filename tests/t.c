@@ -1,0 +1,173 @@
+#define _GNU_SOURCE /* mkdtemp, setenv */
+#include "t.h"
+
+#include <errno.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "../runtime/platform/plat.h"
+
+#define T_SKIP_CODE 77
+#define T_TIMEOUT_S 300
+
+static bool nofork;
+static jmp_buf jump;
+static int jump_code;
+static char tmpdir[256];
+
+_Noreturn void t_fail(const char *file, int line, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "    %s:%d: ", file, line);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    fflush(stderr);
+    if (nofork) {
+        jump_code = 1;
+        longjmp(jump, 1);
+    }
+    _exit(1);
+}
+
+_Noreturn void t_skip(const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "    skip: ");
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    fflush(stderr);
+    if (nofork) {
+        jump_code = T_SKIP_CODE;
+        longjmp(jump, 1);
+    }
+    _exit(T_SKIP_CODE);
+}
+
+const char *t_tmpdir(void)
+{
+    if (!tmpdir[0]) {
+        const char *base = getenv("TMPDIR");
+        snprintf(tmpdir, sizeof tmpdir, "%s/ringside-test-XXXXXX", base && *base ? base : "/tmp");
+        if (!mkdtemp(tmpdir))
+            t_fail(__FILE__, __LINE__, "mkdtemp %s: %s", tmpdir, strerror(errno));
+    }
+    return tmpdir;
+}
+
+void t_write(const char *dir, const char *name, const char *text)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    for (char *s = path + strlen(dir) + 1; (s = strchr(s, '/')) != NULL; s++) {
+        *s = 0;
+        mkdir(path, 0755);
+        *s = '/';
+    }
+    FILE *f = fopen(path, "w");
+    if (!f || fputs(text, f) < 0 || fclose(f) != 0)
+        t_fail(__FILE__, __LINE__, "cannot write %s", path);
+}
+
+struct plat *t_context(const char *backend)
+{
+    if (!plat_backend_built(backend))
+        t_skip("backend %s not built in (built: %s)", backend, plat_built_backends());
+    rs_err err = {0};
+    plat *p = plat_create(&(plat_desc){.backend = backend, .hidden = true, .debug = true}, &err);
+    if (!p)
+        t_fail(__FILE__, __LINE__, "%s context: %s", backend, err.msg);
+    return p;
+}
+
+static void rm_tree(const char *dir)
+{
+    if (!dir[0])
+        return;
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "    warning: could not remove %s\n", dir);
+}
+
+static bool selected(const char *name, int argc, char **argv)
+{
+    if (argc < 2)
+        return true;
+    for (int i = 1; i < argc; i++)
+        if (strstr(name, argv[i]))
+            return true;
+    return false;
+}
+
+int t_main(int argc, char **argv, const t_case *cases, size_t n)
+{
+    const char *suite = strrchr(argv[0], '/');
+    suite = suite ? suite + 1 : argv[0];
+#ifdef RS_SOURCE_DIR
+    setenv("RINGSIDE_DATA", RS_SOURCE_DIR, 0);
+#endif
+    nofork = getenv("T_NOFORK") && *getenv("T_NOFORK") == '1';
+    int pass = 0, fail = 0, skip = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!selected(cases[i].name, argc, argv))
+            continue;
+        fflush(stdout);
+        int code;
+        const char *why = "";
+        char whybuf[64];
+        if (nofork) {
+            jump_code = 0;
+            if (setjmp(jump) == 0)
+                cases[i].fn();
+            code = jump_code;
+            rm_tree(tmpdir);
+            tmpdir[0] = 0;
+        } else {
+            /* the directory is made by the parent so it can clean up after a crash */
+            t_tmpdir();
+            pid_t pid = fork();
+            if (pid == 0) {
+                alarm(T_TIMEOUT_S);
+                cases[i].fn();
+                fflush(stdout);
+                _exit(0);
+            }
+            int st = 0;
+            while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+            }
+            if (WIFEXITED(st)) {
+                code = WEXITSTATUS(st);
+            } else {
+                code = 1;
+                snprintf(whybuf, sizeof whybuf, " (%s %d)",
+                         WTERMSIG(st) == SIGALRM ? "timed out after" : "killed by signal",
+                         WTERMSIG(st) == SIGALRM ? T_TIMEOUT_S : WTERMSIG(st));
+                why = whybuf;
+            }
+            rm_tree(tmpdir);
+            tmpdir[0] = 0;
+        }
+        if (code == 0) {
+            pass++;
+            printf("ok   %s/%s\n", suite, cases[i].name);
+        } else if (code == T_SKIP_CODE) {
+            skip++;
+            printf("skip %s/%s\n", suite, cases[i].name);
+        } else {
+            fail++;
+            printf("FAIL %s/%s%s\n", suite, cases[i].name, why);
+        }
+        fflush(stdout);
+    }
+    printf("%d passed, %d failed, %d skipped\n", pass, fail, skip);
+    return fail ? 1 : 0;
+}

@@ -1,0 +1,74 @@
+#!/bin/sh
+# Installs the Debian packages a make target needs, and nothing more.
+#
+#   tools/deps.sh GROUP...      e.g. tools/deps.sh build test
+#
+# Each group is a short package list (below).  A group whose packages are all
+# present gets a stamp in $RS_DEPS_STAMPS (default build/deps), so the next
+# call costs one file comparison.  Missing packages are installed with
+# apt-get --no-install-recommends when we are root; otherwise the exact
+# command is printed and we fail.  Set RS_NO_INSTALL=1 to only check.
+set -eu
+
+group_pkgs() {
+    case "$1" in
+    # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window
+    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev" ;;
+    # X server for the GLFW backend's tests (xvfb-run needs xauth)
+    test) echo "xvfb xauth" ;;
+    *) echo "deps.sh: unknown group '$1' (known: build test)" >&2; return 1 ;;
+    esac
+}
+
+[ $# -gt 0 ] || { echo "usage: tools/deps.sh GROUP..." >&2; exit 2; }
+stamps=${RS_DEPS_STAMPS:-build/deps}
+
+todo=""
+for g in "$@"; do
+    pkgs=$(group_pkgs "$g")
+    if [ -f "$stamps/$g" ] && [ "$(cat "$stamps/$g")" = "$pkgs" ]; then
+        continue
+    fi
+    todo="$todo $g"
+done
+[ -n "$todo" ] || exit 0
+
+if ! command -v dpkg-query >/dev/null 2>&1; then
+    echo "deps.sh: no dpkg-query (not Debian?); make sure these are installed:" >&2
+    for g in $todo; do echo "  $(group_pkgs "$g")" >&2; done
+    exit 0
+fi
+
+missing=""
+for g in $todo; do
+    for p in $(group_pkgs "$g"); do
+        st=$(dpkg-query -W -f='${db:Status-Abbrev}' "$p" 2>/dev/null || true)
+        case "$st" in ii*) ;; *) missing="$missing $p" ;; esac
+    done
+done
+
+if [ -n "$missing" ]; then
+    if [ "$(id -u)" != 0 ] || [ "${RS_NO_INSTALL:-0}" = 1 ]; then
+        echo "deps.sh: missing Debian packages:$missing" >&2
+        echo "deps.sh: install them with:" >&2
+        echo "  sudo apt-get install -y --no-install-recommends$missing" >&2
+        exit 1
+    fi
+    echo "deps.sh: installing$missing" >&2
+    start=$(date +%s)
+    export DEBIAN_FRONTEND=noninteractive
+    # Package lists may be absent (fresh image) or stale: refresh once if the
+    # first attempt cannot find or fetch something.
+    if ! ls /var/lib/apt/lists/*_Packages >/dev/null 2>&1; then
+        apt-get update -q >&2
+    fi
+    # shellcheck disable=SC2086
+    if ! apt-get install -y -q --no-install-recommends $missing >&2; then
+        apt-get update -q >&2
+        apt-get install -y -q --no-install-recommends $missing >&2
+    fi
+    echo "deps.sh: installed in $(( $(date +%s) - start )) s" >&2
+fi
+
+mkdir -p "$stamps"
+for g in $todo; do group_pkgs "$g" >"$stamps/$g"; done
