@@ -30,7 +30,7 @@ ifeq ($(WERROR),1)
 CFLAGS_BASE += -Werror
 endif
 ifeq ($(SAN),1)
-CFLAGS_BASE += -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+CFLAGS_BASE += -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -DRS_SANITIZE
 LDFLAGS_SAN := -fsanitize=address,undefined
 OPT := -O1
 endif

@@ -5,7 +5,7 @@
 #   t_done
 # RS_BIN is the binary under test (tests/run.sh sets it).
 set -u
-: "${RS_BIN:=build/ringside}"
+: "${RS_BIN:=$(cd "$(dirname "$0")/.." && pwd)/build/ringside}"
 T_SUITE=$(basename "$0" .sh)
 t_pass=0 t_failed=0 t_skipped=0
 T_TMP=$(mktemp -d "${TMPDIR:-/tmp}/ringside-e2e-XXXXXX")

@@ -3,6 +3,11 @@
 # their "N passed, N failed, N skipped" lines into one final line.
 #   tests/run.sh BUILD [NAME]    NAME: run only tests/test_NAME*
 set -u
+# One X server for the whole run, so the GLFW backend is tested too; tests
+# that need "no display" unset DISPLAY themselves.
+if [ -z "${DISPLAY:-}" ] && [ -z "${RS_IN_XVFB:-}" ] && command -v xvfb-run >/dev/null 2>&1; then
+    RS_IN_XVFB=1 exec xvfb-run -a -s "-screen 0 1280x1024x24 -nolisten tcp" sh "$0" "$@"
+fi
 build=${1:-build}
 only=${2:-}
 here=$(cd "$(dirname "$0")" && pwd)

@@ -12,6 +12,10 @@
 
 #include "../runtime/platform/plat.h"
 
+#ifdef RS_SANITIZE
+#include <sanitizer/lsan_interface.h>
+#endif
+
 #define T_SKIP_CODE 77
 #define T_TIMEOUT_S 300
 
@@ -98,6 +102,15 @@ static void rm_tree(const char *dir)
         fprintf(stderr, "    warning: could not remove %s\n", dir);
 }
 
+/* setjmp lives here so t_main's locals are not clobbered by longjmp */
+static int run_inline(void (*fn)(void))
+{
+    jump_code = 0;
+    if (setjmp(jump) == 0)
+        fn();
+    return jump_code;
+}
+
 static bool selected(const char *name, int argc, char **argv)
 {
     if (argc < 2)
@@ -125,10 +138,7 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
         const char *why = "";
         char whybuf[64];
         if (nofork) {
-            jump_code = 0;
-            if (setjmp(jump) == 0)
-                cases[i].fn();
-            code = jump_code;
+            code = run_inline(cases[i].fn);
             rm_tree(tmpdir);
             tmpdir[0] = 0;
         } else {
@@ -139,6 +149,11 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
                 alarm(T_TIMEOUT_S);
                 cases[i].fn();
                 fflush(stdout);
+#ifdef RS_SANITIZE
+                /* _exit skips LeakSanitizer's exit-time check: run it here */
+                if (__lsan_do_recoverable_leak_check())
+                    _exit(1);
+#endif
                 _exit(0);
             }
             int st = 0;

@@ -126,7 +126,7 @@ static void t_png_roundtrip(void)
     size_t n;
     uint8_t *f = (uint8_t *)rs_read_file(path, 1 << 24, &n, &e);
     T_ASSERT(f);
-    int gw, gh, ct;
+    int gw = 0, gh = 0, ct = 0;
     size_t rn;
     uint8_t *raw = png_decode_stored(f, n, &gw, &gh, &ct, &rn);
     T_EQ(gw, w);

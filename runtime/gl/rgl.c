@@ -52,7 +52,10 @@ bool rgl_has_extension(const char *name)
 static void APIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
                               const GLchar *msg, const void *user)
 {
-    (void)source, (void)id, (void)length, (void)user;
+    (void)id, (void)length, (void)user;
+    /* compile errors are reported by r_shader with file:line, not here */
+    if (source == GL_DEBUG_SOURCE_SHADER_COMPILER)
+        return;
     if (type == GL_DEBUG_TYPE_ERROR)
         error_count++;
     if (severity == GL_DEBUG_SEVERITY_NOTIFICATION)

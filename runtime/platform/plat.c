@@ -1,3 +1,4 @@
+#define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE: sanitizer builds only */
 #include "plat.h"
 
 #include <stdio.h>
@@ -56,6 +57,29 @@ bool plat_backend_built(const char *name)
     return find(name) != NULL;
 }
 
+#ifdef RS_SANITIZE
+#include <dlfcn.h>
+#include <link.h>
+/* GL drivers are dlclose()d at eglTerminate, before LeakSanitizer reports at
+ * exit; their leaks then show as "<unknown module>" and no suppression by
+ * library name can match them.  Pin every loaded object so reports name it. */
+static int pin_one(struct dl_phdr_info *info, size_t size, void *data)
+{
+    (void)size, (void)data;
+    if (info->dlpi_name && info->dlpi_name[0])
+        dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    return 0;
+}
+static void pin_modules(void)
+{
+    dl_iterate_phdr(pin_one, NULL);
+}
+#else
+static void pin_modules(void)
+{
+}
+#endif
+
 static void *getproc(void *user, const char *name)
 {
     plat *p = user;
@@ -76,6 +100,7 @@ static plat *try_backend(const plat_backend *be, const plat_desc *d, rs_err *err
         free(p);
         return NULL;
     }
+    pin_modules();
     if (!rgl_load(getproc, p, d->gl_major, d->gl_minor, d->debug, err)) {
         err->code = PLAT_ERR_GL;
         rs_err_prefix(err, "%s", be->name);

@@ -27,10 +27,11 @@ static bool put(r_src *s, const char *p, size_t n, rs_err *err)
     return true;
 }
 
-static bool putf(r_src *s, rs_err *err, const char *fmt, int a, int b)
+/* "#line" for `line` of file `idx`; see R_SHADER_LINE_BASE. */
+static bool put_line(r_src *s, rs_err *err, int line, int idx)
 {
     char buf[64];
-    int n = snprintf(buf, sizeof buf, fmt, a, b);
+    int n = snprintf(buf, sizeof buf, "#line %ld %d\n", (long)idx * R_SHADER_LINE_BASE + line, idx);
     return put(s, buf, (size_t)n, err);
 }
 
@@ -97,7 +98,10 @@ static bool expand(r_src *s, const char *root, const char *name, const char *def
         const char *next = eol ? eol + 1 : end;
         if (!eol)
             eol = end;
-        line++;
+        if (++line >= R_SHADER_LINE_BASE) {
+            ok = rs_fail(err, R_SHADER_ERR_SYNTAX, "%s: more than %d lines", disp, R_SHADER_LINE_BASE - 1);
+            break;
+        }
         const char *arg;
         if (!seen_version) {
             if ((arg = directive(p, eol, "version")) != NULL) {
@@ -107,7 +111,7 @@ static bool expand(r_src *s, const char *root, const char *name, const char *def
                     ok = put(s, defines, strlen(defines), err) &&
                          (defines[strlen(defines) - 1] == '\n' || put(s, "\n", 1, err));
                 }
-                ok = ok && putf(s, err, "#line %d %d\n", line + 1, idx);
+                ok = ok && put_line(s, err, line + 1, idx);
             } else if (is_blank_or_comment(p, eol)) {
                 ok = put(s, p, (size_t)(next - p), err);
             } else {
@@ -122,8 +126,8 @@ static bool expand(r_src *s, const char *root, const char *name, const char *def
             char inc[160], here[300];
             snprintf(inc, sizeof inc, "%.*s", (int)(qe - q - 1), q + 1);
             snprintf(here, sizeof here, "%s:%d", disp, line);
-            ok = putf(s, err, "#line %d %d\n", 1, s->nfiles) &&
-                 expand(s, root, inc, NULL, depth + 1, here, err) && putf(s, err, "#line %d %d\n", line + 1, idx);
+            ok = put_line(s, err, 1, s->nfiles) && expand(s, root, inc, NULL, depth + 1, here, err) &&
+                 put_line(s, err, line + 1, idx);
         } else if (depth > 0 && directive(p, eol, "version")) {
             ok = rs_fail(err, R_SHADER_ERR_SYNTAX, "%s:%d: #version in an included file", disp, line);
         } else {
@@ -227,8 +231,10 @@ int r_log_translate(const r_src *s, const char *log, char *out, size_t n)
             continue;
         long file = 0, line = 0;
         const char *kind, *msg = parse_loc(ln, &file, &line, &kind);
+        file = line / R_SHADER_LINE_BASE; /* the reported source number is not trusted */
+        line %= R_SHADER_LINE_BASE;
         int k;
-        if (msg && file >= 0 && file < s->nfiles)
+        if (msg && file < s->nfiles)
             k = snprintf(out + o, n - o, "%s:%ld: %s%s\n", s->files[file], line, kind, msg);
         else
             k = snprintf(out + o, n - o, "%s: %s\n", s->nfiles ? s->files[0] : "shader", ln);
@@ -262,7 +268,7 @@ static void first_line(rs_err *err, int code, const char *log, int lines)
     const char *eol = strchr(log, '\n');
     int len = eol ? (int)(eol - log) : (int)strlen(log);
     if (lines > 1)
-        rs_fail(err, code, "%.*s (and %d more lines; `ringside shaders` prints them all)", len, log, lines - 1);
+        rs_fail(err, code, "%.*s (+%d more; `ringside shaders` prints all)", len, log, lines - 1);
     else
         rs_fail(err, code, "%.*s", len, log);
 }

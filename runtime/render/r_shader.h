@@ -3,8 +3,10 @@
  * A shader file starts with its own #version (330 core or newer).  Lines of
  * the form  #include "name.glsl"  pull in another file from shaders/ (nested
  * up to R_SHADER_MAX_DEPTH; use #ifndef guards for shared headers).  The
- * loader emits #line directives with one source-string number per file, so
- * the driver's log can be mapped back: every compile error reads
+ * loader emits #line directives that carry the file in the line number
+ * itself (file index * R_SHADER_LINE_BASE + line; the source-string number
+ * is set too, but Mesa reports it wrongly for some errors), so the driver's
+ * log maps back to the file: every compile error reads
  *     shaders/name.frag:LINE: error: ...
  * whatever driver produced it (Mesa "0:12(3):", NVIDIA "0(12) :",
  * AMD/ANGLE "ERROR: 0:12:").
@@ -23,6 +25,7 @@
 #define R_SHADER_MAX_FILES 16
 #define R_SHADER_MAX_DEPTH 8
 #define R_SHADER_MAX_BYTES (1u << 20)
+#define R_SHADER_LINE_BASE 100000 /* also the line limit per file */
 
 enum {
     R_SHADER_ERR_FILE = 1, /* missing or unreadable file, or no data dir */

@@ -1,0 +1,117 @@
+#!/bin/sh
+# End-to-end: the real build/ringside binary, as a user runs it.
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/lib.sh"
+SRC=$(cd "$here/.." && pwd)
+
+t_help() {
+    "$RS_BIN" --help >h.txt || return 1
+    for w in info smoke shaders bench RINGSIDE_DATA "exit status"; do
+        grep -q "$w" h.txt || { echo "--help lacks $w"; return 1; }
+    done
+    for c in info smoke shaders; do
+        "$RS_BIN" $c --help | grep -q "usage: ringside $c" || { echo "$c --help"; return 1; }
+    done
+    "$RS_BIN" help smoke | grep -q "usage: ringside smoke" || return 1
+    "$RS_BIN" --version | grep -Eq '^ringside [0-9]+\.[0-9]+\.[0-9]+$' || return 1
+}
+
+t_usage_errors() {
+    expect_fail 2 "unknown command 'frobnicate'" "$RS_BIN" frobnicate || return 1
+    expect_fail 2 "see 'ringside info --help'" "$RS_BIN" info --bogus || return 1
+    expect_fail 2 "expected WIDTHxHEIGHT" "$RS_BIN" smoke --size 12by9 || return 1
+    expect_fail 2 "at least 16" "$RS_BIN" smoke --size 8x8 -o x.png || return 1
+    expect_fail 2 "unknown image extension" "$RS_BIN" smoke -o x.jpg || return 1
+    expect_fail 1 "unknown backend 'dx12'" "$RS_BIN" info --backend dx12 || return 1
+    [ ! -e x.png ] || { echo "x.png written on a usage error"; return 1; }
+}
+
+info_reports_core() { # backend [wrapper command...]
+    b=$1
+    shift
+    "$@" "$RS_BIN" info --backend "$b" >i.txt 2>e.txt || { cat e.txt; return 1; }
+    grep -q "^backend *$b " i.txt || { echo "backend line"; cat i.txt; return 1; }
+    ver=$(sed -n 's/^context *\([0-9]*\)\.\([0-9]*\) core.*/\1\2/p' i.txt)
+    [ -n "$ver" ] && [ "$ver" -ge 33 ] || { echo "not a core >= 3.3 context"; cat i.txt; return 1; }
+    for k in vendor renderer version glsl "max texture" "float targets" fences "timer queries" "buffer storage"; do
+        grep -q "^$k " i.txt || { echo "info lacks '$k'"; return 1; }
+    done
+}
+
+# headless backends need no display at all
+t_info_egl() { info_reports_core egl env -u DISPLAY -u WAYLAND_DISPLAY; }
+t_info_osmesa() { info_reports_core osmesa env -u DISPLAY -u WAYLAND_DISPLAY; }
+
+t_info_glfw_xvfb() {
+    if [ -n "${DISPLAY:-}" ]; then info_reports_core glfw; return; fi
+    command -v xvfb-run >/dev/null || t_skip_case "no DISPLAY and xvfb-run not installed"
+    info_reports_core glfw xvfb-run -a
+}
+
+t_info_glfw_no_display() {
+    env -u DISPLAY -u WAYLAND_DISPLAY "$RS_BIN" info --backend glfw >out.txt 2>err.txt
+    rc=$?
+    [ $rc = 1 ] || { echo "exit $rc, want 1"; return 1; }
+    [ "$(wc -l <err.txt)" = 1 ] || { echo "want one line:"; cat err.txt; return 1; }
+    grep -q "glfw: cannot open a window" err.txt || { cat err.txt; return 1; }
+}
+
+t_info_falls_back() {
+    __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent __EGL_VENDOR_LIBRARY_DIRS=/nonexistent \
+        "$RS_BIN" info >i.txt 2>e.txt || { cat e.txt; return 1; }
+    grep -q "^backend *osmesa" i.txt || { echo "did not fall back"; cat i.txt; return 1; }
+    grep -q "egl unavailable, using osmesa" e.txt || { echo "no note on stderr"; return 1; }
+}
+
+t_smoke_both_backends() {
+    "$RS_BIN" smoke --backend egl -o egl/a.png 2>e.txt || { cat e.txt; return 1; }
+    "$RS_BIN" smoke --backend osmesa -o b.png 2>>e.txt || { cat e.txt; return 1; }
+    grep -q "matches the reference exactly" e.txt || return 1
+    cmp egl/a.png b.png || { echo "egl and osmesa pictures differ"; return 1; }
+    [ "$(head -c 8 b.png | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || { echo "not a PNG"; return 1; }
+    [ ! -e b.png.part ] || return 1
+}
+
+# a copy of the data dir with one shader changed
+data_copy() { mkdir -p data && cp -r "$SRC/shaders" data/ && export RINGSIDE_DATA=$PWD/data; }
+
+t_broken_shader_names_file_line() {
+    data_copy
+    printf '#version 330 core\nout vec4 c;\nvoid main() {\n    c = vec4(1.0) +;\n}\n' >data/shaders/smoke.frag
+    expect_fail 1 "shaders/smoke.frag:4: " "$RS_BIN" smoke -o s.png || return 1
+    [ "$(wc -l <err.txt)" = 1 ] || { echo "want one line:"; cat err.txt; return 1; }
+    [ ! -e s.png ] && [ ! -e s.png.part ] || { echo "output left behind"; return 1; }
+    "$RS_BIN" shaders >sh.txt 2>&1
+    [ $? = 1 ] || { echo "shaders: want exit 1"; cat sh.txt; return 1; }
+    grep -q "shaders/smoke.frag:4: error" sh.txt || { cat sh.txt; return 1; }
+    grep -q "^ok .*smoke.vert" sh.txt || { cat sh.txt; return 1; }
+}
+
+t_wrong_picture_is_caught() {
+    data_copy
+    sed 's/o_color = u_color;/o_color = u_color.bgra;/' "$SRC/shaders/smoke.frag" >data/shaders/smoke.frag
+    expect_fail 1 "pixels differ from the reference" "$RS_BIN" smoke --size 64x48 -o w.png || return 1
+}
+
+t_missing_data_dir() {
+    expect_fail 1 "RINGSIDE_DATA=/nonexistent: no shaders/" env RINGSIDE_DATA=/nonexistent "$RS_BIN" smoke -o x.png
+}
+
+t_installed_layout() {
+    make -s -C "$SRC" install BUILD="$(dirname "$RS_BIN")" PREFIX="$PWD/prefix" >/dev/null || return 1
+    env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" shaders --quiet >o.txt 2>&1 || { cat o.txt; return 1; }
+    grep -q "0 failed" o.txt || return 1
+    env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" smoke --size 32x32 -o i.png 2>/dev/null || return 1
+}
+
+t_bench_platform() {
+    "$RS_BIN" bench platform --size 64x64 --frames 3 --runs 2 --csv b.csv >b.txt 2>&1 || { cat b.txt; return 1; }
+    grep -q "^egl " b.txt && grep -q "^osmesa " b.txt && grep -q "^ratio osmesa/egl" b.txt || { cat b.txt; return 1; }
+    [ "$(wc -l <b.csv)" = 3 ] || { cat b.csv; return 1; }
+    expect_fail 2 "unknown benchmark 'gpu'" "$RS_BIN" bench gpu || return 1
+}
+
+t_run help usage_errors info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
+    smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
+    installed_layout bench_platform
+t_done
