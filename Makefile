@@ -59,6 +59,8 @@ MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
 .PHONY: all test asan debug demo bench install uninstall clean help deps
 .DEFAULT_GOAL := all
+# keep test objects (they are intermediates of a pattern chain) between builds
+.SECONDARY:
 
 all: $(BUILD)/ringside
 
