@@ -48,7 +48,7 @@ CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
 LDLIBS  = $(CONF_LIBS) -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
-LIB_SRC := $(wildcard runtime/util/*.c runtime/gl/*.c runtime/platform/*.c runtime/render/*.c) \
+LIB_SRC := $(wildcard runtime/*/*.c) \
            $(filter-out runtime/main.c,$(wildcard runtime/*.c))
 MAIN_SRC := runtime/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
@@ -57,7 +57,7 @@ TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
-.PHONY: all test asan debug demo bench install uninstall clean help deps
+.PHONY: all test asan debug demo bench install uninstall clean help deps demo-replays
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -114,12 +114,23 @@ demo: $(BUILD)/ringside
 bench: $(BUILD)/ringside
 	@mkdir -p out
 	$(BUILD)/ringside bench platform --csv out/bench-platform.csv
+	$(BUILD)/ringside bench sim --csv out/bench-sim.csv
+
+# The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
+# same commands must reproduce them byte for byte (tests/test_replay.sh).
+DEMO_REPLAYS := dojo:1 harbor:7 temple:23
+demo-replays: $(BUILD)/ringside
+	@for d in $(DEMO_REPLAYS); do \
+	    stage=$${d%%:*} seed=$${d##*:}; \
+	    $(BUILD)/ringside record --ai --quiet --stage $$stage --seed $$seed -o demos/$$stage.rsr || exit 1; \
+	done
 
 # --- install ---
 install: $(BUILD)/ringside
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/ringside/shaders
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/ringside/shaders $(DESTDIR)$(PREFIX)/share/ringside/demos
 	install -m 755 $(BUILD)/ringside $(DESTDIR)$(PREFIX)/bin/ringside
 	install -m 644 shaders/* $(DESTDIR)$(PREFIX)/share/ringside/shaders/
+	install -m 644 demos/*.rsr $(DESTDIR)$(PREFIX)/share/ringside/demos/
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/ringside

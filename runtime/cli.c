@@ -4,6 +4,9 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+#include "game/g_game.h"
 
 void cli_error(const char *cmd, const char *fmt, ...)
 {
@@ -52,4 +55,21 @@ bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
     *w = (int)a;
     *h = (int)b;
     return true;
+}
+
+bool cli_stage(const char *arg, int *stage)
+{
+    for (int i = 0; i < G_STAGES; i++) {
+        char num[8];
+        snprintf(num, sizeof num, "%d", i);
+        if (!strcmp(arg, g_stages[i].name) || !strcmp(arg, num)) {
+            *stage = i;
+            return true;
+        }
+    }
+    fprintf(stderr, "ringside: --stage '%s': unknown stage (expected", arg);
+    for (int i = 0; i < G_STAGES; i++)
+        fprintf(stderr, "%s %d/%s", i ? "," : "", i, g_stages[i].name);
+    fprintf(stderr, ")\n");
+    return false;
 }

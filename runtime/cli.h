@@ -27,5 +27,10 @@ int cmd_info(int argc, char **argv);
 int cmd_smoke(int argc, char **argv);
 int cmd_shaders(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+int cmd_record(int argc, char **argv);
+int cmd_replay(int argc, char **argv);
+
+/* Stage by name ("dojo") or number; prints a usage error on failure. */
+bool cli_stage(const char *arg, int *stage);
 
 #endif

@@ -1,7 +1,9 @@
 /* ringside bench: benchmarks that print ratios measured in one run.
  *
  *   bench platform   the headless backends side by side on the smoke scene:
- *                    context start-up, draw, draw + glReadPixels. */
+ *                    context start-up, draw, draw + glReadPixels.
+ *   bench sim        a synthetic long CPU-vs-CPU replay (24 hours by default):
+ *                    record, encode, decode and verify speed, sizes. */
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,13 +11,20 @@
 #include <time.h>
 
 #include "cli.h"
+#include "game/g_ai.h"
 #include "gl/rgl.h"
+#include "replay/rp.h"
+#include "util/rs_progress.h"
 #include "platform/plat.h"
 #include "render/r_smoke.h"
 
 static void help(void)
 {
-    printf("usage: ringside bench platform [--size WxH] [--frames N] [--runs N] [--csv FILE]\n\n"
+    printf("usage: ringside bench platform [--size WxH] [--frames N] [--runs N] [--csv FILE]\n"
+           "       ringside bench sim [--hours H] [--csv FILE] [--quiet]\n\n"
+           "bench sim records a synthetic CPU-vs-CPU replay of H hours of continuous\n"
+           "matches (default 24: 5,184,000 ticks), encodes it, decodes it and verifies\n"
+           "every checkpoint, printing ticks per second for each step and the sizes.\n\n"
            "Times every headless backend built in (egl, osmesa) in one run on the smoke\n"
            "scene: context start-up, draw (glFinish), and draw + full-frame glReadPixels.\n"
            "Each figure is the median over the runs; the ratio line compares backends\n"
@@ -24,6 +33,12 @@ static void help(void)
            "  --frames N    frames per run (default 60)\n"
            "  --runs N      runs per backend (default 5)\n"
            "  --csv FILE    also write the table as CSV\n");
+}
+
+static void on_progress(uint64_t done, uint64_t total, void *user)
+{
+    (void)total;
+    rs_progress_update(user, done);
 }
 
 static double now_ms(void)
@@ -92,14 +107,124 @@ static bool bench_backend(const char *name, int w, int h, int frames, int runs, 
     return true;
 }
 
+static int bench_sim(int argc, char **argv)
+{
+    static const struct option opts[] = {{"hours", required_argument, 0, 'H'},
+                                         {"csv", required_argument, 0, 'c'},
+                                         {"quiet", no_argument, 0, 'q'},
+                                         {"help", no_argument, 0, 'h'},
+                                         {0}};
+    long hours = 24;
+    const char *csv = NULL;
+    bool quiet = false;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'H':
+            if (!cli_int("--hours", optarg, 1, 168, &hours))
+                return RS_EXIT_USAGE;
+            break;
+        case 'c': csv = optarg; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default:
+            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
+            return cli_usage_error("bench");
+        }
+    }
+    uint64_t ticks = (uint64_t)hours * 3600 * G_HZ;
+    rs_err err = {0};
+    g_state st;
+    g_ai cpu[2];
+    g_init(&st, 1, 2024);
+    g_ai_init(&cpu[0], 0, 2, 11);
+    g_ai_init(&cpu[1], 1, 3, 12);
+    rp_recorder rec;
+    rp_rec_init(&rec, 1, 2024, RP_CPU, RP_CPU);
+    rs_progress prog;
+    int status = RS_EXIT_FAIL;
+    uint8_t *buf = NULL;
+    size_t len = 0, size_3min = 0;
+    rp_replay back = {0};
+
+    rs_progress_start(&prog, "record", "ticks", ticks, quiet);
+    while (st.tick < ticks) {
+        g_input in[2] = {g_ai_input(&cpu[0], &st), g_ai_input(&cpu[1], &st)};
+        g_step(&st, in, NULL);
+        if (!rp_rec_tick(&rec, in, &st, &err))
+            goto done;
+        if ((st.tick & 0xffff) == 0)
+            rs_progress_update(&prog, st.tick);
+        if (st.tick == 180 * G_HZ) { /* the size of a 3-minute replay */
+            uint8_t *b3;
+            if (!rp_encode(&rec.rp, &b3, &size_3min, &err))
+                goto done;
+            free(b3);
+        }
+    }
+    double t_rec = rs_progress_end(&prog);
+    double t0 = rs_now();
+    if (!rp_encode(&rec.rp, &buf, &len, &err))
+        goto done;
+    double t_enc = rs_now() - t0;
+    t0 = rs_now();
+    if (!rp_decode(buf, len, "synthetic replay", &back, &err))
+        goto done;
+    double t_dec = rs_now() - t0;
+    rs_progress_start(&prog, "verify", "ticks", ticks, quiet);
+    rp_verify_result res;
+    bool ran = rp_verify(&back, NULL, on_progress, &prog, &res, &err);
+    double t_ver = rs_progress_end(&prog);
+    if (!ran)
+        goto done;
+    if (!res.ok) {
+        rs_fail(&err, 1, "synthetic replay desynced at tick %llu: the simulation is not deterministic",
+                (unsigned long long)res.desync_tick);
+        goto done;
+    }
+    printf("bench sim: %ld h of CPU-vs-CPU matches, %llu ticks, %d matches finished, stage %s\n", hours,
+           (unsigned long long)ticks, st.matches, g_stages[st.stage].name);
+    printf("%-22s %12s %14s\n", "step", "seconds", "ticks/s");
+    printf("%-22s %12.3f %14.0f\n", "record (AI + hash)", t_rec, ticks / t_rec);
+    printf("%-22s %12.3f %14.0f\n", "encode", t_enc, ticks / t_enc);
+    printf("%-22s %12.3f %14.0f\n", "decode", t_dec, ticks / t_dec);
+    printf("%-22s %12.3f %14.0f\n", "verify (simulate)", t_ver, ticks / t_ver);
+    printf("replay size: %zu bytes for %ld h (%.1f bytes/s of play); a 3-minute replay: %zu bytes\n", len, hours,
+           len / (hours * 3600.0), size_3min);
+    printf("verify: all %zu checkpoints and the final hash match; goal >= 200000 ticks/s: %s\n", back.ncheck,
+           ticks / t_ver >= 200000 ? "met" : "NOT met");
+    if (csv) {
+        FILE *f = fopen(csv, "w");
+        if (!f || fprintf(f, "hours,ticks,record_tps,encode_tps,decode_tps,verify_tps,bytes,bytes_3min\n"
+                             "%ld,%llu,%.0f,%.0f,%.0f,%.0f,%zu,%zu\n",
+                          hours, (unsigned long long)ticks, ticks / t_rec, ticks / t_enc, ticks / t_dec, ticks / t_ver,
+                          len, size_3min) < 0 || fclose(f) != 0) {
+            rs_fail(&err, 1, "%s: cannot write", csv);
+            goto done;
+        }
+    }
+    status = RS_EXIT_OK;
+done:
+    if (status != RS_EXIT_OK)
+        cli_error("bench", "%s", err.msg);
+    free(buf);
+    rp_free(&back);
+    rp_free(&rec.rp);
+    return status;
+}
+
 int cmd_bench(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
         help();
         return argc < 2 ? RS_EXIT_USAGE : RS_EXIT_OK;
     }
+    if (!strcmp(argv[1], "sim"))
+        return bench_sim(argc - 1, argv + 1);
     if (strcmp(argv[1], "platform") != 0) {
-        cli_error("bench", "unknown benchmark '%s' (expected: platform)", argv[1]);
+        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim)", argv[1]);
         return RS_EXIT_USAGE;
     }
     static const struct option opts[] = {{"size", required_argument, 0, 's'},  {"frames", required_argument, 0, 'f'},

@@ -1,0 +1,134 @@
+/* ringside record: a headless CPU-vs-CPU match written as a replay.  No GL. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "game/g_ai.h"
+#include "game/g_game.h"
+#include "replay/rp.h"
+#include "util/rs_file.h"
+#include "util/rs_progress.h"
+
+#define MATCH_LIMIT_S 600
+
+static void help(void)
+{
+    printf("usage: ringside record --ai -o FILE [--seconds N] [--seed S] [--stage NAME] [--level L] [--quiet]\n\n"
+           "Plays a CPU-vs-CPU match headless (no GL needed) and writes it as a replay\n"
+           "(.rsr, see docs/replay-format.md).  The file is read back and compared with\n"
+           "what was recorded before it is put in place.\n\n"
+           "  --ai          both players are the CPU (required: to record people, use\n"
+           "                'ringside play --record')\n"
+           "  -o FILE       output replay\n"
+           "  --seconds N   record exactly N seconds of game time; matches follow one\n"
+           "                another (default: until the first match is over, at most %d s)\n"
+           "  --seed S      game and CPU random seed (default 1)\n"
+           "  --stage NAME  dojo, harbor or temple, or 0..%d (default dojo)\n"
+           "  --level L     CPU skill 0..3 (default 2)\n"
+           "  --quiet       no progress line\n",
+           MATCH_LIMIT_S, G_STAGES - 1);
+}
+
+int cmd_record(int argc, char **argv)
+{
+    static const struct option opts[] = {{"ai", no_argument, 0, 'a'},          {"output", required_argument, 0, 'o'},
+                                         {"seconds", required_argument, 0, 's'}, {"seed", required_argument, 0, 'S'},
+                                         {"stage", required_argument, 0, 't'},  {"level", required_argument, 0, 'l'},
+                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {0}};
+    const char *out = NULL;
+    bool ai = false, quiet = false;
+    long seconds = 0, level = 2;
+    uint64_t seed = 1;
+    int stage = 0, c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'a': ai = true; break;
+        case 'o': out = optarg; break;
+        case 's':
+            if (!cli_int("--seconds", optarg, 1, (long)(RP_MAX_TICKS / G_HZ), &seconds))
+                return RS_EXIT_USAGE;
+            break;
+        case 'S': {
+            char *end;
+            seed = strtoull(optarg, &end, 0);
+            if (*end || end == optarg || optarg[0] == '-') {
+                cli_error("record", "--seed '%s': expected a non-negative whole number", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        }
+        case 't':
+            if (!cli_stage(optarg, &stage))
+                return RS_EXIT_USAGE;
+            break;
+        case 'l':
+            if (!cli_int("--level", optarg, 0, 3, &level))
+                return RS_EXIT_USAGE;
+            break;
+        case 'q': quiet = true; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default:
+            cli_error("record", "bad option or missing value '%s'", argv[optind - 1]);
+            return cli_usage_error("record");
+        }
+    }
+    if (optind < argc) {
+        cli_error("record", "unexpected argument '%s'", argv[optind]);
+        return cli_usage_error("record");
+    }
+    if (!ai) {
+        cli_error("record", "--ai is required (headless recording is CPU vs CPU; use 'ringside play --record' for people)");
+        return RS_EXIT_USAGE;
+    }
+    if (!out) {
+        cli_error("record", "-o FILE is required");
+        return RS_EXIT_USAGE;
+    }
+
+    rs_err err = {0};
+    g_state st;
+    g_ai cpu[2];
+    g_init(&st, stage, seed);
+    g_ai_init(&cpu[0], 0, (int)level, seed);
+    g_ai_init(&cpu[1], 1, (int)level, seed + 1);
+    rp_recorder rec;
+    rp_rec_init(&rec, stage, seed, RP_CPU, RP_CPU);
+    uint64_t limit = seconds ? (uint64_t)seconds * G_HZ : (uint64_t)MATCH_LIMIT_S * G_HZ;
+    rs_progress prog;
+    rs_progress_start(&prog, "record", "ticks", limit, quiet);
+    int status = RS_EXIT_FAIL;
+    while (st.tick < limit) {
+        g_input in[2] = {g_ai_input(&cpu[0], &st), g_ai_input(&cpu[1], &st)};
+        g_step(&st, in, NULL);
+        if (!rp_rec_tick(&rec, in, &st, &err))
+            goto done;
+        if (!seconds && st.matches > 0)
+            break; /* the first match is over, announcement included */
+        if ((st.tick & 0xfff) == 0)
+            rs_progress_update(&prog, st.tick);
+    }
+    rs_progress_end(&prog);
+    if (!rs_mkdirs_for(out, &err) || !rp_rec_save(&rec, out, &err))
+        goto done;
+    const rp_replay *rp = &rec.rp;
+    fprintf(stderr, "ringside record: wrote %s: %" PRIu64 " ticks (%.2f s), stage %s, seed %" PRIu64 ", ", out, rp->ticks,
+            rp->ticks / (double)G_HZ, g_stages[stage].name, seed);
+    if (rp->winner > 0)
+        fprintf(stderr, "winner P%d (%d-%d)\n", rp->winner, rp->rounds[0], rp->rounds[1]);
+    else if (rp->winner == 0)
+        fprintf(stderr, "draw (%d-%d)\n", rp->rounds[0], rp->rounds[1]);
+    else
+        fprintf(stderr, "match unfinished (%d-%d)\n", rp->rounds[0], rp->rounds[1]);
+    status = RS_EXIT_OK;
+done:
+    if (status != RS_EXIT_OK)
+        cli_error("record", "%s", err.msg);
+    rp_free(&rec.rp);
+    return status;
+}

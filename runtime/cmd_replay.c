@@ -1,0 +1,161 @@
+/* ringside replay info|verify: look into a replay, or re-simulate it and
+ * check every checkpoint.  No GL. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "replay/rp.h"
+#include "util/rs_progress.h"
+
+static void help(void)
+{
+    printf("usage: ringside replay info FILE\n"
+           "       ringside replay verify FILE [--hashes OUT] [--quiet]\n\n"
+           "info    prints the header: stage, seed, duration, players, winner, sizes.\n"
+           "verify  re-simulates every tick from the recorded inputs (no GL) and checks\n"
+           "        every state-hash checkpoint and the final hash.  On a mismatch it\n"
+           "        prints the first checkpoint tick that differs and exits 1.\n\n"
+           "  --hashes OUT  also write \"tick hash\" for every tick to OUT ('-' for stdout)\n"
+           "  --quiet       no progress line\n");
+}
+
+static void duration(uint64_t ticks, char *buf, size_t n)
+{
+    uint64_t cs = ticks * 100 / G_HZ;
+    snprintf(buf, n, "%" PRIu64 ":%02" PRIu64 ".%02" PRIu64, cs / 6000, cs / 100 % 60, cs % 100);
+}
+
+static void winner_text(int winner, const int rounds[2], char *buf, size_t n)
+{
+    if (winner > 0)
+        snprintf(buf, n, "P%d, rounds %d-%d", winner, rounds[0], rounds[1]);
+    else if (winner == 0)
+        snprintf(buf, n, "draw, rounds %d-%d", rounds[0], rounds[1]);
+    else
+        snprintf(buf, n, "none (match unfinished, rounds %d-%d)", rounds[0], rounds[1]);
+}
+
+static int info(const char *path)
+{
+    rp_replay rp;
+    rs_err err = {0};
+    if (!rp_read(path, &rp, &err)) {
+        cli_error("replay", "%s", err.msg);
+        return RS_EXIT_FAIL;
+    }
+    uint8_t *buf;
+    size_t n = 0;
+    if (rp_encode(&rp, &buf, &n, &err))
+        free(buf);
+    char dur[32], win[64];
+    duration(rp.ticks, dur, sizeof dur);
+    winner_text(rp.winner, rp.rounds, win, sizeof win);
+    printf("file         %s (%zu bytes, inputs %zu bytes)\n", path, n, rp.input_bytes);
+    printf("format       version %d\n", rp.version);
+    printf("stage        %d (%s)\n", rp.stage, g_stages[rp.stage].name);
+    printf("seed         %" PRIu64 "\n", rp.seed);
+    printf("duration     %" PRIu64 " ticks, %s\n", rp.ticks, dur);
+    printf("players      P1 %s, P2 %s\n", rp.kind[0] ? "cpu" : "human", rp.kind[1] ? "cpu" : "human");
+    printf("winner       %s\n", win);
+    printf("checkpoints  %zu, every %d ticks\n", rp.ncheck, rp.interval);
+    printf("final hash   %016" PRIx64 "\n", rp.final_hash);
+    rp_free(&rp);
+    return RS_EXIT_OK;
+}
+
+static void on_progress(uint64_t done, uint64_t total, void *user)
+{
+    (void)total;
+    rs_progress_update(user, done);
+}
+
+static int verify(const char *path, const char *hashes_path, bool quiet)
+{
+    rp_replay rp;
+    rs_err err = {0};
+    if (!rp_read(path, &rp, &err)) {
+        cli_error("replay", "%s", err.msg);
+        return RS_EXIT_FAIL;
+    }
+    FILE *hf = NULL;
+    if (hashes_path) {
+        hf = strcmp(hashes_path, "-") ? fopen(hashes_path, "w") : stdout;
+        if (!hf) {
+            cli_error("replay", "%s: cannot create", hashes_path);
+            rp_free(&rp);
+            return RS_EXIT_FAIL;
+        }
+    }
+    rs_progress prog;
+    rs_progress_start(&prog, "verify", "ticks", rp.ticks, quiet);
+    rp_verify_result res;
+    bool ran = rp_verify(&rp, hf, on_progress, &prog, &res, &err);
+    double secs = rs_progress_end(&prog);
+    if (hf && hf != stdout && fclose(hf) != 0 && ran)
+        ran = rs_fail(&err, RP_ERR_IO, "%s: write failed", hashes_path);
+    int status = RS_EXIT_FAIL;
+    if (!ran) {
+        cli_error("replay", "%s: %s", path, err.msg);
+    } else if (!res.ok) {
+        fprintf(stderr,
+                "ringside replay: %s: desync at tick %" PRIu64 ": state hash %016" PRIx64 ", recorded %016" PRIx64
+                " (last matching checkpoint: tick %" PRIu64 "; the inputs diverge in ticks %" PRIu64 "..%" PRIu64 ")\n",
+                path, res.desync_tick, res.got, res.want, res.last_good_tick, res.last_good_tick + 1, res.desync_tick);
+    } else {
+        char win[64];
+        winner_text(res.winner, res.rounds, win, sizeof win);
+        fprintf(stderr,
+                "ringside replay: %s: ok: %" PRIu64 " ticks, %zu checkpoints and the final hash match; winner %s "
+                "(%.0f ticks/s)\n",
+                path, rp.ticks, rp.ncheck, win, secs > 0 ? rp.ticks / secs : 0.0);
+        status = RS_EXIT_OK;
+    }
+    rp_free(&rp);
+    return status;
+}
+
+int cmd_replay(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        help();
+        return argc < 2 ? RS_EXIT_USAGE : RS_EXIT_OK;
+    }
+    const char *sub = argv[1];
+    if (strcmp(sub, "info") && strcmp(sub, "verify")) {
+        cli_error("replay", "unknown subcommand '%s' (expected info or verify)", sub);
+        return RS_EXIT_USAGE;
+    }
+    static const struct option opts[] = {
+        {"hashes", required_argument, 0, 'H'}, {"quiet", no_argument, 0, 'q'}, {"help", no_argument, 0, 'h'}, {0}};
+    const char *hashes = NULL;
+    bool quiet = false;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc - 1, argv + 1, "qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'H': hashes = optarg; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default:
+            cli_error("replay", "bad option or missing value '%s'", argv[optind]);
+            return cli_usage_error("replay");
+        }
+    }
+    if (optind + 1 != argc - 1) {
+        cli_error("replay", "%s needs exactly one FILE", sub);
+        return cli_usage_error("replay");
+    }
+    const char *file = argv[optind + 1];
+    if (!strcmp(sub, "info")) {
+        if (hashes) {
+            cli_error("replay", "--hashes belongs to 'replay verify'");
+            return RS_EXIT_USAGE;
+        }
+        return info(file);
+    }
+    return verify(file, hashes, quiet);
+}

@@ -1,0 +1,84 @@
+/* Replay files (.rsr): key inputs of both players, tick by tick, with state
+ * hash checkpoints.  The format is documented in docs/replay-format.md.
+ *
+ * Reading is strict and bounded: every error names the file, the byte
+ * offset and what was expected, and nothing is allocated beyond what the
+ * file's own (checked) sizes justify, capped by RP_MAX_FILE and
+ * RP_MAX_TICKS. */
+#ifndef RP_H
+#define RP_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "../game/g_game.h"
+#include "../util/rs_err.h"
+
+#define RP_MAGIC "RSRP"
+#define RP_VERSION 1
+#define RP_HEADER_BYTES 36
+#define RP_MAX_FILE (64u << 20)
+#define RP_MAX_TICKS (7ull * 24 * 3600 * G_HZ) /* a week of play */
+#define RP_DEFAULT_INTERVAL 60
+
+enum { RP_ERR_IO = 1, RP_ERR_FORMAT, RP_ERR_VERSION, RP_ERR_CHECKSUM, RP_ERR_DESYNC, RP_ERR_ARG };
+enum { RP_HUMAN = 0, RP_CPU = 1 };
+
+typedef struct rp_replay {
+    int version;
+    int stage;
+    uint64_t seed;
+    uint64_t ticks;
+    int interval;         /* ticks between checkpoints */
+    int kind[2];          /* RP_HUMAN / RP_CPU */
+    int winner;           /* first match: -1 unfinished, 0 draw, 1, 2 */
+    int rounds[2];        /* rounds won in the first match (or so far) */
+    g_input *inputs;      /* 2 * ticks: p1, p2 for tick 1, then tick 2, ... */
+    uint64_t *checkpoints; /* hash after tick k * interval, k = 1..ncheck */
+    size_t ncheck;
+    uint64_t final_hash;  /* hash after the last tick */
+    size_t input_bytes;   /* size of the encoded input section */
+} rp_replay;
+
+/* --- recording --- */
+typedef struct rp_recorder {
+    rp_replay rp;
+    size_t cap_ticks, cap_check;
+    bool failed;
+} rp_recorder;
+
+void rp_rec_init(rp_recorder *r, int stage, uint64_t seed, int kind1, int kind2);
+/* After g_step: the inputs of that tick and the state they produced. */
+bool rp_rec_tick(rp_recorder *r, const g_input in[2], const g_state *after, rs_err *err);
+/* Writes the file (.part, read back and compared, then renamed).  The
+ * recorder keeps its data; free it with rp_free(&r->rp). */
+bool rp_rec_save(rp_recorder *r, const char *path, rs_err *err);
+
+/* --- bytes and files --- */
+/* Encodes into a malloc'd buffer. */
+bool rp_encode(const rp_replay *rp, uint8_t **out, size_t *len, rs_err *err);
+/* name is used in messages (a path, or "upload"). */
+bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, rs_err *err);
+bool rp_read(const char *path, rp_replay *rp, rs_err *err);
+bool rp_write(const char *path, const rp_replay *rp, rs_err *err);
+void rp_free(rp_replay *rp);
+
+/* --- verification: simulation only, no GL --- */
+typedef struct rp_verify_result {
+    bool ok;
+    uint64_t desync_tick;   /* first checkpoint tick whose hash differs (0 if none) */
+    uint64_t last_good_tick; /* last checkpoint that matched */
+    uint64_t want, got;
+    int winner;             /* of the first match, as simulated */
+    int rounds[2];
+} rp_verify_result;
+
+/* Steps the game through every tick; checks every checkpoint and the final
+ * hash.  hashes (optional) gets "tick hash" per tick.  progress (optional)
+ * is called every 2^16 ticks. */
+bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t done, uint64_t total, void *user),
+               void *user, rp_verify_result *res, rs_err *err);
+
+#endif
