@@ -40,8 +40,23 @@ OPT := -O0
 endif
 
 STAMPS := build/deps
-ifeq ($(filter clean help,$(MAKECMDGOALS)),)
+# Goals that build nothing must not install packages or configure.
+NOBUILD_GOALS := clean help uninstall
+ifneq ($(filter clean,$(MAKECMDGOALS)),)
+ifneq ($(filter-out clean,$(MAKECMDGOALS)),)
+$(error run 'make clean' on its own, then 'make $(filter-out clean,$(MAKECMDGOALS))')
+endif
+endif
+ifneq ($(MAKECMDGOALS),)
+ifeq ($(filter-out $(NOBUILD_GOALS),$(MAKECMDGOALS)),)
+SKIP_CONFIG := 1
+endif
+endif
+ifneq ($(SKIP_CONFIG),1)
 -include $(BUILD)/config.mk
+# Objects depend on the compile flags: `make SAN=1` after `make` rebuilds.
+FLAGS_SIG := $(CC) $(CFLAGS_BASE) $(OPT) $(EXTRA_CFLAGS) $(CURDIR)
+$(shell mkdir -p $(BUILD) && (echo '$(FLAGS_SIG)' | cmp -s - $(BUILD)/flags || echo '$(FLAGS_SIG)' > $(BUILD)/flags))
 endif
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
@@ -76,7 +91,7 @@ $(BUILD)/config.mk: tools/configure.sh $(STAMPS)/build
 	@tools/configure.sh > $@.tmp && mv $@.tmp $@
 
 # --- build ---
-$(BUILD)/obj/%.o: %.c $(BUILD)/config.mk
+$(BUILD)/obj/%.o: %.c $(BUILD)/config.mk $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -c $< -o $@
 
@@ -87,7 +102,7 @@ $(BUILD)/libringside.a: $(LIB_OBJ)
 $(BUILD)/ringside: $(MAIN_OBJ) $(BUILD)/libringside.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-$(BUILD)/obj/tests/%.o: tests/%.c $(BUILD)/config.mk
+$(BUILD)/obj/tests/%.o: tests/%.c $(BUILD)/config.mk $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -DRS_SOURCE_DIR='"$(CURDIR)"' -c $< -o $@
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "game/g_game.h"
+#include "platform/plat.h"
 
 void cli_error(const char *cmd, const char *fmt, ...)
 {
@@ -72,4 +73,9 @@ bool cli_stage(const char *arg, int *stage)
         fprintf(stderr, "%s %d/%s", i ? "," : "", i, g_stages[i].name);
     fprintf(stderr, ")\n");
     return false;
+}
+
+int cli_plat_status(const struct rs_err *err)
+{
+    return err->code == PLAT_ERR_UNKNOWN_BACKEND ? RS_EXIT_USAGE : RS_EXIT_FAIL;
 }

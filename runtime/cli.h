@@ -30,6 +30,10 @@ int cmd_bench(int argc, char **argv);
 int cmd_record(int argc, char **argv);
 int cmd_replay(int argc, char **argv);
 
+/* Exit status for a failed plat_create: 2 for an unknown backend name. */
+struct rs_err;
+int cli_plat_status(const struct rs_err *err);
+
 /* Stage by name ("dojo") or number; prints a usage error on failure. */
 bool cli_stage(const char *arg, int *stage);
 

@@ -14,6 +14,7 @@
 #include "game/g_ai.h"
 #include "gl/rgl.h"
 #include "replay/rp.h"
+#include "util/rs_file.h"
 #include "util/rs_progress.h"
 #include "platform/plat.h"
 #include "render/r_smoke.h"
@@ -82,6 +83,11 @@ static bool bench_backend(const char *name, int w, int h, int frames, int runs, 
     r->create_ms = now_ms() - t0;
     snprintf(r->renderer, sizeof r->renderer, "%s", glcaps.renderer);
     uint8_t *px = malloc((size_t)w * h * 4);
+    if (!px) {
+        r_smoke_destroy(s);
+        plat_destroy(p);
+        return rs_fail(err, 1, "out of memory for a %dx%d frame", w, h);
+    }
     double draw[64], rd[64];
     r_smoke_draw(s); /* warm-up: shader JIT, first allocation */
     gl.Finish();
@@ -196,7 +202,7 @@ static int bench_sim(int argc, char **argv)
     printf("verify: all %zu checkpoints and the final hash match; goal >= 200000 ticks/s: %s\n", back.ncheck,
            ticks / t_ver >= 200000 ? "met" : "NOT met");
     if (csv) {
-        FILE *f = fopen(csv, "w");
+        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
         if (!f || fprintf(f, "hours,ticks,record_tps,encode_tps,decode_tps,verify_tps,bytes,bytes_3min\n"
                              "%ld,%llu,%.0f,%.0f,%.0f,%.0f,%zu,%zu\n",
                           hours, (unsigned long long)ticks, ticks / t_rec, ticks / t_enc, ticks / t_dec, ticks / t_ver,
@@ -281,8 +287,9 @@ int cmd_bench(int argc, char **argv)
     if (nres == 2)
         printf("ratio osmesa/egl: draw %.2f, draw+read %.2f (>1: osmesa slower)\n", res[1].draw_ms / res[0].draw_ms,
                res[1].read_ms / res[0].read_ms);
-    if (csv) {
-        FILE *f = fopen(csv, "w");
+    if (csv && nres) {
+        rs_err err = {0};
+        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
         if (!f) {
             cli_error("bench", "%s: cannot create", csv);
             return RS_EXIT_FAIL;

@@ -48,7 +48,7 @@ int cmd_info(int argc, char **argv)
     plat *p = plat_create(&d, &err);
     if (!p) {
         cli_error("info", "%s", err.msg);
-        return RS_EXIT_FAIL;
+        return cli_plat_status(&err);
     }
     if (plat_fallback_reason(p)[0])
         fprintf(stderr, "ringside info: egl unavailable, using %s: %s\n", plat_backend_name(p), plat_fallback_reason(p));

@@ -48,6 +48,10 @@ int cmd_shaders(int argc, char **argv)
             return cli_usage_error("shaders");
         }
     }
+    if (optind < argc) {
+        cli_error("shaders", "unexpected argument '%s'", argv[optind]);
+        return cli_usage_error("shaders");
+    }
     rs_err err = {0};
     const char *root = rs_data_dir(&err);
     if (!root) {
@@ -64,9 +68,18 @@ int cmd_shaders(int argc, char **argv)
     char *names[512];
     int n = 0;
     struct dirent *de;
-    while ((de = readdir(dp)) != NULL && n < 512)
-        if (r_shader_stage(de->d_name))
-            names[n++] = strdup(de->d_name);
+    while ((de = readdir(dp)) != NULL) {
+        if (!r_shader_stage(de->d_name))
+            continue;
+        if (n == 512 || !(names[n] = strdup(de->d_name))) {
+            cli_error("shaders", "%s: more than 512 shader files (or out of memory)", dir);
+            for (int i = 0; i < n; i++)
+                free(names[i]);
+            closedir(dp);
+            return RS_EXIT_FAIL;
+        }
+        n++;
+    }
     closedir(dp);
     qsort(names, (size_t)n, sizeof names[0], by_name);
 
@@ -75,7 +88,7 @@ int cmd_shaders(int argc, char **argv)
         cli_error("shaders", "%s", err.msg);
         for (int i = 0; i < n; i++)
             free(names[i]);
-        return RS_EXIT_FAIL;
+        return cli_plat_status(&err);
     }
     int failed = 0;
     for (int i = 0; i < n; i++) {

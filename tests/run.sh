@@ -17,7 +17,7 @@ export LSAN_OPTIONS="suppressions=$here/lsan.supp:print_suppressions=0"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 
-pass=0 fail=0 skip=0
+pass=0 fail=0 skip=0 ran=0
 start=$(date +%s)
 for t in "$build"/tests/test_* "$here"/test_*.sh; do
     [ -e "$t" ] || continue
@@ -26,19 +26,30 @@ for t in "$build"/tests/test_* "$here"/test_*.sh; do
     [ -z "$only" ] || case "$name" in test_"$only"*) ;; *) continue ;; esac
     echo "== $name"
     log=$(mktemp)
+    ran=$((ran + 1))
     if [ "${t%.sh}" != "$t" ]; then sh "$t" >"$log" 2>&1; else "$t" >"$log" 2>&1; fi
+    rc=$?
     cat "$log"
     line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$log" | tail -1)
     rm -f "$log"
     if [ -z "$line" ]; then
-        echo "FAIL $name: ended without a summary line (crashed?)"
+        echo "FAIL $name: ended without a summary line (exit $rc; crashed?)"
         fail=$((fail + 1))
         continue
     fi
     set -- $line
     pass=$((pass + $1)) fail=$((fail + $3))
     [ "$#" -ge 6 ] && skip=$((skip + $5))
+    # a crash or sanitizer report after the summary still fails
+    if [ "$rc" != 0 ] && [ "$3" = 0 ]; then
+        echo "FAIL $name: exit status $rc although no case failed"
+        fail=$((fail + 1))
+    fi
 done
+if [ "$ran" = 0 ]; then
+    echo "FAIL: no test matched '${only}' (tests are named test_<module>)"
+    fail=$((fail + 1))
+fi
 echo "tests took $(( $(date +%s) - start )) s"
 echo "$pass passed, $fail failed, $skip skipped"
 [ "$fail" = 0 ]

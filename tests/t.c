@@ -129,6 +129,17 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
     setenv("RINGSIDE_DATA", RS_SOURCE_DIR, 0);
 #endif
     nofork = getenv("T_NOFORK") && *getenv("T_NOFORK") == '1';
+    if (nofork) {
+        /* in-process cases share environment and cwd: allow exactly one */
+        size_t sel = 0;
+        for (size_t i = 0; i < n; i++)
+            sel += selected(cases[i].name, argc, argv);
+        if (sel != 1) {
+            fprintf(stderr, "T_NOFORK=1 runs one case in-process (for a debugger); %zu match, name one\n", sel);
+            printf("0 passed, 1 failed, 0 skipped\n");
+            return 1;
+        }
+    }
     int pass = 0, fail = 0, skip = 0;
     for (size_t i = 0; i < n; i++) {
         if (!selected(cases[i].name, argc, argv))

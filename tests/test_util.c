@@ -2,6 +2,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -159,6 +161,27 @@ static void t_png_failure_leaves_nothing(void)
     T_CONTAINS(e.msg, "cannot write a 0x16 image");
 }
 
+static void t_png_disk_full(void)
+{
+    /* a file size limit makes the write itself fail half way (as a full
+     * disk does): an error naming the file, and no .part left behind */
+    signal(SIGXFSZ, SIG_IGN);
+    struct rlimit rl = {4096, 4096};
+    T_ASSERT(setrlimit(RLIMIT_FSIZE, &rl) == 0);
+    static uint8_t px[256 * 256 * 3];
+    char path[512], part[600];
+    snprintf(path, sizeof path, "%s/big.png", t_tmpdir());
+    snprintf(part, sizeof part, "%s.part", path);
+    rs_err e = {0};
+    T_ASSERT(!rs_png_write(path, 256, 256, 3, px, &e));
+    T_CONTAINS(e.msg, "big.png: write failed: File too large");
+    T_ASSERT(access(path, F_OK) != 0 && access(part, F_OK) != 0);
+    T_ASSERT(!rs_pnm_write(path, 256, 256, 3, px, &e)); /* wrong extension for PPM */
+    snprintf(path, sizeof path, "%s/big.ppm", t_tmpdir());
+    T_ASSERT(!rs_pnm_write(path, 256, 256, 3, px, &e));
+    T_CONTAINS(e.msg, "big.ppm: write failed: File too large");
+}
+
 static void t_pnm_roundtrip(void)
 {
     uint8_t px[5 * 3 * 3];
@@ -247,5 +270,6 @@ static void t_flip_rows(void)
 
 T_MAIN({"err_one_line", t_err_one_line}, {"read_file_limits", t_read_file_limits},
        {"png_roundtrip", t_png_roundtrip}, {"png_failure_leaves_nothing", t_png_failure_leaves_nothing},
+       {"png_disk_full", t_png_disk_full},
        {"pnm_roundtrip", t_pnm_roundtrip}, {"pnm_bad_input", t_pnm_bad_input},
        {"pnm_random_corruption", t_pnm_random_corruption}, {"flip_rows", t_flip_rows})

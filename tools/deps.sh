@@ -27,6 +27,7 @@ todo=""
 for g in "$@"; do
     pkgs=$(group_pkgs "$g")
     if [ -f "$stamps/$g" ] && [ "$(cat "$stamps/$g")" = "$pkgs" ]; then
+        touch "$stamps/$g" # newer than deps.sh again: make stops asking
         continue
     fi
     todo="$todo $g"

@@ -73,9 +73,10 @@ static void APIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum seve
 static bool probe_float_rt(void)
 {
     GLuint tex = 0, fbo = 0;
-    GLint old_tex = 0, old_fbo = 0;
+    GLint old_tex = 0, old_draw = 0, old_read = 0;
     gl.GetIntegerv(GL_TEXTURE_BINDING_2D, &old_tex);
-    gl.GetIntegerv(GL_FRAMEBUFFER_BINDING, &old_fbo);
+    gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &old_draw);
+    gl.GetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &old_read);
     gl.GenTextures(1, &tex);
     gl.BindTexture(GL_TEXTURE_2D, tex);
     gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, 4, 4, 0, GL_RGBA, GL_FLOAT, NULL);
@@ -83,7 +84,8 @@ static bool probe_float_rt(void)
     gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
     bool ok = gl.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-    gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)old_fbo);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)old_draw);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)old_read);
     gl.BindTexture(GL_TEXTURE_2D, (GLuint)old_tex);
     gl.DeleteFramebuffers(1, &fbo);
     gl.DeleteTextures(1, &tex);
@@ -135,9 +137,6 @@ bool rgl_load(rgl_getproc getproc, void *user, int min_major, int min_minor, boo
     while (gl.GetError() != GL_NO_ERROR) {
         /* a probe above may legitimately fail; start clean */
     }
-    const char *env = getenv("RINGSIDE_GL_DEBUG");
-    if (env && *env && strcmp(env, "0") != 0)
-        debug = true;
     if (debug && glcaps.khr_debug) {
         gl.Enable(GL_DEBUG_OUTPUT);
         gl.Enable(GL_DEBUG_OUTPUT_SYNCHRONOUS);

@@ -130,6 +130,9 @@ plat *plat_create(const plat_desc *desc, rs_err *err)
 #ifdef RS_DEBUG
     d.debug = true;
 #endif
+    const char *dbg = getenv("RINGSIDE_GL_DEBUG");
+    if (dbg && *dbg && strcmp(dbg, "0") != 0)
+        d.debug = true;
     const char *name = d.backend && *d.backend ? d.backend : "auto";
     if (strcmp(name, "auto") != 0) {
         const plat_backend *be = find(name);

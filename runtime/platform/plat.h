@@ -45,7 +45,7 @@ typedef struct plat_desc {
     bool hidden;         /* glfw: do not show the window (info, tests) */
     bool fullscreen;     /* glfw: primary monitor, its current mode */
     bool no_vsync;       /* glfw: swap interval 0 */
-    bool debug;          /* debug context + KHR_debug logging (RINGSIDE_GL_DEBUG=1 too) */
+    bool debug;          /* debug context + KHR_debug logging; RINGSIDE_GL_DEBUG=1 sets it */
     int gl_major, gl_minor; /* minimum version; 0 -> 3.3 */
 } plat_desc;
 

@@ -10,6 +10,8 @@
  * RINGSIDE_EGL_DEVICE=N forces device N of the enumeration.
  * Plain eglGetDisplay(EGL_DEFAULT_DISPLAY) is never used: without X it fails
  * or picks a platform by guesswork. */
+#ifdef RS_HAVE_EGL /* configure.sh found the library; otherwise this file is empty */
+
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <stdio.h>
@@ -24,8 +26,43 @@
 
 #define MAX_DEVICES 16
 
+/* eglGetPlatformDisplayEXT returns the same EGLDisplay for the same device,
+ * and eglTerminate ends it for every context on it.  Count our users per
+ * display and terminate with the last one. */
+static struct {
+    EGLDisplay dpy;
+    int users;
+} displays[MAX_DEVICES + 1];
+
+static void display_ref(EGLDisplay dpy)
+{
+    int free_slot = -1;
+    for (int i = 0; i <= MAX_DEVICES; i++) {
+        if (displays[i].users && displays[i].dpy == dpy) {
+            displays[i].users++;
+            return;
+        }
+        if (!displays[i].users && free_slot < 0)
+            free_slot = i;
+    }
+    if (free_slot >= 0) {
+        displays[free_slot].dpy = dpy;
+        displays[free_slot].users = 1;
+    }
+}
+
+/* true when this was the last user */
+static bool display_unref(EGLDisplay dpy)
+{
+    for (int i = 0; i <= MAX_DEVICES; i++)
+        if (displays[i].users && displays[i].dpy == dpy)
+            return --displays[i].users == 0;
+    return true;
+}
+
 typedef struct egl_impl {
     EGLDisplay dpy;
+    bool counted; /* display_ref() was called */
     EGLContext ctx;
     EGLSurface surf; /* 1x1 pbuffer only when surfaceless contexts are missing */
 } egl_impl;
@@ -68,6 +105,8 @@ static bool make_context(plat *p, egl_impl *im, char *why, size_t whyn)
         snprintf(why, whyn, "eglInitialize: %s", egl_error_name(eglGetError()));
         return false;
     }
+    display_ref(im->dpy);
+    im->counted = true;
     const char *ext = eglQueryString(im->dpy, EGL_EXTENSIONS);
     bool v15 = major > 1 || (major == 1 && minor >= 5);
     if (!v15 && !has_ext(ext, "EGL_KHR_create_context")) {
@@ -99,8 +138,10 @@ static bool make_context(plat *p, egl_impl *im, char *why, size_t whyn)
     attr[k++] = EGL_CONTEXT_OPENGL_PROFILE_MASK_KHR;
     attr[k++] = EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT_KHR;
     if (p->desc.debug) {
-        attr[k++] = EGL_CONTEXT_FLAGS_KHR;
-        attr[k++] = EGL_CONTEXT_OPENGL_DEBUG_BIT_KHR;
+        /* the KHR flag where the extension is present, EGL 1.5's own otherwise */
+        bool khr = has_ext(ext, "EGL_KHR_create_context");
+        attr[k++] = khr ? EGL_CONTEXT_FLAGS_KHR : EGL_CONTEXT_OPENGL_DEBUG;
+        attr[k++] = khr ? EGL_CONTEXT_OPENGL_DEBUG_BIT_KHR : EGL_TRUE;
     }
     attr[k] = EGL_NONE;
     im->ctx = eglCreateContext(im->dpy, cfg, EGL_NO_CONTEXT, attr);
@@ -129,12 +170,15 @@ static void release(egl_impl *im)
 {
     if (im->dpy == EGL_NO_DISPLAY)
         return;
-    eglMakeCurrent(im->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (eglGetCurrentContext() == im->ctx)
+        eglMakeCurrent(im->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (im->surf != EGL_NO_SURFACE)
         eglDestroySurface(im->dpy, im->surf);
     if (im->ctx != EGL_NO_CONTEXT)
         eglDestroyContext(im->dpy, im->ctx);
-    eglTerminate(im->dpy);
+    if (!im->counted || display_unref(im->dpy))
+        eglTerminate(im->dpy);
+    im->counted = false;
     im->dpy = EGL_NO_DISPLAY;
     im->ctx = EGL_NO_CONTEXT;
     im->surf = EGL_NO_SURFACE;
@@ -293,3 +337,7 @@ const plat_backend plat_egl_backend = {
     .poll = egl_poll,
     .destroy = egl_destroy,
 };
+
+#else
+typedef int plat_egl_not_built; /* ISO C wants something in a file */
+#endif

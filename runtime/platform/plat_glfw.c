@@ -3,6 +3,8 @@
  * GLFW is initialised on the first window and terminated with the last; its
  * error callback writes into a buffer so a failure (no DISPLAY, no GLX) comes
  * back as one line through rs_err instead of GLFW's own stderr output. */
+#ifdef RS_HAVE_GLFW /* configure.sh found the library; otherwise this file is empty */
+
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <stdio.h>
@@ -41,8 +43,14 @@ static bool glfw_create(plat *p, rs_err *err)
     glfwWindowHint(GLFW_STENCIL_BITS, 8);
     GLFWmonitor *mon = p->desc.fullscreen ? glfwGetPrimaryMonitor() : NULL;
     int w = p->desc.width, h = p->desc.height;
-    if (mon) {
-        const GLFWvidmode *m = glfwGetVideoMode(mon);
+    const GLFWvidmode *m = mon ? glfwGetVideoMode(mon) : NULL;
+    if (p->desc.fullscreen && !m) {
+        if (live_windows == 0)
+            glfwTerminate();
+        return rs_fail(err, PLAT_ERR_NO_DISPLAY, "glfw: --fullscreen: no monitor or video mode: %s",
+                       last_error[0] ? last_error : "unknown error");
+    }
+    if (m) {
         w = m->width;
         h = m->height;
         glfwWindowHint(GLFW_REFRESH_RATE, m->refreshRate);
@@ -111,3 +119,7 @@ const plat_backend plat_glfw_backend = {
     .size = glfw_size,
     .destroy = glfw_destroy,
 };
+
+#else
+typedef int plat_glfw_not_built; /* ISO C wants something in a file */
+#endif

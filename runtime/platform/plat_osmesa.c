@@ -4,6 +4,8 @@
  *
  * Only <GL/osmesa.h> is included here (it drags in GL/gl.h, which must not
  * meet glcorearb.h in one file); GL calls go through rgl like elsewhere. */
+#ifdef RS_HAVE_OSMESA /* configure.sh found the library; otherwise this file is empty */
+
 #include <GL/osmesa.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -95,3 +97,7 @@ const plat_backend plat_osmesa_backend = {
     .poll = osm_poll,
     .destroy = osm_destroy,
 };
+
+#else
+typedef int plat_osmesa_not_built; /* ISO C wants something in a file */
+#endif

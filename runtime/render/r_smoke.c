@@ -80,6 +80,16 @@ void r_smoke_reference(int w, int h, uint8_t *rgba)
     }
 }
 
+size_t r_smoke_compare(const uint8_t *got, const uint8_t *want, int w, int h, size_t *first)
+{
+    size_t bad = 0;
+    *first = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        if (memcmp(got + 4 * i, want + 4 * i, 4) && !bad++)
+            *first = i;
+    return bad;
+}
+
 struct r_smoke {
     int w, h, nshapes;
     shape shapes[8];
@@ -137,6 +147,7 @@ r_smoke *r_smoke_create(int w, int h, rs_err *err)
     gl.EnableVertexAttribArray(0);
     gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, NULL);
     gl.BindVertexArray(0);
+    gl.BindBuffer(GL_ARRAY_BUFFER, 0);
 
     gl.GenTextures(1, &s->tex);
     gl.BindTexture(GL_TEXTURE_2D, s->tex);
@@ -148,6 +159,7 @@ r_smoke *r_smoke_create(int w, int h, rs_err *err)
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, s->tex, 0);
     GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
         rs_fail(err, 1, "smoke scene: RGBA8 %dx%d framebuffer incomplete (%s)", w, h, rgl_enum_name(st));
         r_smoke_destroy(s);
@@ -180,6 +192,7 @@ void r_smoke_draw(r_smoke *s)
     }
     gl.BindVertexArray(0);
     gl.UseProgram(0);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     RGL_CHECK("r_smoke_draw");
 }
 
@@ -189,6 +202,7 @@ void r_smoke_read(r_smoke *s, uint8_t *rgba)
     gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl.ReadPixels(0, 0, s->w, s->h, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     rs_flip_rows(rgba, s->w, s->h, 4);
     RGL_CHECK("r_smoke_read");

@@ -9,6 +9,7 @@
 #define R_SMOKE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "../util/rs_err.h"
@@ -27,5 +28,8 @@ void r_smoke_destroy(r_smoke *s);
 
 /* The exact expected picture, rows top-down. */
 void r_smoke_reference(int w, int h, uint8_t *rgba);
+
+/* Number of RGBA pixels that differ; *first gets the index of the first. */
+size_t r_smoke_compare(const uint8_t *got, const uint8_t *want, int w, int h, size_t *first);
 
 #endif

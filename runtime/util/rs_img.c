@@ -117,6 +117,7 @@ bool rs_png_write(const char *path, int w, int h, int channels, const uint8_t *p
         return rs_fail(err, RS_IMG_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
     }
     static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    errno = 0;
     bool ok = fwrite(sig, 1, 8, f) == 8 && png_chunk(f, "IHDR", ihdr, 13) && png_chunk(f, "IDAT", z, (uint32_t)o) &&
               png_chunk(f, "IEND", NULL, 0);
     int saved = errno;
@@ -129,16 +130,22 @@ bool rs_png_write(const char *path, int w, int h, int channels, const uint8_t *p
     return rs_commit_file(path, err);
 }
 
+static bool ends_with(const char *s, const char *suf);
+
 bool rs_pnm_write(const char *path, int w, int h, int channels, const uint8_t *px, rs_err *err)
 {
     if (!check_args(path, w, h, channels, err))
         return false;
+    if (ends_with(path, ".pgm") != (channels == 1))
+        return rs_fail(err, RS_IMG_ERR_ARG, "%s: %s", path,
+                       channels == 1 ? "a grey image is written as .pgm" : "a colour image is written as .ppm or .png");
     char part[PATH_MAX + 8];
     rs_part_path(path, part, sizeof part);
     FILE *f = fopen(part, "wb");
     if (!f)
         return rs_fail(err, RS_IMG_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
     int out_ch = channels == 1 ? 1 : 3;
+    errno = 0;
     bool ok = fprintf(f, "P%d\n%d %d\n255\n", out_ch == 1 ? 5 : 6, w, h) > 0;
     for (size_t i = 0; ok && i < (size_t)w * h; i++)
         ok = fwrite(px + i * channels, 1, out_ch, f) == (size_t)out_ch;
