@@ -82,6 +82,7 @@ void g_init(g_state *st, int stage, uint64_t seed)
     memset(st, 0, sizeof *st);
     st->stage = stage >= 0 && stage < G_STAGES ? stage : 0;
     st->rng = seed;
+    st->input_digest = G_FNV_OFFSET;
     st->match_winner = -1;
     if (g_stages[st->stage].storm)
         st->flash_in = 300 + (int32_t)(rng_next(&st->rng) % 900);
@@ -397,6 +398,7 @@ void g_step(g_state *st, const g_input in_raw[2], g_events *ev)
         ev->n = 0;
     g_input in[2] = {g_input_clean(in_raw[0]), g_input_clean(in_raw[1])};
     st->tick++;
+    st->input_digest = g_fnv1a(st->input_digest, in, 2);
     st->phase_ticks++;
     if (st->tick == 1)
         emit(ev, G_EV_ROUND, 0, st->round);
@@ -489,6 +491,7 @@ size_t g_serialize(const g_state *st, uint8_t *buf)
                            st->round_winner, st->match_winner, st->matches, st->flash_in, st->flash};
     for (size_t k = 0; k < sizeof top / sizeof top[0]; k++)
         p = put32(p, top[k]);
+    p = put64(p, st->input_digest);
     for (int i = 0; i < 2; i++) {
         const g_fighter *f = &st->f[i];
         const int32_t v[] = {f->x, f->y, f->vx, f->vy, f->facing, f->move, f->frame, f->health, f->stun, f->hit_done,

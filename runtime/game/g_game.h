@@ -93,6 +93,10 @@ typedef struct g_fighter {
 typedef struct g_state {
     uint64_t tick;
     uint64_t rng;
+    /* FNV-1a of every input so far: the state hash then certifies the input
+     * history too, so an input that changed nothing on screen (a button in
+     * the round intro) still shows at the next checkpoint */
+    uint64_t input_digest;
     int32_t stage;
     int32_t phase;        /* g_phase */
     int32_t phase_ticks;

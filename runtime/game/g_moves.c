@@ -74,8 +74,8 @@ static const g_key k_jump_kick[] = {
 static const g_key k_special[] = {
     STANCE(0, -0.05),
     P(8, 0.05, -0.30, 80, 65, 60, 75, 85, -80, 40, -130, -70, -40, -120, 0, -100, -120, 0),
-    P(13, 0.10, 0.02, 95, 95, 95, 95, 95, -60, 30, 55, 80, -75, -90, 0, -120, -100, -10),
-    P(20, 0.10, 0.02, 95, 95, 95, 95, 95, -60, 30, 55, 80, -75, -90, 0, -120, -100, -10),
+    P(13, 0.12, 0.02, 92, 92, 90, 92, 95, -60, 30, 30, 55, -75, -90, 0, -120, -100, -10),
+    P(20, 0.12, 0.02, 92, 92, 90, 92, 95, -60, 30, 30, 55, -75, -90, 0, -120, -100, -10),
     P(30, 0.02, -0.06, 90, 86, 82, 85, 90, -70, 50, -80, 40, -80, -95, 0, -105, -90, 0),
     STANCE(40, -0.05),
 };
@@ -133,7 +133,7 @@ const g_move g_moves[G_MV_COUNT] = {
     [G_MV_SPECIAL] = {.name = "rising_palm", .frames = 40, .end = G_END_IDLE, .kind = G_STAND,
                       .hit_bones = 1u << G_R_FOREARM | 1u << G_R_UPPERARM, .active_start = 12, .active_end = 18,
                       .damage = 28, .hitstun = 0, .blockstun = 16, .level = G_MID, .knockdown = 1,
-                      .push = FX(0.050), .lunge = FX(0.050), .lunge_start = 6, .lunge_end = 14, KEYS(k_special)},
+                      .push = FX(0.050), .lunge = FX(0.060), .lunge_start = 4, .lunge_end = 14, KEYS(k_special)},
     [G_MV_GUARD] = {.name = "guard", .frames = 4, .end = G_END_HOLD, .kind = G_STAND, KEYS(k_guard)},
     [G_MV_CROUCH_GUARD] = {.name = "crouch_guard", .frames = 4, .end = G_END_HOLD, .kind = G_CROUCHING,
                            KEYS(k_crouch_guard)},

@@ -1,0 +1,114 @@
+#!/bin/sh
+# End-to-end: record / replay info / replay verify through the real binary,
+# determinism across runs and across -O0 / -O2 builds, bad replay files.
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/lib.sh"
+SRC=$(cd "$here/.." && pwd)
+BIN_DIR=$(dirname "$RS_BIN")
+
+t_record_is_reproducible() {
+    "$RS_BIN" record --ai --quiet --seed 77 --stage temple -o a.rsr 2>/dev/null || return 1
+    "$RS_BIN" record --ai --quiet --seed 77 --stage temple -o b.rsr 2>/dev/null || return 1
+    cmp a.rsr b.rsr || { echo "two recordings with the same seed differ"; return 1; }
+    "$RS_BIN" record --ai --quiet --seed 78 --stage temple -o c.rsr 2>/dev/null || return 1
+    ! cmp -s a.rsr c.rsr || { echo "different seeds, same file"; return 1; }
+}
+
+t_demos_are_current() {
+    # the bundled demos are exactly what 'make demo-replays' makes now
+    for d in dojo:1 harbor:7 temple:23; do
+        stage=${d%%:*} seed=${d##*:}
+        "$RS_BIN" record --ai --quiet --stage "$stage" --seed "$seed" -o "$stage.rsr" 2>/dev/null || return 1
+        cmp "$stage.rsr" "$SRC/demos/$stage.rsr" ||
+            { echo "demos/$stage.rsr is stale: run 'make demo-replays' and commit"; return 1; }
+        "$RS_BIN" replay verify --quiet "$SRC/demos/$stage.rsr" 2>v.txt || { cat v.txt; return 1; }
+        grep -q "ok: .* checkpoints and the final hash match" v.txt || { cat v.txt; return 1; }
+    done
+}
+
+t_info() {
+    "$RS_BIN" record --ai --quiet --seed 3 --stage harbor -o m.rsr 2>/dev/null || return 1
+    "$RS_BIN" replay info m.rsr >i.txt || return 1
+    for k in "stage        1 (harbor)" "seed         3" "players      P1 cpu, P2 cpu" "format       version 1" \
+        "every 60 ticks"; do
+        grep -q "$k" i.txt || { echo "info lacks '$k'"; cat i.txt; return 1; }
+    done
+    grep -Eq "^winner       (P[12]|draw), rounds [0-9]-[0-9]" i.txt || { cat i.txt; return 1; }
+    grep -Eq "^duration     [0-9]+ ticks, [0-9]+:[0-9]{2}\.[0-9]{2}" i.txt || { cat i.txt; return 1; }
+}
+
+t_seconds_exact() {
+    "$RS_BIN" record --ai --quiet --seconds 200 --seed 4 -o s.rsr 2>/dev/null || return 1
+    "$RS_BIN" replay info s.rsr | grep -q "^duration     12000 ticks, 3:20.00" || return 1
+    [ "$(wc -c <s.rsr)" -lt 16384 ] || { echo "more than 16 KiB for 200 s"; return 1; }
+}
+
+t_hashes_same_at_O0_O2_and_in_ringside() {
+    for o in O0 O2; do
+        [ -x "$BIN_DIR/tests/simhash-$o" ] || { echo "missing $BIN_DIR/tests/simhash-$o"; return 1; }
+    done
+    for d in dojo harbor temple; do
+        "$BIN_DIR/tests/simhash-O0" "$SRC/demos/$d.rsr" >o0.txt || { echo "O0 build fails $d"; return 1; }
+        "$BIN_DIR/tests/simhash-O2" "$SRC/demos/$d.rsr" >o2.txt || { echo "O2 build fails $d"; return 1; }
+        "$RS_BIN" replay verify --quiet --hashes r.txt "$SRC/demos/$d.rsr" 2>/dev/null || return 1
+        cmp o0.txt o2.txt || { echo "$d: -O0 and -O2 hashes differ"; return 1; }
+        cmp o0.txt r.txt || { echo "$d: ringside and simhash hashes differ"; return 1; }
+        ticks=$("$RS_BIN" replay info "$SRC/demos/$d.rsr" | sed -n 's/^duration *\([0-9]*\) ticks.*/\1/p')
+        [ "$(wc -l <r.txt)" = "$ticks" ] || { echo "$d: want one hash per tick"; return 1; }
+    done
+}
+
+t_flipped_bit_reports_tick() {
+    "$BIN_DIR/tests/simhash-O2" --flip 1234 6 "$SRC/demos/dojo.rsr" bad.rsr || return 1
+    expect_fail 1 "bad.rsr: desync at tick 1260: .*last matching checkpoint: tick 1200; the inputs diverge in ticks 1201..1260" \
+        "$RS_BIN" replay verify --quiet bad.rsr || return 1
+    [ "$(wc -l <err.txt)" = 1 ] || { cat err.txt; return 1; }
+}
+
+t_bad_files() {
+    cp "$SRC/demos/dojo.rsr" good.rsr
+    head -c 100 good.rsr >trunc.rsr
+    expect_fail 1 "trunc.rsr: checksum mismatch at byte 96" "$RS_BIN" replay verify trunc.rsr || return 1
+    : >empty.rsr
+    expect_fail 1 "empty.rsr: not a ringside replay: expected \"RSRP\" at byte 0" "$RS_BIN" replay info empty.rsr || return 1
+    printf 'RSRP\002\000' >v2.rsr
+    expect_fail 1 "v2.rsr: format version 2 at byte 4 is not supported" "$RS_BIN" replay info v2.rsr || return 1
+    # one flipped bit in the middle: the checksum catches it
+    size=$(wc -c <good.rsr)
+    dd if=good.rsr of=flip.rsr bs=1 count=$((size / 2)) 2>/dev/null
+    printf '\377' >>flip.rsr
+    dd if=good.rsr bs=1 skip=$((size / 2 + 1)) 2>/dev/null >>flip.rsr
+    expect_fail 1 "flip.rsr: checksum mismatch" "$RS_BIN" replay verify flip.rsr || return 1
+    expect_fail 1 "nope.rsr: cannot open" "$RS_BIN" replay verify nope.rsr || return 1
+    mkdir dir.rsr
+    expect_fail 1 "dir.rsr: read error" "$RS_BIN" replay info dir.rsr || return 1
+    for f in err.txt; do [ "$(wc -l <$f)" = 1 ] || { cat $f; return 1; }; done
+}
+
+t_usage() {
+    expect_fail 2 "--ai is required" "$RS_BIN" record -o x.rsr || return 1
+    expect_fail 2 "-o FILE is required" "$RS_BIN" record --ai || return 1
+    expect_fail 2 "unknown stage" "$RS_BIN" record --ai --stage moon -o x.rsr || return 1
+    expect_fail 2 "--level '9'" "$RS_BIN" record --ai --level 9 -o x.rsr || return 1
+    expect_fail 2 "unknown subcommand 'play'" "$RS_BIN" replay play x.rsr || return 1
+    expect_fail 2 "needs exactly one FILE" "$RS_BIN" replay verify || return 1
+    [ ! -e x.rsr ] || return 1
+}
+
+t_disk_full_keeps_nothing() {
+    ( trap '' XFSZ; ulimit -f 1; exec "$RS_BIN" record --ai --quiet --seconds 120 -o full.rsr ) >out.txt 2>err.txt
+    rc=$?
+    [ $rc = 1 ] || { echo "exit $rc"; cat err.txt; return 1; }
+    grep -q "full.rsr: write failed: File too large" err.txt || { cat err.txt; return 1; }
+    [ ! -e full.rsr ] && [ ! -e full.rsr.part ] || { echo "a partial file was left"; ls; return 1; }
+}
+
+t_bench_sim_short() {
+    "$RS_BIN" bench sim --hours 1 --quiet --csv b.csv >b.txt 2>&1 || { cat b.txt; return 1; }
+    grep -q "verify: all 3600 checkpoints and the final hash match" b.txt || { cat b.txt; return 1; }
+    [ "$(wc -l <b.csv)" = 2 ] || return 1
+}
+
+t_run record_is_reproducible demos_are_current info seconds_exact hashes_same_at_O0_O2_and_in_ringside \
+    flipped_bit_reports_tick bad_files usage disk_full_keeps_nothing bench_sim_short
+t_done
