@@ -72,7 +72,7 @@ TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
-.PHONY: all test asan debug demo bench install uninstall clean help deps demo-replays
+.PHONY: all test asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -117,6 +117,18 @@ SIM_SRC := $(wildcard runtime/game/*.c runtime/replay/*.c) runtime/util/rs_err.c
 $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/replay/*.h) $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(filter-out -O% -MMD -MP,$(CFLAGS)) $(subst simhash-,-,$(notdir $@)) $(LDFLAGS) -o $@ $(SIM_SRC) -lm
+
+# libFuzzer on the replay reader (clang; not part of make test)
+FUZZ_SECONDS ?= 600
+fuzz: build/fuzz/fuzz_replay
+build/fuzz/fuzz_replay: tests/fuzz_replay.c $(SIM_SRC)
+	@mkdir -p build/fuzz
+	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer,address,undefined \
+	    -o $@ tests/fuzz_replay.c $(filter-out tests/simhash.c,$(SIM_SRC)) -lm
+fuzz-run: build/fuzz/fuzz_replay
+	@mkdir -p build/fuzz/corpus
+	cp demos/*.rsr build/fuzz/corpus/
+	build/fuzz/fuzz_replay -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -print_final_stats=1 build/fuzz/corpus
 
 # --- tests ---
 test: $(STAMPS)/test $(BUILD)/ringside $(TEST_BIN) $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2

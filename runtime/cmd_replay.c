@@ -60,6 +60,11 @@ static int info(const char *path)
     printf("duration     %" PRIu64 " ticks, %s\n", rp.ticks, dur);
     printf("players      P1 %s, P2 %s\n", rp.kind[0] ? "cpu" : "human", rp.kind[1] ? "cpu" : "human");
     printf("winner       %s\n", win);
+    uint64_t active[2] = {0, 0};
+    for (uint64_t t = 0; t < rp.ticks; t++)
+        for (int i = 0; i < 2; i++)
+            active[i] += rp.inputs[2 * t + (uint64_t)i] != 0;
+    printf("input ticks  P1 %" PRIu64 ", P2 %" PRIu64 " (ticks with a button or direction held)\n", active[0], active[1]);
     printf("checkpoints  %zu, every %d ticks\n", rp.ncheck, rp.interval);
     printf("final hash   %016" PRIx64 "\n", rp.final_hash);
     rp_free(&rp);

@@ -11,6 +11,7 @@ static const cli_cmd commands[] = {
     {"info", cmd_info, "print the GL backend, driver and capabilities"},
     {"smoke", cmd_smoke, "render the smoke test scene headless to an image"},
     {"shaders", cmd_shaders, "compile every shader in shaders/ and report errors"},
+    {"play", cmd_play, "play in a window (or watch a replay), fixed 60 Hz"},
     {"record", cmd_record, "record a CPU-vs-CPU match headless to a replay"},
     {"replay", cmd_replay, "replay info FILE, replay verify FILE"},
     {"bench", cmd_bench, "run a benchmark (bench platform, bench sim)"},

@@ -14,8 +14,9 @@ group_pkgs() {
     case "$1" in
     # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window
     build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev" ;;
-    # X server for the GLFW backend's tests (xvfb-run needs xauth)
-    test) echo "xvfb xauth" ;;
+    # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
+    # presses keys in that window to prove a person can play
+    test) echo "xvfb xauth xdotool" ;;
     *) echo "deps.sh: unknown group '$1' (known: build test)" >&2; return 1 ;;
     esac
 }

@@ -1,0 +1,311 @@
+/* ringside play: the game in a window (or headless), live or from a replay.
+ *
+ * One thread: the loop (loop.c) owns the GL context, the game state and
+ * the recorder; input devices are polled on the same thread between ticks. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli.h"
+#include "game/g_ai.h"
+#include "gl/rgl.h"
+#include "input.h"
+#include "loop.h"
+#include "platform/plat.h"
+#include "render/r_game.h"
+#include "replay/rp.h"
+#include "util/rs_file.h"
+#include "util/rs_img.h"
+
+static void help(void)
+{
+    printf("usage: ringside play [--p1 human|cpu] [--p2 human|cpu] [--stage NAME] [--seed S] [--level L]\n"
+           "                     [--record FILE] [--replay FILE] [--seconds N] [--screenshot FILE]\n"
+           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n\n"
+           "Plays the game at a fixed 60 Hz in a window (GLFW; needs X, or xvfb-run -a).\n"
+           "Keys: player 1 W A S D, J punch, K kick, L guard; player 2 arrows, numpad\n"
+           "1 2 3 (or , . /); gamepads 1 and 2 too.  The 2-3-6 motion + punch is the\n"
+           "special move.  Escape quits.  Matches follow one another until you quit.\n\n"
+           "  --p1 / --p2 K    who plays each side (default: human vs cpu)\n"
+           "  --stage NAME     dojo, harbor or temple (default dojo)\n"
+           "  --seed S         random seed (default: the clock); stored in recordings\n"
+           "  --level L        CPU skill 0..3 (default 2)\n"
+           "  --record FILE    write what was played as a replay when the game ends\n"
+           "  --replay FILE    watch a replay instead of playing; ends with it\n"
+           "  --seconds N      stop after N seconds of game time\n"
+           "  --screenshot F   save the last frame as .png or .ppm\n"
+           "  --size WxH       window or frame size (default 1280x720)\n"
+           "  --fullscreen     primary monitor, its current mode\n"
+           "  --no-vsync       do not wait for the display\n"
+           "  --headless       no window: EGL/OSMesa, one tick per frame, as fast as possible\n"
+           "  --quiet          no summary line\n");
+}
+
+typedef struct play {
+    g_state prev, cur;
+    g_ai ai[2];
+    int kind[2]; /* RP_HUMAN / RP_CPU */
+    rp_replay *watch;
+    rp_recorder *rec;
+    plat *p;
+    r_game *r;
+    GLuint fbo, color, depth; /* headless target */
+    int w, h;
+    uint64_t limit;
+    bool quit, failed;
+    rs_err err;
+} play;
+
+static void on_input(void *user, g_input in[2])
+{
+    play *s = user;
+    for (int i = 0; i < 2; i++) {
+        if (s->watch)
+            in[i] = s->watch->inputs[2 * s->cur.tick + (uint64_t)i];
+        else if (s->kind[i] == RP_CPU)
+            in[i] = g_ai_input(&s->ai[i], &s->cur);
+        else
+            in[i] = plat_window(s->p) ? in_read(plat_window(s->p), i) : 0;
+    }
+}
+
+static void on_step(void *user, const g_input in[2])
+{
+    play *s = user;
+    s->prev = s->cur;
+    g_step(&s->cur, in, NULL);
+    if (s->rec && !rp_rec_tick(s->rec, in, &s->cur, &s->err))
+        s->failed = true;
+}
+
+static void on_render(void *user, float alpha)
+{
+    play *s = user;
+    int w = s->w, h = s->h;
+    if (plat_window(s->p))
+        plat_size(s->p, &w, &h);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s->fbo);
+    if (w > 0 && h > 0)
+        r_game_draw(s->r, &s->prev, &s->cur, alpha, w, h);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    plat_present(s->p);
+}
+
+static bool on_running(void *user)
+{
+    play *s = user;
+    if (s->failed || s->quit)
+        return false;
+    if (plat_window(s->p)) {
+        if (!plat_poll(s->p) || in_quit(plat_window(s->p))) {
+            s->quit = true;
+            return false;
+        }
+    }
+    if (s->watch && s->cur.tick >= s->watch->ticks)
+        return false;
+    return !s->limit || s->cur.tick < s->limit;
+}
+
+static bool make_target(play *s, rs_err *err)
+{
+    gl.GenFramebuffers(1, &s->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s->fbo);
+    gl.GenRenderbuffers(1, &s->color);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, s->color);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, s->w, s->h);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, s->color);
+    gl.GenRenderbuffers(1, &s->depth);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, s->depth);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, s->w, s->h);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, s->depth);
+    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
+    if (st != GL_FRAMEBUFFER_COMPLETE)
+        return rs_fail(err, 1, "%dx%d frame buffer incomplete (%s)", s->w, s->h, rgl_enum_name(st));
+    return true;
+}
+
+/* Renders the final state once more and saves it. */
+static bool screenshot(play *s, const char *path, rs_err *err)
+{
+    int w = s->w, h = s->h;
+    if (plat_window(s->p))
+        plat_size(s->p, &w, &h);
+    uint8_t *px = malloc((size_t)w * h * 4);
+    if (!px)
+        return rs_fail(err, 1, "out of memory for a %dx%d screenshot", w, h);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s->fbo);
+    r_game_draw(s->r, &s->prev, &s->cur, 1.0f, w, h);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, s->fbo);
+    if (!s->fbo)
+        gl.ReadBuffer(GL_BACK);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    rs_flip_rows(px, w, h, 4);
+    bool ok = rs_mkdirs_for(path, err) && rs_image_write(path, w, h, 4, px, err);
+    free(px);
+    return ok;
+}
+
+static bool parse_kind(const char *opt, const char *arg, int *kind)
+{
+    if (!strcmp(arg, "human"))
+        *kind = RP_HUMAN;
+    else if (!strcmp(arg, "cpu") || !strcmp(arg, "ai"))
+        *kind = RP_CPU;
+    else {
+        fprintf(stderr, "ringside play: %s '%s': expected human or cpu\n", opt, arg);
+        return false;
+    }
+    return true;
+}
+
+int cmd_play(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"p1", required_argument, 0, '1'},     {"p2", required_argument, 0, '2'},
+        {"stage", required_argument, 0, 't'},  {"seed", required_argument, 0, 'S'},
+        {"level", required_argument, 0, 'l'},  {"record", required_argument, 0, 'r'},
+        {"replay", required_argument, 0, 'R'}, {"seconds", required_argument, 0, 's'},
+        {"screenshot", required_argument, 0, 'o'}, {"size", required_argument, 0, 'z'},
+        {"fullscreen", no_argument, 0, 'f'},   {"no-vsync", no_argument, 0, 'v'},
+        {"headless", no_argument, 0, 'H'},     {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'},         {0}};
+    play *s = calloc(1, sizeof *s);
+    if (!s)
+        return RS_EXIT_FAIL;
+    s->kind[0] = RP_HUMAN;
+    s->kind[1] = RP_CPU;
+    s->w = 1280;
+    s->h = 720;
+    int stage = 0, c, status = RS_EXIT_USAGE;
+    long level = 2, seconds = 0;
+    uint64_t seed = (uint64_t)time(NULL);
+    const char *record = NULL, *replay = NULL, *shot = NULL;
+    bool headless = false, quiet = false;
+    plat_desc pd = {.title = "ringside"};
+    rp_replay watch = {0};
+    rp_recorder rec;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+        switch (c) {
+        case '1': if (!parse_kind("--p1", optarg, &s->kind[0])) goto done; break;
+        case '2': if (!parse_kind("--p2", optarg, &s->kind[1])) goto done; break;
+        case 't': if (!cli_stage(optarg, &stage)) goto done; break;
+        case 'S': {
+            char *end;
+            seed = strtoull(optarg, &end, 0);
+            if (*end || end == optarg || optarg[0] == '-') {
+                cli_error("play", "--seed '%s': expected a non-negative whole number", optarg);
+                goto done;
+            }
+            break;
+        }
+        case 'l': if (!cli_int("--level", optarg, 0, 3, &level)) goto done; break;
+        case 'r': record = optarg; break;
+        case 'R': replay = optarg; break;
+        case 's': if (!cli_int("--seconds", optarg, 1, 7 * 24 * 3600, &seconds)) goto done; break;
+        case 'o': shot = optarg; break;
+        case 'z': if (!cli_size("--size", optarg, 8192, &s->w, &s->h)) goto done; break;
+        case 'f': pd.fullscreen = true; break;
+        case 'v': pd.no_vsync = true; break;
+        case 'H': headless = true; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); status = RS_EXIT_OK; goto done;
+        default:
+            cli_error("play", "bad option or missing value '%s'", argv[optind - 1]);
+            status = cli_usage_error("play");
+            goto done;
+        }
+    }
+    if (optind < argc) {
+        cli_error("play", "unexpected argument '%s'", argv[optind]);
+        status = cli_usage_error("play");
+        goto done;
+    }
+    if (shot) {
+        const char *dot = strrchr(shot, '.');
+        if (!dot || (strcmp(dot, ".png") && strcmp(dot, ".ppm"))) {
+            cli_error("play", "%s: unknown image extension (expected .png or .ppm)", shot);
+            goto done;
+        }
+    }
+    if (replay && record) {
+        cli_error("play", "--replay and --record together: the replay is already recorded");
+        goto done;
+    }
+    status = RS_EXIT_FAIL;
+    if (replay) {
+        if (!rp_read(replay, &watch, &s->err))
+            goto done;
+        s->watch = &watch;
+        stage = watch.stage;
+        seed = watch.seed;
+    }
+    pd.backend = headless ? NULL : "glfw";
+    pd.width = s->w;
+    pd.height = s->h;
+    pd.hidden = false;
+    s->p = plat_create(&pd, &s->err);
+    if (!s->p) {
+        status = cli_plat_status(&s->err);
+        goto done;
+    }
+    s->r = r_game_create(&s->err);
+    if (!s->r || (headless && !make_target(s, &s->err)))
+        goto done;
+    g_init(&s->cur, stage, seed);
+    s->prev = s->cur;
+    g_ai_init(&s->ai[0], 0, (int)level, seed);
+    g_ai_init(&s->ai[1], 1, (int)level, seed + 1);
+    if (record) {
+        rp_rec_init(&rec, stage, seed, s->kind[0], s->kind[1]);
+        s->rec = &rec;
+    }
+    s->limit = seconds ? (uint64_t)seconds * G_HZ : 0;
+    if (!headless && !replay && s->kind[0] == RP_CPU && s->kind[1] == RP_CPU && !seconds && !quiet)
+        fprintf(stderr, "ringside play: CPU vs CPU; Escape quits\n");
+
+    lp_game g = {s, on_input, on_step, on_render, on_running};
+    lp_stats st;
+    lp_run(&(lp_desc){.headless = headless}, &g, &st);
+    if (s->failed)
+        goto done;
+    if (shot && !screenshot(s, shot, &s->err))
+        goto done;
+    if (s->rec && !rp_rec_save(s->rec, record, &s->err))
+        goto done;
+    if (!quiet) {
+        fprintf(stderr,
+                "ringside play: %" PRIu64 " ticks (%.1f s of game) in %.1f s, %" PRIu64 " frames, %" PRIu64
+                " late ticks, %" PRIu64 " stalls; rounds %d-%d%s%s\n",
+                st.ticks, st.ticks / (double)G_HZ, st.seconds, st.frames, st.late_ticks, st.stalls,
+                s->cur.f[0].rounds_won, s->cur.f[1].rounds_won, record ? "; recorded " : "", record ? record : "");
+    }
+    status = RS_EXIT_OK;
+done:
+    if (status == RS_EXIT_FAIL || (status == RS_EXIT_USAGE && s->err.msg[0]))
+        cli_error("play", "%s", s->err.msg);
+    if (s->p) {
+        if (s->fbo) {
+            gl.DeleteFramebuffers(1, &s->fbo);
+            gl.DeleteRenderbuffers(1, &s->color);
+            gl.DeleteRenderbuffers(1, &s->depth);
+        }
+        r_game_destroy(s->r);
+        plat_destroy(s->p);
+    }
+    if (s->rec)
+        rp_free(&s->rec->rp);
+    rp_free(&watch);
+    free(s);
+    return status;
+}

@@ -1,0 +1,34 @@
+/* Meshes generated at load from primitives: no asset files.
+ *
+ * Vertex format (r_vertex): position, normal, tangent (xyz + handedness),
+ * uv, bone index.  Tangents and UVs are there for the normal and colour
+ * specular maps of the renderer-core work; the plain renderer uses
+ * position, normal and bone. */
+#ifndef R_MESH_H
+#define R_MESH_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "../game/g_skel.h"
+
+typedef struct r_vertex {
+    float pos[3], normal[3], tangent[4], uv[2];
+    float bone;
+} r_vertex;
+
+typedef struct r_mesh_data {
+    r_vertex *v;
+    unsigned *idx;
+    size_t nv, ni, capv, capi;
+} r_mesh_data;
+
+/* A capsule along +x from 0 to `length`, radius r, for bone `bone`. */
+int r_mesh_capsule(r_mesh_data *m, float length, float r, int bone, int segments, int rings);
+/* An axis-aligned box from lo to hi (bone index -1: world space). */
+int r_mesh_box(r_mesh_data *m, const float lo[3], const float hi[3]);
+/* The whole fighter: one capsule per bone of g_bones. */
+int r_mesh_fighter(r_mesh_data *m);
+void r_mesh_free(r_mesh_data *m);
+
+#endif
