@@ -143,8 +143,9 @@ debug:
 # --- the main job and benchmarks ---
 demo: $(BUILD)/ringside
 	@mkdir -p out
-	$(BUILD)/ringside smoke -o out/demo.png
-	@echo "demo: out/demo.png (the smoke scene; the game renderer replaces it once it lands)"
+	$(BUILD)/ringside replay verify demos/dojo.rsr
+	$(BUILD)/ringside play --headless --replay demos/dojo.rsr --screenshot out/demo.png
+	@echo "demo: out/demo.png, the last frame of demos/dojo.rsr rendered headless (video output arrives with capture)"
 
 bench: $(BUILD)/ringside
 	@mkdir -p out

@@ -38,6 +38,19 @@ bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out)
     return true;
 }
 
+bool cli_u64(const char *opt, const char *arg, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(arg, &end, 0);
+    if (errno || end == arg || *end || arg[0] == '-') {
+        fprintf(stderr, "ringside: %s '%s': expected a non-negative whole number\n", opt, arg);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
 bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
 {
     char *x;

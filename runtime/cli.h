@@ -3,6 +3,7 @@
 #define CLI_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #define RS_VERSION "0.1.0"
 
@@ -16,6 +17,8 @@ typedef struct cli_cmd {
 
 /* Parses "WxH" with 1 <= W,H <= max; prints a usage error naming opt. */
 bool cli_size(const char *opt, const char *arg, int max, int *w, int *h);
+/* Parses a non-negative 64-bit number (decimal or 0x hex). */
+bool cli_u64(const char *opt, const char *arg, uint64_t *out);
 /* Parses an integer in [lo, hi]; prints a usage error naming opt. */
 bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out);
 /* "ringside CMD: message" on stderr. */

@@ -200,15 +200,7 @@ int cmd_play(int argc, char **argv)
         case '1': if (!parse_kind("--p1", optarg, &s->kind[0])) goto done; break;
         case '2': if (!parse_kind("--p2", optarg, &s->kind[1])) goto done; break;
         case 't': if (!cli_stage(optarg, &stage)) goto done; break;
-        case 'S': {
-            char *end;
-            seed = strtoull(optarg, &end, 0);
-            if (*end || end == optarg || optarg[0] == '-') {
-                cli_error("play", "--seed '%s': expected a non-negative whole number", optarg);
-                goto done;
-            }
-            break;
-        }
+        case 'S': if (!cli_u64("--seed", optarg, &seed)) goto done; break;
         case 'l': if (!cli_int("--level", optarg, 0, 3, &level)) goto done; break;
         case 'r': record = optarg; break;
         case 'R': replay = optarg; break;

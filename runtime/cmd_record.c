@@ -54,15 +54,10 @@ int cmd_record(int argc, char **argv)
             if (!cli_int("--seconds", optarg, 1, (long)(RP_MAX_TICKS / G_HZ), &seconds))
                 return RS_EXIT_USAGE;
             break;
-        case 'S': {
-            char *end;
-            seed = strtoull(optarg, &end, 0);
-            if (*end || end == optarg || optarg[0] == '-') {
-                cli_error("record", "--seed '%s': expected a non-negative whole number", optarg);
+        case 'S':
+            if (!cli_u64("--seed", optarg, &seed))
                 return RS_EXIT_USAGE;
-            }
             break;
-        }
         case 't':
             if (!cli_stage(optarg, &stage))
                 return RS_EXIT_USAGE;
@@ -108,8 +103,8 @@ int cmd_record(int argc, char **argv)
         g_step(&st, in, NULL);
         if (!rp_rec_tick(&rec, in, &st, &err))
             goto done;
-        if (!seconds && st.matches > 0)
-            break; /* the first match is over, announcement included */
+        if (!seconds && st.phase == G_PHASE_MATCH_END && st.phase_ticks == G_MATCH_END_TICKS - 1)
+            break; /* the last tick of the winner announcement: the next would start a new match */
         if ((st.tick & 0xfff) == 0)
             rs_progress_update(&prog, st.tick);
     }

@@ -346,23 +346,12 @@ bool rp_write(const char *path, const rp_replay *rp, rs_err *err)
     size_t n;
     if (!rp_encode(rp, &buf, &n, err))
         return false;
+    bool written = rs_write_part(path, buf, n, err);
+    free(buf);
+    if (!written)
+        return false;
     char part[PATH_MAX + 8];
     rs_part_path(path, part, sizeof part);
-    FILE *f = fopen(part, "wb");
-    if (!f) {
-        free(buf);
-        return rs_fail(err, RP_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
-    }
-    bool ok = fwrite(buf, 1, n, f) == n;
-    int saved = errno;
-    ok = fflush(f) == 0 && ok;
-    ok = fsync(fileno(f)) == 0 && ok;
-    ok = fclose(f) == 0 && ok;
-    free(buf);
-    if (!ok) {
-        unlink(part);
-        return rs_fail(err, RP_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : errno));
-    }
     /* read back what is on disk: it must decode to exactly what we recorded */
     rp_replay back;
     if (!rp_read(part, &back, err)) {

@@ -121,6 +121,30 @@ void rs_part_path(const char *path, char *out, size_t n)
     snprintf(out, n, "%s.part", path);
 }
 
+bool rs_write_part(const char *path, const void *data, size_t n, rs_err *err)
+{
+    char part[PATH_MAX + 8];
+    rs_part_path(path, part, sizeof part);
+    FILE *f = fopen(part, "wb");
+    if (!f)
+        return rs_fail(err, RS_FILE_ERR_WRITE, "%s: cannot create: %s", part, strerror(errno));
+    errno = 0;
+    bool ok = fwrite(data, 1, n, f) == n;
+    int saved = errno;
+    ok = fflush(f) == 0 && ok;
+    if (!saved)
+        saved = errno;
+    ok = fsync(fileno(f)) == 0 && ok;
+    ok = fclose(f) == 0 && ok;
+    if (!ok) {
+        if (!saved)
+            saved = errno;
+        unlink(part);
+        return rs_fail(err, RS_FILE_ERR_WRITE, "%s: write failed: %s", path, strerror(saved));
+    }
+    return true;
+}
+
 bool rs_commit_file(const char *path, rs_err *err)
 {
     char part[PATH_MAX + 8];

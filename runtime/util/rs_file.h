@@ -32,6 +32,9 @@ bool rs_mkdirs_for(const char *path, rs_err *err);
 /* Atomic output: write to "<path>.part", then rs_commit_file renames it.
  * A failed run never leaves a file that looks finished. */
 void rs_part_path(const char *path, char *out, size_t n);
+/* Writes n bytes to "<path>.part" and fsyncs it; on failure the part file is
+ * removed and the message names the file and the system's reason. */
+bool rs_write_part(const char *path, const void *data, size_t n, rs_err *err);
 bool rs_commit_file(const char *path, rs_err *err);
 
 #endif

@@ -37,16 +37,15 @@ static void be32(uint8_t *p, uint32_t v)
     p[3] = (uint8_t)v;
 }
 
-static bool png_chunk(FILE *f, const char *type, const uint8_t *data, uint32_t n)
+/* Appends one chunk (length, type, data, CRC) at out; returns its size. */
+static size_t png_chunk(uint8_t *out, const char *type, const uint8_t *data, uint32_t n)
 {
-    uint8_t hdr[8];
-    be32(hdr, n);
-    memcpy(hdr + 4, type, 4);
-    uint32_t crc = rs_crc32(0, hdr + 4, 4);
-    crc = rs_crc32(crc, data, n);
-    uint8_t tail[4];
-    be32(tail, crc);
-    return fwrite(hdr, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) && fwrite(tail, 1, 4, f) == 4;
+    be32(out, n);
+    memcpy(out + 4, type, 4);
+    if (n)
+        memcpy(out + 8, data, n);
+    be32(out + 8 + n, rs_crc32(0, out + 4, (size_t)n + 4));
+    return (size_t)n + 12;
 }
 
 static bool check_args(const char *path, int w, int h, int channels, rs_err *err)
@@ -109,25 +108,22 @@ bool rs_png_write(const char *path, int w, int h, int channels, const uint8_t *p
     ihdr[9] = colour_type[channels];
     ihdr[10] = ihdr[11] = ihdr[12] = 0;
 
-    char part[PATH_MAX + 8];
-    rs_part_path(path, part, sizeof part);
-    FILE *f = fopen(part, "wb");
-    if (!f) {
-        free(z);
-        return rs_fail(err, RS_IMG_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
-    }
     static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    errno = 0;
-    bool ok = fwrite(sig, 1, 8, f) == 8 && png_chunk(f, "IHDR", ihdr, 13) && png_chunk(f, "IDAT", z, (uint32_t)o) &&
-              png_chunk(f, "IEND", NULL, 0);
-    int saved = errno;
-    ok = (fclose(f) == 0) && ok;
-    free(z);
-    if (!ok) {
-        remove(part);
-        return rs_fail(err, RS_IMG_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : errno));
+    size_t n = 8 + (12 + 13) + (12 + o) + 12;
+    uint8_t *file = malloc(n);
+    if (!file) {
+        free(z);
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: out of memory", path);
     }
-    return rs_commit_file(path, err);
+    memcpy(file, sig, 8);
+    size_t at = 8;
+    at += png_chunk(file + at, "IHDR", ihdr, 13);
+    at += png_chunk(file + at, "IDAT", z, (uint32_t)o);
+    at += png_chunk(file + at, "IEND", NULL, 0);
+    free(z);
+    bool ok = rs_write_part(path, file, at, err) && rs_commit_file(path, err);
+    free(file);
+    return ok;
 }
 
 static bool ends_with(const char *s, const char *suf);
@@ -139,23 +135,19 @@ bool rs_pnm_write(const char *path, int w, int h, int channels, const uint8_t *p
     if (ends_with(path, ".pgm") != (channels == 1))
         return rs_fail(err, RS_IMG_ERR_ARG, "%s: %s", path,
                        channels == 1 ? "a grey image is written as .pgm" : "a colour image is written as .ppm or .png");
-    char part[PATH_MAX + 8];
-    rs_part_path(path, part, sizeof part);
-    FILE *f = fopen(part, "wb");
-    if (!f)
-        return rs_fail(err, RS_IMG_ERR_IO, "%s: cannot create: %s", part, strerror(errno));
     int out_ch = channels == 1 ? 1 : 3;
-    errno = 0;
-    bool ok = fprintf(f, "P%d\n%d %d\n255\n", out_ch == 1 ? 5 : 6, w, h) > 0;
-    for (size_t i = 0; ok && i < (size_t)w * h; i++)
-        ok = fwrite(px + i * channels, 1, out_ch, f) == (size_t)out_ch;
-    int saved = errno;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok) {
-        remove(part);
-        return rs_fail(err, RS_IMG_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : errno));
-    }
-    return rs_commit_file(path, err);
+    char hdr[64];
+    size_t hn = (size_t)snprintf(hdr, sizeof hdr, "P%d\n%d %d\n255\n", out_ch == 1 ? 5 : 6, w, h);
+    size_t n = hn + (size_t)w * h * out_ch;
+    uint8_t *file = malloc(n);
+    if (!file)
+        return rs_fail(err, RS_IMG_ERR_IO, "%s: out of memory", path);
+    memcpy(file, hdr, hn);
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        memcpy(file + hn + i * out_ch, px + i * channels, (size_t)out_ch);
+    bool ok = rs_write_part(path, file, n, err) && rs_commit_file(path, err);
+    free(file);
+    return ok;
 }
 
 /* Reads the next header integer, skipping whitespace and # comments. */
