@@ -203,10 +203,13 @@ static int bench_sim(int argc, char **argv)
            ticks / t_ver >= 200000 ? "met" : "NOT met");
     if (csv) {
         FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
-        if (!f || fprintf(f, "hours,ticks,record_tps,encode_tps,decode_tps,verify_tps,bytes,bytes_3min\n"
-                             "%ld,%llu,%.0f,%.0f,%.0f,%.0f,%zu,%zu\n",
-                          hours, (unsigned long long)ticks, ticks / t_rec, ticks / t_enc, ticks / t_dec, ticks / t_ver,
-                          len, size_3min) < 0 || fclose(f) != 0) {
+        bool wrote = f && fprintf(f, "hours,ticks,record_tps,encode_tps,decode_tps,verify_tps,bytes,bytes_3min\n"
+                                     "%ld,%llu,%.0f,%.0f,%.0f,%.0f,%zu,%zu\n",
+                                  hours, (unsigned long long)ticks, ticks / t_rec, ticks / t_enc, ticks / t_dec,
+                                  ticks / t_ver, len, size_3min) > 0;
+        if (f && fclose(f) != 0)
+            wrote = false;
+        if (!wrote) {
             rs_fail(&err, 1, "%s: cannot write", csv);
             goto done;
         }

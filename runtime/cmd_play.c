@@ -230,6 +230,10 @@ int cmd_play(int argc, char **argv)
             goto done;
         }
     }
+    if (headless && !replay && !seconds) {
+        cli_error("play", "--headless needs --seconds N or --replay FILE (nobody can close a headless game)");
+        goto done;
+    }
     if (replay && record) {
         cli_error("play", "--replay and --record together: the replay is already recorded");
         goto done;

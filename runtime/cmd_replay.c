@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "replay/rp.h"
@@ -46,14 +47,12 @@ static int info(const char *path)
         cli_error("replay", "%s", err.msg);
         return RS_EXIT_FAIL;
     }
-    uint8_t *buf;
-    size_t n = 0;
-    if (rp_encode(&rp, &buf, &n, &err))
-        free(buf);
+    struct stat sb;
+    long long n = stat(path, &sb) == 0 ? (long long)sb.st_size : -1;
     char dur[32], win[64];
     duration(rp.ticks, dur, sizeof dur);
     winner_text(rp.winner, rp.rounds, win, sizeof win);
-    printf("file         %s (%zu bytes, inputs %zu bytes)\n", path, n, rp.input_bytes);
+    printf("file         %s (%lld bytes, inputs %zu bytes)\n", path, n, rp.input_bytes);
     printf("format       version %d\n", rp.version);
     printf("stage        %d (%s)\n", rp.stage, g_stages[rp.stage].name);
     printf("seed         %" PRIu64 "\n", rp.seed);
@@ -104,6 +103,11 @@ static int verify(const char *path, const char *hashes_path, bool quiet)
     int status = RS_EXIT_FAIL;
     if (!ran) {
         cli_error("replay", "%s: %s", path, err.msg);
+    } else if (res.header_mismatch) {
+        fprintf(stderr,
+                "ringside replay: %s: the header says winner %d, rounds %d-%d, but the simulation gives winner %d, "
+                "rounds %d-%d (byte 32; the inputs themselves verify)\n",
+                path, rp.winner, rp.rounds[0], rp.rounds[1], res.winner, res.rounds[0], res.rounds[1]);
     } else if (!res.ok) {
         fprintf(stderr,
                 "ringside replay: %s: desync at tick %" PRIu64 ": state hash %016" PRIx64 ", recorded %016" PRIx64

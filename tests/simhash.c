@@ -2,7 +2,8 @@
  *   simhash REPLAY                    prints "tick hash" for every tick
  *   simhash --flip TICK BIT IN OUT    writes IN with one input bit flipped at
  *                                     TICK (1-based, player 1), re-encoded with
- *                                     a valid checksum: a replay that desyncs */
+ *                                     a valid checksum: a replay that desyncs
+ *   simhash --winner W IN OUT         writes IN claiming winner W in its header */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +42,18 @@ int main(int argc, char **argv)
         rp_free(&rp);
         return ok ? 0 : 1;
     }
-    fprintf(stderr, "usage: simhash REPLAY | simhash --flip TICK BIT IN OUT\n");
+    if (argc == 5 && !strcmp(argv[1], "--winner")) {
+        if (!rp_read(argv[3], &rp, &err)) {
+            fprintf(stderr, "simhash: %s\n", err.msg);
+            return 1;
+        }
+        rp.winner = atoi(argv[2]);
+        bool ok = rp_write(argv[4], &rp, &err);
+        if (!ok)
+            fprintf(stderr, "simhash: %s\n", err.msg);
+        rp_free(&rp);
+        return ok ? 0 : 1;
+    }
+    fprintf(stderr, "usage: simhash REPLAY | simhash --flip TICK BIT IN OUT | simhash --winner W IN OUT\n");
     return 2;
 }

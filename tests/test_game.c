@@ -151,6 +151,53 @@ static void t_guard_levels(void)
     T_EQ(st.f[1].health, G_MAX_HEALTH - g_moves[G_MV_KICK].damage);
 }
 
+static void t_trades_hit_both(void)
+{
+    /* both punch on the same tick: both take the damage, both recover */
+    g_state st;
+    fight_at(&st, FX(0.75));
+    g_events ev = {0};
+    run(&st, G_IN_PUNCH, G_IN_PUNCH, 1, &ev);
+    run(&st, 0, 0, 12, &ev);
+    T_EQ(st.f[0].health, G_MAX_HEALTH - g_moves[G_MV_PUNCH].damage);
+    T_EQ(st.f[1].health, G_MAX_HEALTH - g_moves[G_MV_PUNCH].damage);
+    T_EQ(st.f[0].hits, 1);
+    T_EQ(st.f[1].hits, 1);
+    run(&st, 0, 0, 40, NULL);
+    T_EQ(st.f[0].move, G_MV_IDLE);
+    T_EQ(st.f[1].move, G_MV_IDLE);
+    /* and both can act again */
+    run(&st, G_IN_RIGHT, G_IN_LEFT, 3, NULL);
+    T_EQ(st.f[0].move, G_MV_WALK_F);
+    T_EQ(st.f[1].move, G_MV_WALK_F);
+}
+
+static void t_double_ko_is_a_draw(void)
+{
+    g_state st;
+    fight_at(&st, FX(0.75));
+    st.f[0].health = st.f[1].health = 5;
+    run(&st, G_IN_PUNCH, G_IN_PUNCH, 1, NULL);
+    for (int i = 0; i < 20 && st.phase == G_PHASE_FIGHT; i++)
+        run(&st, 0, 0, 1, NULL);
+    T_EQ(st.phase, G_PHASE_ROUND_END);
+    T_EQ(st.round_result, G_RES_DRAW);
+    T_EQ(st.f[0].rounds_won + st.f[1].rounds_won, 0);
+}
+
+static void t_crouch_ducks_highs(void)
+{
+    for (fx gap = FX(0.6); gap <= FX(1.0); gap += FX(0.1)) {
+        g_state st;
+        fight_at(&st, gap);
+        run(&st, 0, G_IN_DOWN, 6, NULL);
+        run(&st, G_IN_PUNCH, G_IN_DOWN, 1, NULL);
+        run(&st, 0, G_IN_DOWN, 14, NULL);
+        T_ASSERTF(st.f[1].health == G_MAX_HEALTH, "a high punch hit a crouching fighter at %.1f m",
+                  fx_to_float(gap));
+    }
+}
+
 static void t_special_motion(void)
 {
     g_state st;
@@ -209,6 +256,23 @@ static void t_walking_cannot_push_out(void)
     run(&st, G_IN_RIGHT, G_IN_RIGHT, 400, NULL); /* P2 walks back to the edge, P1 follows */
     T_EQ(st.phase, G_PHASE_FIGHT);
     T_ASSERT(st.f[1].x <= edge);
+}
+
+static void t_blocked_to_the_edge_then_walked_into(void)
+{
+    /* knock-back may leave a fighter in the last centimetres; walking into
+     * them still must not push them off */
+    g_state st;
+    fight_at(&st, FX(1.0));
+    fx edge = g_stages[st.stage].ring_half;
+    st.f[0].x = edge - FX(0.12) - FX(0.9);
+    st.f[1].x = edge - FX(0.12);
+    run(&st, 0, G_IN_GUARD, 2, NULL);
+    run(&st, G_IN_KICK, G_IN_GUARD, 1, NULL);
+    run(&st, 0, G_IN_GUARD, 30, NULL);
+    run(&st, G_IN_RIGHT, 0, 300, NULL);
+    T_EQ(st.phase, G_PHASE_FIGHT);
+    T_ASSERT(fx_abs(st.f[1].x) <= edge);
 }
 
 static void t_time_up_draw(void)
@@ -316,6 +380,29 @@ static void t_hash_covers_all_state(void)
     }
 }
 
+static void t_nobody_stuck(void)
+{
+    /* over long AI play, every fighter becomes actionable again within
+     * a few seconds of every hit (no state holds a fighter forever) */
+    g_state st;
+    g_ai a, b;
+    g_init(&st, 0, 1234);
+    g_ai_init(&a, 0, 3, 5);
+    g_ai_init(&b, 1, 3, 6);
+    int stuck[2] = {0, 0};
+    for (int i = 0; i < 20 * 60 * G_HZ; i++) {
+        g_input in[2] = {g_ai_input(&a, &st), g_ai_input(&b, &st)};
+        g_step(&st, in, NULL);
+        for (int k = 0; k < 2; k++) {
+            int m = st.f[k].move;
+            bool busy = st.phase == G_PHASE_FIGHT && (m == G_MV_HITSTUN || m == G_MV_BLOCKSTUN);
+            stuck[k] = busy ? stuck[k] + 1 : 0;
+            T_ASSERTF(stuck[k] < 3 * G_HZ, "fighter %d held in %s for 3 s at tick %llu", k + 1, g_move_name(m),
+                      (unsigned long long)st.tick);
+        }
+    }
+}
+
 static void t_long_run_stays_bounded(void)
 {
     /* an hour of back-to-back matches: counters stay in their ranges */
@@ -342,8 +429,10 @@ static void t_long_run_stays_bounded(void)
 T_MAIN({"trig", t_trig}, {"isqrt", t_isqrt}, {"segment_distance", t_segment_distance},
        {"skeleton_stands", t_skeleton_stands}, {"inputs", t_inputs},
        {"punch_hits_and_guard_blocks", t_punch_hits_and_guard_blocks}, {"guard_levels", t_guard_levels},
-       {"special_motion", t_special_motion}, {"special_knocks_down_and_out", t_special_knocks_down_and_out},
-       {"walking_cannot_push_out", t_walking_cannot_push_out}, {"time_up_draw", t_time_up_draw},
+       {"trades_hit_both", t_trades_hit_both}, {"double_ko_is_a_draw", t_double_ko_is_a_draw},
+       {"crouch_ducks_highs", t_crouch_ducks_highs}, {"special_motion", t_special_motion}, {"special_knocks_down_and_out", t_special_knocks_down_and_out},
+       {"walking_cannot_push_out", t_walking_cannot_push_out},
+       {"blocked_to_the_edge_then_walked_into", t_blocked_to_the_edge_then_walked_into}, {"time_up_draw", t_time_up_draw},
        {"ai_match_finishes", t_ai_match_finishes}, {"same_inputs_same_hashes", t_same_inputs_same_hashes},
        {"rollback_sync", t_rollback_sync}, {"hash_covers_all_state", t_hash_covers_all_state},
-       {"long_run_stays_bounded", t_long_run_stays_bounded})
+       {"nobody_stuck", t_nobody_stuck}, {"long_run_stays_bounded", t_long_run_stays_bounded})

@@ -119,6 +119,7 @@ static void t_corruption_cases(void)
     expect_bad(g, n, 30, &k3, 1, true, "player 1 kind 3 at byte 30", NULL);
     expect_bad(g, n, 32, &w7, 1, true, "winner 7 at byte 32", NULL);
     expect_bad(g, n, 33, &r9, 1, true, "rounds won 9 at byte 33", NULL);
+    expect_bad(g, n, 35, &k3, 1, true, "reserved byte 35 is 3", NULL);
     /* input section: a run past the tick count, opposite directions */
     const uint8_t huge_run[5] = {0xff, 0xff, 0xff, 0x7f, 0x00};
     expect_bad(g, n, 40, huge_run, 4, true, "goes past the tick count", "byte 40");
@@ -195,14 +196,22 @@ static void t_random_corruption(void)
         if (rp_decode(b, len, "fuzz.rsr", &out, &e)) {
             accepted++;
             T_ASSERT(out.ticks >= 1 && out.ncheck == out.ticks / (uint64_t)out.interval);
-            rp_verify_result res;
-            T_ASSERT(rp_verify(&out, NULL, NULL, NULL, &res, &e));
+            /* whatever is accepted re-encodes to a file that decodes the same */
+            uint8_t *re;
+            size_t rn;
+            rp_replay again;
+            encode(&out, &re, &rn);
+            T_ASSERT(rp_decode(re, rn, "again", &again, &e));
+            T_ASSERT(again.ticks == out.ticks && again.final_hash == out.final_hash &&
+                     !memcmp(again.inputs, out.inputs, (size_t)out.ticks * 2));
+            free(re);
+            rp_free(&again);
             rp_free(&out);
         } else {
             T_CONTAINS(e.msg, "fuzz.rsr: ");
         }
     }
-    T_ASSERT(accepted < 4000);
+    T_ASSERT(accepted > 0 && accepted < 4000); /* some repaired mutations are valid files */
     free(b);
     free(g);
     rp_free(&rp);
@@ -260,6 +269,36 @@ static void t_write_read_back_and_failures(void)
     rp_free(&rp);
 }
 
+static void t_short_recording(void)
+{
+    /* under one checkpoint interval: no checkpoints at all, still valid */
+    rp_replay rp, back;
+    record(&rp, 2, 0, 30);
+    T_EQ(rp.ncheck, 0);
+    char path[512];
+    snprintf(path, sizeof path, "%s/short.rsr", t_tmpdir());
+    rs_err e = {0};
+    T_ASSERTF(rp_write(path, &rp, &e), "%s", e.msg);
+    T_ASSERTF(rp_read(path, &back, &e), "%s", e.msg);
+    rp_verify_result res;
+    T_ASSERT(rp_verify(&back, NULL, NULL, NULL, &res, &e) && res.ok);
+    rp_free(&rp);
+    rp_free(&back);
+}
+
+static void t_header_result_checked(void)
+{
+    rp_replay rp;
+    record(&rp, 4, 0, 60 * 200); /* long enough for the first match to end */
+    T_ASSERT(rp.winner > 0);
+    rp.winner = 3 - rp.winner;
+    rp_verify_result res;
+    rs_err e = {0};
+    T_ASSERT(rp_verify(&rp, NULL, NULL, NULL, &res, &e));
+    T_ASSERT(!res.ok && res.header_mismatch && res.desync_tick == 0);
+    rp_free(&rp);
+}
+
 static void t_demos_verify(void)
 {
     static const char *const names[] = {"dojo", "harbor", "temple"};
@@ -283,4 +322,5 @@ T_MAIN({"roundtrip", t_roundtrip}, {"three_minutes_under_16k", t_three_minutes_u
        {"corruption_cases", t_corruption_cases}, {"oversized_file", t_oversized_file},
        {"random_corruption", t_random_corruption},
        {"flipped_input_desyncs_at_its_checkpoint", t_flipped_input_desyncs_at_its_checkpoint},
-       {"write_read_back_and_failures", t_write_read_back_and_failures}, {"demos_verify", t_demos_verify})
+       {"write_read_back_and_failures", t_write_read_back_and_failures}, {"short_recording", t_short_recording},
+       {"header_result_checked", t_header_result_checked}, {"demos_verify", t_demos_verify})

@@ -58,6 +58,22 @@ t_hashes_same_at_O0_O2_and_in_ringside() {
     done
 }
 
+t_hashes_same_with_clang() {
+    [ -x "$BIN_DIR/tests/simhash-clang" ] || t_skip_case "clang not installed"
+    for d in dojo harbor temple; do
+        "$BIN_DIR/tests/simhash-clang" "$SRC/demos/$d.rsr" >c.txt || { echo "clang build fails $d"; return 1; }
+        "$BIN_DIR/tests/simhash-O2" "$SRC/demos/$d.rsr" >g.txt || return 1
+        cmp c.txt g.txt || { echo "$d: clang and gcc hashes differ"; return 1; }
+    done
+}
+
+t_header_tampering_is_reported() {
+    # a replay whose inputs verify but whose header claims another winner
+    "$BIN_DIR/tests/simhash-O2" --winner 0 "$SRC/demos/dojo.rsr" lie.rsr || return 1
+    expect_fail 1 "lie.rsr: the header says winner 0.*but the simulation gives winner" \
+        "$RS_BIN" replay verify --quiet lie.rsr || return 1
+}
+
 t_flipped_bit_reports_tick() {
     "$BIN_DIR/tests/simhash-O2" --flip 1234 6 "$SRC/demos/dojo.rsr" bad.rsr || return 1
     expect_fail 1 "bad.rsr: desync at tick 1260: .*last matching checkpoint: tick 1200; the inputs diverge in ticks 1201..1260" \
@@ -110,5 +126,5 @@ t_bench_sim_short() {
 }
 
 t_run record_is_reproducible demos_are_current info seconds_exact hashes_same_at_O0_O2_and_in_ringside \
-    flipped_bit_reports_tick bad_files usage disk_full_keeps_nothing bench_sim_short
+    hashes_same_with_clang header_tampering_is_reported flipped_bit_reports_tick bad_files usage disk_full_keeps_nothing bench_sim_short
 t_done

@@ -11,6 +11,11 @@
 
 #include <stdint.h>
 
+/* Fixed point relies on >> of a negative value being an arithmetic
+ * (flooring) shift.  C11 leaves that to the implementation; every compiler
+ * we build with does it, and this stops the build on one that does not. */
+_Static_assert((-65536 >> 16) == -1 && (-1 >> 1) == -1, "arithmetic right shift required");
+
 typedef int32_t fx;   /* Q16.16 */
 typedef int32_t fang; /* 65536 per turn */
 

@@ -229,14 +229,15 @@ static void separate(g_state *st)
     /* walking into someone never pushes them out of the ring: a fighter
      * at the edge stays, the other takes the whole push */
     fx lim = g_stages[st->stage].ring_half - EDGE_MARGIN;
+    fx alim = fx_abs(a->x) > lim ? fx_abs(a->x) : lim, blim = fx_abs(b->x) > lim ? fx_abs(b->x) : lim;
     fx ax = a->x - push * dir, bx = b->x + push * dir;
-    if (fx_abs(ax) > lim && fx_abs(a->x) <= lim) {
-        fx c = ax > 0 ? lim : -lim;
+    if (fx_abs(ax) > alim) {
+        fx c = ax > 0 ? alim : -alim;
         bx += c - ax;
         ax = c;
     }
-    if (fx_abs(bx) > lim && fx_abs(b->x) <= lim) {
-        fx c = bx > 0 ? lim : -lim;
+    if (fx_abs(bx) > blim) {
+        fx c = bx > 0 ? blim : -blim;
         ax += c - bx;
         bx = c;
     }
@@ -278,6 +279,8 @@ static bool attack_connects(const g_state *st, int a, int d)
         return false;
     if (invulnerable(&st->f[d]))
         return false;
+    if (m->level == G_HIGH && g_moves[st->f[d].move].kind == G_CROUCHING)
+        return false; /* high attacks go over a crouching fighter (a rule, as in Virtua Fighter) */
     g_capsule ca[G_BONES], cd[G_BONES];
     g_fighter_capsules(st, a, ca);
     g_fighter_capsules(st, d, cd);
@@ -291,13 +294,16 @@ static bool attack_connects(const g_state *st, int a, int d)
     return false;
 }
 
-static void apply_hit(g_state *st, int a, int d, g_events *ev)
+/* before: the state as both attacks were tested, so a trade resolves both
+ * hits from the moves the fighters were doing, not from the reaction the
+ * first hit already put the other into */
+static void apply_hit(g_state *st, const g_state *before, int a, int d, g_events *ev)
 {
     g_fighter *fa = &st->f[a], *fd = &st->f[d];
-    const g_move *m = &g_moves[fa->move];
+    const g_move *m = &g_moves[before->f[a].move];
     fa->hit_done = 1;
     int away = fd->x >= fa->x ? 1 : -1;
-    if (blocks(fd, m->level) && fd->y == 0) {
+    if (blocks(&before->f[d], m->level) && fd->y == 0) {
         set_move(fd, fd->move == G_MV_CROUCH_GUARD ? G_MV_CROUCH_GUARD : G_MV_BLOCKSTUN);
         fd->frame = 0;
         fd->stun = m->blockstun;
@@ -333,6 +339,10 @@ static void animate(g_fighter *f)
         set_move(f, f->move == G_MV_CROUCH_GUARD ? G_MV_CROUCH_GUARD : G_MV_IDLE);
         return;
     }
+    if ((f->move == G_MV_HITSTUN || f->move == G_MV_BLOCKSTUN) && f->stun <= 0) {
+        set_move(f, G_MV_IDLE); /* never held in a stun state without stun */
+        return;
+    }
     if (f->frame < m->frames)
         return;
     switch (m->end) {
@@ -354,7 +364,8 @@ static void end_round(g_state *st, int result, int winner, g_events *ev)
     st->round_winner = winner;
     if (winner)
         st->f[winner - 1].rounds_won++;
-    emit(ev, result == G_RES_KO ? G_EV_KO : result == G_RES_RING_OUT ? G_EV_RING_OUT : G_EV_TIME_UP, winner, 0);
+    if (result == G_RES_KO || result == G_RES_RING_OUT || result == G_RES_TIME)
+        emit(ev, result == G_RES_KO ? G_EV_KO : result == G_RES_RING_OUT ? G_EV_RING_OUT : G_EV_TIME_UP, winner, 0);
     emit(ev, winner ? G_EV_ROUND_WIN : G_EV_DRAW, winner, st->round);
 }
 
@@ -450,10 +461,13 @@ void g_step(g_state *st, const g_input in_raw[2], g_events *ev)
     if (st->phase == G_PHASE_FIGHT) {
         /* both attacks are tested before either lands: trades are fair */
         bool hit0 = attack_connects(st, 0, 1), hit1 = attack_connects(st, 1, 0);
-        if (hit0)
-            apply_hit(st, 0, 1, ev);
-        if (hit1)
-            apply_hit(st, 1, 0, ev);
+        if (hit0 || hit1) {
+            g_state before = *st;
+            if (hit0)
+                apply_hit(st, &before, 0, 1, ev);
+            if (hit1)
+                apply_hit(st, &before, 1, 0, ev);
+        }
     }
     for (int i = 0; i < 2; i++)
         animate(&st->f[i]);

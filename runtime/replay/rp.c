@@ -187,6 +187,7 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
         return rs_fail(err, RP_ERR_CHECKSUM,
                        "%s: checksum mismatch at byte %zu: stored %08x, computed %08x (file damaged or truncated)",
                        name, len - 4, stored, crc);
+    r.n = len - 4; /* from here on, fields end where the checksum begins */
     if (!rd_u(&r, 2, &v, "flags"))
         return false;
     if (v != 0)
@@ -231,6 +232,8 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
     }
     if (!rd_u(&r, 1, &v, "reserved byte"))
         return false;
+    if (v != 0)
+        return BAD("%s: reserved byte 35 is %llu (expected 0)", name, (unsigned long long)v);
     if (!rd_u(&r, 4, &v, "input section length"))
         return false;
     size_t body_end = len - 4;
@@ -238,7 +241,7 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
         return BAD("%s: input section length %llu at byte 36 runs past the end of the file (%zu bytes left)", name,
                    (unsigned long long)v, body_end - r.o);
     /* each run is at least 3 bytes and covers at least one tick */
-    if (v < 3 || v / 3 > rp->ticks)
+    if (v < 3 || v > 3 * rp->ticks)
         return BAD("%s: input section length %llu at byte 36 does not fit %llu ticks", name, (unsigned long long)v,
                    (unsigned long long)rp->ticks);
     rp->input_bytes = (size_t)v;
@@ -337,7 +340,7 @@ static bool same(const rp_replay *a, const rp_replay *b)
            a->kind[0] == b->kind[0] && a->kind[1] == b->kind[1] && a->winner == b->winner &&
            a->rounds[0] == b->rounds[0] && a->rounds[1] == b->rounds[1] && a->ncheck == b->ncheck &&
            a->final_hash == b->final_hash && !memcmp(a->inputs, b->inputs, (size_t)a->ticks * 2) &&
-           !memcmp(a->checkpoints, b->checkpoints, a->ncheck * 8);
+           (a->ncheck == 0 || !memcmp(a->checkpoints, b->checkpoints, a->ncheck * 8));
 }
 
 bool rp_write(const char *path, const rp_replay *rp, rs_err *err)
@@ -480,6 +483,10 @@ bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t, uin
         }
         if (progress && ((t + 1) & 0xffff) == 0)
             progress(t + 1, rp->ticks, user);
+    }
+    if (res->winner != rp->winner || res->rounds[0] != rp->rounds[0] || res->rounds[1] != rp->rounds[1]) {
+        res->header_mismatch = true; /* hashes agree, the header's summary does not */
+        return true;
     }
     res->ok = true;
     return true;

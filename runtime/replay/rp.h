@@ -73,6 +73,7 @@ typedef struct rp_verify_result {
     uint64_t want, got;
     int winner;             /* of the first match, as simulated */
     int rounds[2];
+    bool header_mismatch;   /* every hash matched, but the header's winner or rounds do not */
 } rp_verify_result;
 
 /* Steps the game through every tick; checks every checkpoint and the final
