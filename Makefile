@@ -63,7 +63,7 @@ CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
 LDLIBS  = $(CONF_LIBS) -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
-LIB_SRC := $(wildcard runtime/*/*.c) \
+LIB_SRC := $(wildcard runtime/*/*.c capture/*.c) \
            $(filter-out runtime/main.c,$(wildcard runtime/*.c))
 MAIN_SRC := runtime/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
@@ -153,8 +153,8 @@ debug:
 demo: $(BUILD)/ringside
 	@mkdir -p out
 	$(BUILD)/ringside replay verify demos/dojo.rsr
-	$(BUILD)/ringside play --headless --replay demos/dojo.rsr --screenshot out/demo.png
-	@echo "demo: out/demo.png, the last frame of demos/dojo.rsr rendered headless (video output arrives with capture)"
+	$(BUILD)/ringside render demos/dojo.rsr -o out/demo.mp4
+	@echo "demo: out/demo.mp4, demos/dojo.rsr rendered headless (1280x720 drawn, 640x360 H.264, 60 fps)"
 
 bench: $(BUILD)/ringside
 	@mkdir -p out

@@ -32,6 +32,7 @@ int cmd_shaders(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 int cmd_record(int argc, char **argv);
 int cmd_play(int argc, char **argv);
+int cmd_render(int argc, char **argv);
 int cmd_replay(int argc, char **argv);
 
 /* Exit status for a failed plat_create: 2 for an unknown backend name. */

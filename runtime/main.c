@@ -12,6 +12,7 @@ static const cli_cmd commands[] = {
     {"smoke", cmd_smoke, "render the smoke test scene headless to an image"},
     {"shaders", cmd_shaders, "compile every shader in shaders/ and report errors"},
     {"play", cmd_play, "play in a window (or watch a replay), fixed 60 Hz"},
+    {"render", cmd_render, "render a replay to a video (.y4m, .mp4, ...), headless"},
     {"record", cmd_record, "record a CPU-vs-CPU match headless to a replay"},
     {"replay", cmd_replay, "replay info FILE, replay verify FILE"},
     {"bench", cmd_bench, "run a benchmark (bench platform, bench sim)"},

@@ -5,15 +5,17 @@
 set -eu
 cflags="" libs="" have=""
 probe() { # name pkg-config-module define
-    if pkg-config --exists "$2" 2>/dev/null; then
-        cflags="$cflags -D$3=1 $(pkg-config --cflags "$2")"
-        libs="$libs $(pkg-config --libs "$2")"
+    # shellcheck disable=SC2086
+    if pkg-config --exists $2 2>/dev/null; then
+        cflags="$cflags -D$3=1 $(pkg-config --cflags $2)"
+        libs="$libs $(pkg-config --libs $2)"
         have="$have $1"
     fi
 }
 probe egl egl RS_HAVE_EGL
 probe osmesa osmesa RS_HAVE_OSMESA
 probe glfw glfw3 RS_HAVE_GLFW
+probe ffmpeg "libavformat libavcodec libavutil" RS_HAVE_FFMPEG
 case "$have" in
 *egl*|*osmesa*) ;;
 *) echo "configure: neither EGL nor OSMesa found by pkg-config; run tools/deps.sh build" >&2; exit 1 ;;

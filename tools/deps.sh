@@ -12,11 +12,13 @@ set -eu
 
 group_pkgs() {
     case "$1" in
-    # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window
-    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev" ;;
+    # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window,
+    # FFmpeg's libraries for video output (x264 and libvpx come with libavcodec)
+    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev" ;;
     # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
-    # presses keys in that window to prove a person can play
-    test) echo "xvfb xauth xdotool" ;;
+    # presses keys in that window to prove a person can play; ffprobe (in
+    # ffmpeg) is the independent player that checks our videos
+    test) echo "xvfb xauth xdotool ffmpeg" ;;
     *) echo "deps.sh: unknown group '$1' (known: build test)" >&2; return 1 ;;
     esac
 }

@@ -1,0 +1,68 @@
+#include "cap_out.h"
+
+#include <errno.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "../runtime/util/rs_file.h"
+
+bool cap_out_open(cap_out *o, const char *path, rs_err *err)
+{
+    memset(o, 0, sizeof *o);
+    snprintf(o->path, sizeof o->path, "%s", path);
+    struct stat st;
+    o->device = stat(path, &st) == 0 && S_ISCHR(st.st_mode);
+    snprintf(o->tmp, sizeof o->tmp, o->device ? "%s" : "%s.part", path);
+    if (!o->device && !rs_mkdirs_for(path, err))
+        return false;
+    o->f = fopen(o->tmp, "wb");
+    if (!o->f)
+        return rs_fail(err, 1, "%s: cannot create: %s", o->tmp, strerror(errno));
+    setvbuf(o->f, NULL, _IOFBF, 1 << 20);
+    return true;
+}
+
+bool cap_out_write(cap_out *o, const void *data, size_t n, rs_err *err)
+{
+    errno = 0;
+    if (fwrite(data, 1, n, o->f) != n)
+        return rs_fail(err, 1, "%s: write failed: %s", o->path, strerror(errno ? errno : EIO));
+    return true;
+}
+
+bool cap_out_close(cap_out *o, bool ok, rs_err *err)
+{
+    if (!o->f)
+        return !ok;
+    if (ok) {
+        errno = 0;
+        bool good = fflush(o->f) == 0;
+        int e = errno;
+        if (good && !o->device && fsync(fileno(o->f)) != 0) {
+            good = false;
+            e = errno;
+        }
+        if (fclose(o->f) != 0 && good) {
+            good = false;
+            e = errno;
+        }
+        o->f = NULL;
+        if (!good) {
+            if (!o->device)
+                unlink(o->tmp);
+            return rs_fail(err, 1, "%s: write failed: %s", o->path, strerror(e ? e : EIO));
+        }
+        if (!o->device && rename(o->tmp, o->path) != 0) {
+            e = errno;
+            unlink(o->tmp);
+            return rs_fail(err, 1, "%s: cannot rename %s into place: %s", o->path, o->tmp, strerror(e));
+        }
+        return true;
+    }
+    fclose(o->f);
+    o->f = NULL;
+    if (!o->device)
+        unlink(o->tmp);
+    return true;
+}

@@ -1,0 +1,54 @@
+/* Capture sinks: where finished frames go.  One file per sink kind
+ * (cap_sink_y4m.c, cap_sink_ffmpeg.c, ...), all behind cap_sink_ops.
+ *
+ * A sink writes under a temporary name and makes the output appear only
+ * in close(ok = true): a failed render never leaves a file that looks
+ * finished.  Sinks are driven by one thread at a time (the writer). */
+#ifndef CAP_SINK_H
+#define CAP_SINK_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../runtime/util/rs_err.h"
+
+/* Frame layouts a sink can take. */
+typedef enum cap_pixfmt {
+    CAP_I420, /* planar Y, then Cb, then Cr at half size: BT.709 limited range, chroma sited at the centre */
+    CAP_RGBA, /* 8-bit RGBA, rows top-down */
+} cap_pixfmt;
+
+size_t cap_frame_bytes(cap_pixfmt fmt, int w, int h);
+
+typedef struct cap_sink cap_sink;
+
+typedef struct cap_sink_ops {
+    const char *name;
+    bool (*open)(cap_sink *s, rs_err *err);
+    bool (*write)(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *err);
+    /* ok: commit the output; !ok: remove everything written */
+    bool (*close)(cap_sink *s, bool ok, rs_err *err);
+} cap_sink_ops;
+
+struct cap_sink {
+    const cap_sink_ops *ops;
+    void *impl;
+    char path[1024];
+    int w, h;
+    cap_pixfmt fmt;
+    uint64_t frames;
+};
+
+/* Picks the sink from the output's extension (.y4m, .mp4, .mkv, .webm,
+ * name%06d.png|.exr|.tif) and checks it can work (the encoder exists) before
+ * anything is rendered.  Does not create the file yet: that is open(). */
+bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err);
+
+/* Human-readable list of what this build can write. */
+const char *cap_sink_formats(void);
+
+extern const cap_sink_ops cap_sink_y4m;
+extern const cap_sink_ops cap_sink_null; /* counts frames, writes nothing (benchmarks) */
+
+#endif

@@ -1,0 +1,226 @@
+/* ringside render: a replay to a video, headless, one frame per tick. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../capture/cap.h"
+#include "cli.h"
+#include "gl/rgl.h"
+#include "platform/plat.h"
+#include "render/r_game.h"
+#include "replay/rp.h"
+#include "util/rs_file.h"
+#include "util/rs_progress.h"
+
+static void help(void)
+{
+    printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
+           "                       [--capture async|sequential] [--downscale gpu|cpu] [--pbo N] [--queue N]\n"
+           "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n\n"
+           "Renders every tick of a replay headless and writes one video frame per tick\n"
+           "(60 frames a second, exact).  The output type comes from the extension:\n"
+           "%s.\n"
+           "The output appears only when complete; a failed render leaves nothing.\n\n"
+           "  -o OUT             output file ('/dev/null' and other devices are streamed)\n"
+           "  --size WxH         output size, even numbers (default 640x360)\n"
+           "  --render-size WxH  size the game is drawn at (default 1280x720)\n"
+           "  --capture MODE     async (default): GPU downscale, PBO ring, writer thread;\n"
+           "                     sequential: the original, everything on the game thread\n"
+           "  --downscale WHERE  gpu (async default) or cpu (sequential default)\n"
+           "  --pbo N            pixel-buffer ring size, 1..%d (default %d)\n"
+           "  --queue N          writer queue cap in frames, 0..1000 (default %d; 0: no thread)\n"
+           "  --hashes FILE      write \"frame hash\" (64-bit FNV-1a of the frame bytes) per frame\n"
+           "  --backend B        GL backend (default egl, falling back to osmesa)\n"
+           "  --quiet            no progress line\n",
+           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
+}
+
+typedef struct render_target {
+    GLuint fbo, tex, depth;
+} render_target;
+
+static bool make_target(render_target *t, int w, int h, rs_err *err)
+{
+    gl.GenFramebuffers(1, &t->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    gl.GenTextures(1, &t->tex);
+    gl.BindTexture(GL_TEXTURE_2D, t->tex);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->tex, 0);
+    gl.GenRenderbuffers(1, &t->depth);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, t->depth);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, w, h);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, t->depth);
+    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
+    if (st != GL_FRAMEBUFFER_COMPLETE)
+        return rs_fail(err, 1, "render target %dx%d incomplete (%s)", w, h, rgl_enum_name(st));
+    return true;
+}
+
+int cmd_render(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"output", required_argument, 0, 'o'},     {"size", required_argument, 0, 's'},
+        {"render-size", required_argument, 0, 'r'}, {"capture", required_argument, 0, 'c'},
+        {"downscale", required_argument, 0, 'd'},  {"pbo", required_argument, 0, 'p'},
+        {"queue", required_argument, 0, 'Q'},      {"hashes", required_argument, 0, 'H'},
+        {"backend", required_argument, 0, 'b'},    {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'},             {0}};
+    const char *out = NULL, *hashes = NULL, *backend = NULL;
+    cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
+    bool quiet = false;
+    long v;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'o': out = optarg; break;
+        case 's': if (!cli_size("--size", optarg, 8192, &cd.w, &cd.h)) return RS_EXIT_USAGE; break;
+        case 'r': if (!cli_size("--render-size", optarg, 8192, &cd.src_w, &cd.src_h)) return RS_EXIT_USAGE; break;
+        case 'c':
+            if (!strcmp(optarg, "async"))
+                cd.mode = CAP_ASYNC;
+            else if (!strcmp(optarg, "sequential"))
+                cd.mode = CAP_SEQUENTIAL;
+            else {
+                cli_error("render", "--capture '%s': expected async or sequential", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case 'd':
+            if (!strcmp(optarg, "gpu"))
+                cd.downscale = CAP_DS_GPU;
+            else if (!strcmp(optarg, "cpu"))
+                cd.downscale = CAP_DS_CPU;
+            else {
+                cli_error("render", "--downscale '%s': expected gpu or cpu", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case 'p': if (!cli_int("--pbo", optarg, 1, CAP_MAX_PBO, &v)) return RS_EXIT_USAGE; cd.pbo = (int)v; break;
+        case 'Q':
+            if (!cli_int("--queue", optarg, 0, 1000, &v))
+                return RS_EXIT_USAGE;
+            cd.queue = v ? (int)v : CAP_QUEUE_NONE;
+            break;
+        case 'H': hashes = optarg; break;
+        case 'b': backend = optarg; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default:
+            cli_error("render", "bad option or missing value '%s'", argv[optind - 1]);
+            return cli_usage_error("render");
+        }
+    }
+    if (optind + 1 != argc) {
+        cli_error("render", optind >= argc ? "a REPLAY file is required" : "unexpected argument '%s'",
+                  argv[argc - 1]);
+        return cli_usage_error("render");
+    }
+    if (!out) {
+        cli_error("render", "-o OUT is required");
+        return RS_EXIT_USAGE;
+    }
+    const char *replay = argv[optind];
+    rs_err err = {0};
+    if (!cap_check_sizes(cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
+        cli_error("render", "%s", err.msg);
+        return RS_EXIT_USAGE;
+    }
+
+    int status = RS_EXIT_FAIL;
+    rp_replay rp = {0};
+    cap_sink sink;
+    plat *p = NULL;
+    r_game *r = NULL;
+    render_target t = {0};
+    FILE *hf = NULL;
+    char hpart[1100] = "";
+    /* everything that can be checked without rendering, first */
+    if (!rp_read(replay, &rp, &err) || !cap_sink_for(out, cd.w, cd.h, &sink, &err))
+        goto done;
+    if (hashes) {
+        snprintf(hpart, sizeof hpart, "%s.part", hashes);
+        if (!rs_mkdirs_for(hashes, &err) || !(hf = fopen(hpart, "w"))) {
+            if (!err.msg[0])
+                rs_fail(&err, 1, "%s: cannot create", hpart);
+            goto done;
+        }
+        cd.hashes = hf;
+    }
+    p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err);
+    if (!p) {
+        status = cli_plat_status(&err);
+        goto done;
+    }
+    if (!(r = r_game_create(&err)) || !make_target(&t, cd.src_w, cd.src_h, &err))
+        goto done;
+    cap *cp = cap_open(&cd, &sink, &err);
+    if (!cp)
+        goto done;
+
+    g_state prev, cur;
+    g_init(&cur, rp.stage, rp.seed);
+    rs_progress prog;
+    rs_progress_start(&prog, "render", "frames", rp.ticks, quiet);
+    bool ok = true;
+    for (uint64_t tick = 0; tick < rp.ticks && ok; tick++) {
+        prev = cur;
+        g_step(&cur, &rp.inputs[2 * tick], NULL);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+        r_game_draw(r, &prev, &cur, 1.0f, cd.src_w, cd.src_h);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        ok = cap_frame(cp, t.tex, &err);
+        rs_progress_update(&prog, tick + 1);
+    }
+    double secs = rs_progress_end(&prog);
+    cap_stats st;
+    if (!cap_close(cp, ok, &st, &err))
+        goto done;
+    if (hf) {
+        bool hok = fclose(hf) == 0;
+        hf = NULL;
+        if (!hok || rename(hpart, hashes) != 0) {
+            rs_fail(&err, 1, "%s: write failed", hashes);
+            goto done;
+        }
+        hpart[0] = 0;
+    }
+    if (!quiet)
+        fprintf(stderr,
+                "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d) in %.1f s, %.1f fps; %s capture, "
+                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits\n",
+                out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, secs, secs > 0 ? st.frames / secs : 0.0,
+                cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
+                (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
+                cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.queue == CAP_QUEUE_NONE || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
+                st.high_water, st.fence_waits);
+    status = RS_EXIT_OK;
+done:
+    if (status != RS_EXIT_OK)
+        cli_error("render", "%s", err.msg);
+    if (hf)
+        fclose(hf);
+    if (hpart[0])
+        unlink(hpart);
+    if (p) {
+        if (t.fbo) {
+            gl.DeleteFramebuffers(1, &t.fbo);
+            gl.DeleteTextures(1, &t.tex);
+            gl.DeleteRenderbuffers(1, &t.depth);
+        }
+        r_game_destroy(r);
+        plat_destroy(p);
+    }
+    rp_free(&rp);
+    return status;
+}

@@ -1,0 +1,282 @@
+/* capture/: the writer queue (cap, order, errors), the CPU reference
+ * conversions, and the GPU path against the CPU path. */
+#define _GNU_SOURCE /* usleep */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../capture/cap.h"
+#include "../capture/cap_writer.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
+#include "t.h"
+
+/* A sink that checks order, can be slow, and can fail at a given frame. */
+typedef struct fake {
+    uint64_t next, fail_at;
+    int delay_us;
+    bool closed, committed;
+} fake;
+
+static bool f_open(cap_sink *s, rs_err *e)
+{
+    (void)s, (void)e;
+    return true;
+}
+static bool f_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *e)
+{
+    fake *f = s->impl;
+    if (f->delay_us)
+        usleep((useconds_t)f->delay_us);
+    if (index != f->next || frame[0] != (uint8_t)index || frame[7] != (uint8_t)(index >> 8))
+        return rs_fail(e, 1, "frame %llu out of order or torn", (unsigned long long)index);
+    f->next++;
+    if (f->fail_at && index + 1 == f->fail_at)
+        return rs_fail(e, 1, "fake: No space left on device");
+    return true;
+}
+static bool f_close(cap_sink *s, bool ok, rs_err *e)
+{
+    (void)e;
+    fake *f = s->impl;
+    f->closed = true;
+    f->committed = ok;
+    return ok;
+}
+static const cap_sink_ops fake_ops = {"fake", f_open, f_write, f_close};
+
+static void run_queue(int cap_frames, int delay_us, int frames, uint64_t fail_at, bool *ok_out, cap_writer_stats *st,
+                      fake *f, rs_err *err)
+{
+    *f = (fake){.fail_at = fail_at, .delay_us = delay_us};
+    cap_sink s = {.ops = &fake_ops, .impl = f, .w = 8, .h = 8};
+    cap_writer *w = cap_writer_start(&s, 16, cap_frames, NULL, err);
+    T_ASSERT(w);
+    bool ok = true;
+    for (int i = 0; i < frames && ok; i++) {
+        uint8_t *slot = cap_writer_acquire(w);
+        if (!slot) {
+            ok = false;
+            break;
+        }
+        memset(slot, 0, 16);
+        slot[0] = (uint8_t)i;
+        slot[7] = (uint8_t)(i >> 8);
+        ok = cap_writer_submit(w, slot);
+    }
+    bool fin = cap_writer_finish(w, st, err);
+    *ok_out = ok && fin;
+}
+
+static void t_queue_cap_holds(void)
+{
+    /* a slow sink: the queue fills to its cap and never beyond */
+    for (int capn = 1; capn <= 8; capn *= 2) {
+        bool ok;
+        cap_writer_stats st;
+        fake f;
+        rs_err e = {0};
+        run_queue(capn, 300, 60, 0, &ok, &st, &f, &e);
+        T_ASSERTF(ok, "%s", e.msg);
+        T_EQ(st.frames, 60);
+        T_EQ(f.next, 60);
+        T_ASSERTF(st.high_water <= capn && st.high_water >= capn - 1, "cap %d, high-water %d", capn, st.high_water);
+        T_ASSERT(st.full_waits > 0);
+    }
+}
+
+static void t_inline_queue(void)
+{
+    bool ok;
+    cap_writer_stats st;
+    fake f;
+    rs_err e = {0};
+    run_queue(0, 0, 100, 0, &ok, &st, &f, &e);
+    T_ASSERT(ok);
+    T_EQ(st.frames, 100);
+    T_EQ(st.high_water, 0);
+}
+
+static void t_writer_error_reaches_the_game_thread(void)
+{
+    for (int capn = 0; capn <= 8; capn += 8) {
+        bool ok;
+        cap_writer_stats st;
+        fake f;
+        rs_err e = {0};
+        run_queue(capn, 100, 500, 37, &ok, &st, &f, &e);
+        T_ASSERT(!ok);
+        T_CONTAINS(e.msg, "No space left on device");
+        T_EQ(st.frames, 36); /* frames before the failing one */
+        T_ASSERT(f.next <= 40); /* the writer stopped: it did not write the rest */
+    }
+}
+
+static void t_hash_is_fnv1a(void)
+{
+    T_EQ(cap_frame_hash((const uint8_t *)"", 0), 0xcbf29ce484222325ull);
+    T_EQ(cap_frame_hash((const uint8_t *)"a", 1), 0xaf63dc4c8601ec8cull);
+}
+
+static void t_cpu_yuv_known_colours(void)
+{
+    /* BT.709 limited range: black 16/128/128, white 235/128/128, pure red
+     * Y = 16 + 219 * 0.2126 = 62.6, Cr = 240 */
+    uint8_t rgba[2 * 2 * 4], out[6];
+    const uint8_t cols[3][3] = {{0, 0, 0}, {255, 255, 255}, {255, 0, 0}};
+    const uint8_t want[3][3] = {{16, 128, 128}, {235, 128, 128}, {63, 102, 240}};
+    for (int c = 0; c < 3; c++) {
+        for (int i = 0; i < 4; i++) {
+            memcpy(rgba + 4 * i, cols[c], 3);
+            rgba[4 * i + 3] = 255;
+        }
+        cap_cpu_rgba_to_i420(rgba, 2, 2, out);
+        T_ASSERTF(out[0] == want[c][0] && out[4] == want[c][1] && out[5] == want[c][2], "colour %d: %u %u %u", c,
+                  out[0], out[4], out[5]);
+    }
+}
+
+static void t_cpu_downscale_averages_and_flips(void)
+{
+    /* 4x2 source (bottom-up): bottom row 0, 100, 200, 40; top row all 80 */
+    uint8_t src[4 * 2 * 4] = {0};
+    const uint8_t bottom[4] = {0, 100, 200, 40};
+    for (int x = 0; x < 4; x++) {
+        src[x * 4] = bottom[x];
+        src[(4 + x) * 4] = 80;
+    }
+    uint8_t dst[2 * 1 * 4];
+    cap_cpu_downscale(src, 4, 2, dst, 2, 1);
+    T_EQ(dst[0], 65);  /* (0 + 100 + 80 + 80) / 4 */
+    T_EQ(dst[4], 100); /* (200 + 40 + 80 + 80) / 4 */
+    uint8_t odd[3 * 1 * 4];
+    cap_cpu_downscale(src, 4, 2, odd, 3, 1); /* 4/3 footprints: coverage weights */
+    T_EQ(odd[0], 53);  /* (0 + 100/3 + 80 + 80/3) / (8/3) = 52.5 -> 53 */
+    uint8_t dst2[2 * 2 * 4];
+    cap_cpu_downscale(src, 4, 2, dst2, 2, 2); /* 2x1 boxes; output row 0 is the top */
+    T_EQ(dst2[0], 80);
+    T_EQ(dst2[8], 50);
+}
+
+static void t_sizes(void)
+{
+    rs_err e = {0};
+    T_ASSERT(cap_check_sizes(1280, 720, 640, 360, &e));
+    T_ASSERT(!cap_check_sizes(1280, 720, 641, 360, &e));
+    T_CONTAINS(e.msg, "must be even");
+    T_ASSERT(!cap_check_sizes(640, 360, 1280, 720, &e));
+    T_CONTAINS(e.msg, "larger than the render size");
+    T_ASSERT(!cap_check_sizes(1280, 720, 100, 90, &e));
+    T_CONTAINS(e.msg, "more than 8 times");
+}
+
+/* A test picture in a texture: gradients and hard edges. */
+static GLuint test_texture(int w, int h, uint8_t *px)
+{
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            uint8_t *p = px + ((size_t)y * w + x) * 4;
+            p[0] = (uint8_t)(x * 255 / (w - 1));
+            p[1] = (uint8_t)(y * 255 / (h - 1));
+            p[2] = (x / 16 + y / 16) % 2 ? 220 : 30;
+            p[3] = 255;
+        }
+    GLuint t;
+    gl.GenTextures(1, &t);
+    gl.BindTexture(GL_TEXTURE_2D, t);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    return t;
+}
+
+/* Captures one texture through cap into an in-memory frame. */
+typedef struct grab {
+    uint8_t frame[160 * 90 * 3 / 2];
+    int n;
+} grab;
+static bool g_open(cap_sink *s, rs_err *e)
+{
+    (void)s, (void)e;
+    return true;
+}
+static bool g_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *e)
+{
+    (void)index, (void)e;
+    grab *g = s->impl;
+    memcpy(g->frame, frame, sizeof g->frame);
+    g->n++;
+    return true;
+}
+static bool g_close(cap_sink *s, bool ok, rs_err *e)
+{
+    (void)s, (void)e;
+    return ok;
+}
+static const cap_sink_ops grab_ops = {"grab", g_open, g_write, g_close};
+
+static void capture_one(GLuint tex, cap_mode mode, cap_downscale ds, int pbo, grab *g)
+{
+    cap_sink s = {.ops = &grab_ops, .impl = g, .w = 160, .h = 90, .fmt = CAP_I420};
+    rs_err e = {0};
+    cap *c = cap_open(&(cap_desc){.src_w = 320, .src_h = 180, .w = 160, .h = 90, .mode = mode, .downscale = ds,
+                                  .pbo = pbo},
+                      &s, &e);
+    T_ASSERTF(c, "%s", e.msg);
+    for (int i = 0; i < 3; i++)
+        T_ASSERT(cap_frame(c, tex, &e));
+    cap_stats st;
+    T_ASSERTF(cap_close(c, true, &st, &e), "%s", e.msg);
+    T_EQ(st.frames, 3);
+    T_EQ(g->n, 3);
+}
+
+static double psnr(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    double se = 0;
+    for (size_t i = 0; i < n; i++)
+        se += (double)(a[i] - b[i]) * (a[i] - b[i]);
+    return se == 0 ? 99.0 : 10 * log10(255.0 * 255.0 * n / se);
+}
+
+static void gpu_vs_cpu(const char *backend)
+{
+    plat *p = t_context(backend);
+    static uint8_t px[320 * 180 * 4];
+    GLuint tex = test_texture(320, 180, px);
+    static grab gpu_async, gpu_seq, cpu_seq, pbo1, pbo3;
+    capture_one(tex, CAP_ASYNC, CAP_DS_GPU, 2, &gpu_async);
+    capture_one(tex, CAP_SEQUENTIAL, CAP_DS_GPU, 0, &gpu_seq);
+    capture_one(tex, CAP_SEQUENTIAL, CAP_DS_CPU, 0, &cpu_seq);
+    capture_one(tex, CAP_ASYNC, CAP_DS_GPU, 1, &pbo1);
+    capture_one(tex, CAP_ASYNC, CAP_DS_GPU, 3, &pbo3);
+    size_t n = sizeof gpu_async.frame;
+    /* same downscale, same bytes, whatever the path or ring size */
+    T_ASSERT(!memcmp(gpu_async.frame, gpu_seq.frame, n));
+    T_ASSERT(!memcmp(gpu_async.frame, pbo1.frame, n));
+    T_ASSERT(!memcmp(gpu_async.frame, pbo3.frame, n));
+    /* GPU and CPU implement the same maths: only rounding may differ */
+    double q = psnr(gpu_async.frame, cpu_seq.frame, n);
+    T_ASSERTF(q > 50, "GPU vs CPU conversion: PSNR %.1f dB", q);
+    /* orientation: the top-left output pixel comes from the top-left of the
+     * picture (x = 0: red 0; top rows: green high) */
+    uint8_t top_left_y = gpu_async.frame[0], bottom_left_y = gpu_async.frame[(size_t)89 * 160];
+    /* the texture's row 0 (GL bottom) has green 0; the top has green 255 */
+    T_ASSERTF(top_left_y > bottom_left_y + 60, "flipped? top-left Y %u, bottom-left Y %u", top_left_y, bottom_left_y);
+    gl.DeleteTextures(1, &tex);
+    plat_destroy(p);
+}
+
+static void t_gpu_matches_cpu_egl(void) { gpu_vs_cpu("egl"); }
+static void t_gpu_matches_cpu_osmesa(void) { gpu_vs_cpu("osmesa"); }
+
+T_MAIN({"queue_cap_holds", t_queue_cap_holds}, {"inline_queue", t_inline_queue},
+       {"writer_error_reaches_the_game_thread", t_writer_error_reaches_the_game_thread},
+       {"hash_is_fnv1a", t_hash_is_fnv1a}, {"cpu_yuv_known_colours", t_cpu_yuv_known_colours},
+       {"cpu_downscale_averages_and_flips", t_cpu_downscale_averages_and_flips}, {"sizes", t_sizes},
+       {"gpu_matches_cpu_egl", t_gpu_matches_cpu_egl}, {"gpu_matches_cpu_osmesa", t_gpu_matches_cpu_osmesa})

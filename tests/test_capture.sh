@@ -1,0 +1,91 @@
+#!/bin/sh
+# End-to-end: ringside render, checked by an independent player (ffprobe).
+# Small sizes and a short replay keep it quick on llvmpipe.
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/lib.sh"
+SRC=$(cd "$here/.." && pwd)
+SIZES="--render-size 320x180 --size 160x90"
+
+short_replay() { # 300 ticks: the intro and the start of round 1
+    "$RS_BIN" record --ai --quiet --seconds 5 --seed 21 -o short.rsr 2>/dev/null
+}
+
+probe() { # file -> "frames rate duration"
+    ffprobe -v error -count_frames -select_streams v:0 \
+        -show_entries stream=nb_read_frames,r_frame_rate:format=duration -of default=nw=1:nk=1 "$1" | tr '\n' ' '
+}
+
+t_async_equals_sequential() {
+    short_replay || return 1
+    "$RS_BIN" render short.rsr -o a.y4m $SIZES --quiet --hashes a.txt || return 1
+    "$RS_BIN" render short.rsr -o s.y4m $SIZES --quiet --capture sequential --downscale gpu --hashes s.txt || return 1
+    "$RS_BIN" render short.rsr -o p.y4m $SIZES --quiet --pbo 3 --queue 8 --hashes p.txt || return 1
+    [ "$(wc -l <a.txt)" = 300 ] || { echo "want 300 hashes"; return 1; }
+    cmp a.txt s.txt || { echo "async and sequential frames differ"; return 1; }
+    cmp a.txt p.txt || { echo "pbo 3 / queue 8 frames differ"; return 1; }
+    # frame numbers 0..299 in order
+    [ "$(cut -d' ' -f1 a.txt | tr '\n' ' ')" = "$(seq -s' ' 0 299) " ] || { echo "frame order"; return 1; }
+}
+
+t_y4m_plays() {
+    command -v ffprobe >/dev/null || t_skip_case "ffprobe not installed"
+    short_replay || return 1
+    "$RS_BIN" render short.rsr -o v.y4m $SIZES --quiet || return 1
+    set -- $(probe v.y4m)
+    [ "$1 $2" = "60/1 300" ] || { echo "y4m: rate/frames $1 $2"; return 1; }
+    head -c 80 v.y4m | grep -q "^YUV4MPEG2 W160 H90 F60:1 Ip A1:1 C420jpeg XCOLORRANGE=LIMITED" || return 1
+}
+
+t_mp4_exact_timing() {
+    command -v ffprobe >/dev/null || t_skip_case "ffprobe not installed"
+    "$RS_BIN" render --help | grep -q "\.mp4" || t_skip_case "this build has no FFmpeg"
+    short_replay || return 1
+    "$RS_BIN" render short.rsr -o v.mp4 $SIZES --quiet 2>e.txt || { cat e.txt; return 1; }
+    [ ! -s e.txt ] || { echo "noise on stderr with --quiet:"; cat e.txt; return 1; }
+    set -- $(probe v.mp4)
+    [ "$1" = "60/1" ] && [ "$2" = 300 ] || { echo "mp4: rate $1 frames $2"; return 1; }
+    [ "$3" = "5.000000" ] || { echo "mp4: duration $3, want 5.000000"; return 1; }
+    ffprobe -v error -show_entries stream=codec_name,color_range,color_space -of csv=p=0 v.mp4 | grep -q "h264,tv,bt709" ||
+        { ffprobe -v error -show_entries stream=codec_name,color_range,color_space -of csv=p=0 v.mp4; return 1; }
+    "$RS_BIN" render short.rsr -o v.mkv $SIZES --quiet || return 1
+    set -- $(probe v.mkv)
+    [ "$2" = 300 ] || { echo "mkv frames $2"; return 1; }
+}
+
+t_disk_full() {
+    short_replay || return 1
+    expect_fail 1 "/dev/full: write failed: No space left on device" "$RS_BIN" render short.rsr -o /dev/full $SIZES --quiet ||
+        return 1
+    [ "$(wc -l <err.txt)" = 1 ] || { cat err.txt; return 1; }
+    # an ordinary file that cannot grow: nothing left behind
+    ( trap '' XFSZ; ulimit -f 200; exec "$RS_BIN" render short.rsr -o big.y4m $SIZES --quiet --hashes big.txt ) 2>err.txt
+    [ $? = 1 ] || { echo "want exit 1"; cat err.txt; return 1; }
+    grep -q "big.y4m: write failed: File too large" err.txt || { cat err.txt; return 1; }
+    [ ! -e big.y4m ] && [ ! -e big.y4m.part ] && [ ! -e big.txt ] && [ ! -e big.txt.part ] ||
+        { echo "left behind:"; ls; return 1; }
+}
+
+t_bad_input() {
+    short_replay || return 1
+    expect_fail 2 "must be even for 4:2:0" "$RS_BIN" render short.rsr -o x.y4m --size 161x90 || return 1
+    expect_fail 2 "larger than the render size" "$RS_BIN" render short.rsr -o x.y4m --size 1920x1080 || return 1
+    expect_fail 1 "x.avi: unknown output type '.avi'" "$RS_BIN" render short.rsr -o x.avi || return 1
+    expect_fail 1 "nope.rsr: cannot open" "$RS_BIN" render nope.rsr -o x.y4m || return 1
+    expect_fail 2 "--capture 'fast'" "$RS_BIN" render short.rsr -o x.y4m --capture fast || return 1
+    expect_fail 2 "--pbo '9'" "$RS_BIN" render short.rsr -o x.y4m --pbo 9 || return 1
+    expect_fail 2 "-o OUT is required" "$RS_BIN" render short.rsr || return 1
+    head -c 50 short.rsr >cut.rsr
+    expect_fail 1 "cut.rsr: truncated: 50 bytes" "$RS_BIN" render cut.rsr -o x.y4m || return 1
+    [ ! -e x.y4m ] && [ ! -e x.y4m.part ] && [ ! -e x.avi ] || { echo "output left behind"; return 1; }
+}
+
+t_queue_cap_in_report() {
+    short_replay || return 1
+    "$RS_BIN" render short.rsr -o /dev/null $SIZES --queue 4 2>r.txt || { cat r.txt; return 1; }
+    hw=$(sed -n 's/.*high-water \([0-9]*\).*/\1/p' r.txt)
+    [ -n "$hw" ] && [ "$hw" -le 4 ] || { cat r.txt; return 1; }
+    grep -q "300 frames 160x90" r.txt || { cat r.txt; return 1; }
+}
+
+t_run async_equals_sequential y4m_plays mp4_exact_timing disk_full bad_input queue_cap_in_report
+t_done
