@@ -60,7 +60,12 @@ $(shell mkdir -p $(BUILD) && (echo '$(FLAGS_SIG)' | cmp -s - $(BUILD)/flags || e
 endif
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  = $(CONF_LIBS) -lm -lpthread -ldl
+# the one C++ file: OpenImageIO's C face (capture/cap_oiio.cpp)
+CXX     ?= g++
+SAN_CXX := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(filter 1,$(WERROR)),-Werror) \
+           $(if $(filter 1,$(SAN)),$(SAN_CXX))
+LDLIBS  = $(CONF_LIBS) -lstdc++ -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
 LIB_SRC := $(wildcard runtime/*/*.c capture/*.c) \
@@ -69,7 +74,8 @@ MAIN_SRC := runtime/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
-LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+LIB_CXX  := $(wildcard capture/*.cpp)
+LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
 .PHONY: all test asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
@@ -94,6 +100,10 @@ $(BUILD)/config.mk: tools/configure.sh $(STAMPS)/build
 $(BUILD)/obj/%.o: %.c $(BUILD)/config.mk $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/%.o: %.cpp $(BUILD)/config.mk $(BUILD)/flags
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -c $< -o $@
 
 $(BUILD)/libringside.a: $(LIB_OBJ)
 	@rm -f $@
@@ -160,6 +170,7 @@ bench: $(BUILD)/ringside
 	@mkdir -p out
 	$(BUILD)/ringside bench platform --csv out/bench-platform.csv
 	$(BUILD)/ringside bench sim --csv out/bench-sim.csv
+	$(BUILD)/ringside bench capture --csv out/bench-capture.csv --chart out/bench-capture.png
 
 # The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
 # same commands must reproduce them byte for byte (tests/test_replay.sh).

@@ -19,6 +19,7 @@
 
 #include "../runtime/render/r_shader.h"
 #include "../runtime/util/rs_progress.h"
+#include "cap_scale.h"
 #include "cap_writer.h"
 
 typedef struct target {
@@ -34,8 +35,9 @@ struct cap {
     bool gpu;          /* GPU downscale + convert */
     bool failed;
     /* GPU stage */
-    GLuint vao, prog_box, prog_luma, prog_chroma;
-    GLint u_src, u_src_size, u_dst_size, u_rgb_luma, u_rgb_chroma;
+    cap_scaler *scaler;
+    GLuint vao, prog_luma, prog_chroma;
+    GLint u_rgb_luma, u_rgb_chroma;
     target rgb, luma, chroma;
     GLuint read_fbo;   /* to read the source texture (CPU path) */
     /* PBO ring (async) */
@@ -96,16 +98,13 @@ static void free_target(target *t)
 
 static bool gpu_setup(cap *c, rs_err *err)
 {
-    c->prog_box = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "cap_box.frag"}, err);
-    if (c->prog_box)
+    c->scaler = cap_scaler_create(c->d.filter, c->d.src_w, c->d.src_h, c->d.w, c->d.h, err);
+    if (c->scaler)
         c->prog_luma = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "cap_luma.frag"}, err);
     if (c->prog_luma)
         c->prog_chroma = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "cap_chroma.frag"}, err);
     if (!c->prog_chroma)
         return false;
-    c->u_src = gl.GetUniformLocation(c->prog_box, "u_src");
-    c->u_src_size = gl.GetUniformLocation(c->prog_box, "u_src_size");
-    c->u_dst_size = gl.GetUniformLocation(c->prog_box, "u_dst_size");
     c->u_rgb_luma = gl.GetUniformLocation(c->prog_luma, "u_rgb");
     c->u_rgb_chroma = gl.GetUniformLocation(c->prog_chroma, "u_rgb");
     gl.GenVertexArrays(1, &c->vao);
@@ -118,23 +117,15 @@ static bool gpu_setup(cap *c, rs_err *err)
 /* Downscale src into rgb, then Y, Cb, Cr planes; nothing is read back here. */
 static void gpu_convert(cap *c, GLuint src)
 {
+    cap_scaler_run(c->scaler, src, c->rgb.fbo);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.Disable(GL_CULL_FACE);
     gl.BindVertexArray(c->vao);
     gl.ActiveTexture(GL_TEXTURE0);
-
-    gl.BindFramebuffer(GL_FRAMEBUFFER, c->rgb.fbo);
-    gl.Viewport(0, 0, c->d.w, c->d.h);
-    gl.UseProgram(c->prog_box);
-    gl.BindTexture(GL_TEXTURE_2D, src);
-    gl.Uniform1i(c->u_src, 0);
-    gl.Uniform2i(c->u_src_size, c->d.src_w, c->d.src_h);
-    gl.Uniform2i(c->u_dst_size, c->d.w, c->d.h);
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
-
     gl.BindTexture(GL_TEXTURE_2D, c->rgb.tex[0]);
     gl.BindFramebuffer(GL_FRAMEBUFFER, c->luma.fbo);
+    gl.Viewport(0, 0, c->d.w, c->d.h);
     gl.UseProgram(c->prog_luma);
     gl.Uniform1i(c->u_rgb_luma, 0);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
@@ -374,7 +365,7 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err)
         gl.DeleteFramebuffers(1, &c->read_fbo);
     if (c->vao)
         gl.DeleteVertexArrays(1, &c->vao);
-    gl.DeleteProgram(c->prog_box);
+    cap_scaler_destroy(c->scaler);
     gl.DeleteProgram(c->prog_luma);
     gl.DeleteProgram(c->prog_chroma);
     free(c->full);

@@ -19,6 +19,7 @@
 #include <stdio.h>
 
 #include "../runtime/gl/rgl.h"
+#include "cap_scale.h"
 #include "cap_sink.h"
 
 typedef enum cap_mode { CAP_ASYNC, CAP_SEQUENTIAL } cap_mode;
@@ -36,6 +37,7 @@ typedef struct cap_desc {
     int w, h;                /* output; even, at most the render size */
     cap_mode mode;           /* default async */
     cap_downscale downscale; /* default: GPU for async, CPU for sequential */
+    cap_filter filter;       /* GPU downscale filter, default box (the CPU path is always box) */
     int pbo;                 /* ring size, default 2 */
     int queue;               /* writer queue cap, default 120; CAP_QUEUE_NONE: inline */
     FILE *hashes;            /* optional: "index hash" per output frame */

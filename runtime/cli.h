@@ -30,6 +30,8 @@ int cmd_info(int argc, char **argv);
 int cmd_smoke(int argc, char **argv);
 int cmd_shaders(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+int bench_capture(int argc, char **argv);
+int bench_accuracy(int argc, char **argv);
 int cmd_record(int argc, char **argv);
 int cmd_play(int argc, char **argv);
 int cmd_render(int argc, char **argv);

@@ -18,7 +18,8 @@
 static void help(void)
 {
     printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
-           "                       [--capture async|sequential] [--downscale gpu|cpu] [--pbo N] [--queue N]\n"
+           "                       [--capture async|sequential] [--downscale gpu|cpu] [--filter F]\n"
+           "                       [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension:\n"
@@ -30,6 +31,8 @@ static void help(void)
            "  --capture MODE     async (default): GPU downscale, PBO ring, writer thread;\n"
            "                     sequential: the original, everything on the game thread\n"
            "  --downscale WHERE  gpu (async default) or cpu (sequential default)\n"
+           "  --filter F         GPU downscale: box (default), bilinear, nearest, lanczos3\n"
+           "                     (docs/capture.md compares them)\n"
            "  --pbo N            pixel-buffer ring size, 1..%d (default %d)\n"
            "  --queue N          writer queue cap in frames, 0..1000 (default %d; 0: no thread)\n"
            "  --hashes FILE      write \"frame hash\" (64-bit FNV-1a of the frame bytes) per frame\n"
@@ -73,6 +76,7 @@ int cmd_render(int argc, char **argv)
         {"downscale", required_argument, 0, 'd'},  {"pbo", required_argument, 0, 'p'},
         {"queue", required_argument, 0, 'Q'},      {"hashes", required_argument, 0, 'H'},
         {"backend", required_argument, 0, 'b'},    {"quiet", no_argument, 0, 'q'},
+        {"filter", required_argument, 0, 'F'},
         {"help", no_argument, 0, 'h'},             {0}};
     const char *out = NULL, *hashes = NULL, *backend = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
@@ -111,6 +115,12 @@ int cmd_render(int argc, char **argv)
             if (!cli_int("--queue", optarg, 0, 1000, &v))
                 return RS_EXIT_USAGE;
             cd.queue = v ? (int)v : CAP_QUEUE_NONE;
+            break;
+        case 'F':
+            if (!cap_filter_parse(optarg, &cd.filter)) {
+                cli_error("render", "--filter '%s': expected box, bilinear, nearest or lanczos3", optarg);
+                return RS_EXIT_USAGE;
+            }
             break;
         case 'H': hashes = optarg; break;
         case 'b': backend = optarg; break;

@@ -13,6 +13,13 @@ const int MAX_TAPS = 10; // footprints up to 8 texels wide (plus partial edges)
 void main()
 {
     ivec2 p = ivec2(gl_FragCoord.xy); // p.y: image row from the top
+#ifdef FACTOR2
+    // exactly 2x in both axes: one bilinear tap at the centre of the 2x2
+    // block is its average (the sampler filters linearly)
+    vec2 c = vec2(2 * p.x + 1, float(u_src_size.y) - float(2 * p.y + 1));
+    o_color = texture(u_src, c / vec2(u_src_size));
+    return;
+#endif
     vec2 scale = vec2(u_src_size) / vec2(u_dst_size);
     vec2 lo = vec2(p) * scale, hi = lo + scale;
     vec4 sum = vec4(0.0);

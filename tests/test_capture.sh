@@ -87,5 +87,42 @@ t_queue_cap_in_report() {
     grep -q "300 frames 160x90" r.txt || { cat r.txt; return 1; }
 }
 
-t_run async_equals_sequential y4m_plays mp4_exact_timing disk_full bad_input queue_cap_in_report
+t_bench_capture_small() {
+    "$RS_BIN" bench capture --frames 10 --runs 1 --render-size 320x180 --size 160x90 --sink y4m --csv b.csv --chart b.png \
+        >b.txt 2>&1 || { cat b.txt; return 1; }
+    for row in render-only writer-only sequential "async pbo1 q0" "async pbo2 q120" "async pbo3 q8"; do
+        grep -q "^$row " b.txt || { echo "no row $row"; cat b.txt; return 1; }
+    done
+    grep -q "^async (pbo 2, queue 120) / sequential: *[0-9.]*x" b.txt || { cat b.txt; return 1; }
+    grep -q "^async / min(render-only" b.txt || { cat b.txt; return 1; }
+    [ "$(wc -l <b.csv)" = 13 ] || { echo "csv rows"; cat b.csv; return 1; }
+    [ "$(head -c 8 b.png | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || { echo "chart is not a PNG"; return 1; }
+    [ ! -e out/bench-capture-scratch.y4m ] || { echo "scratch output left"; return 1; }
+}
+
+t_filters() {
+    short_replay || return 1
+    for f in box bilinear nearest lanczos3; do
+        "$RS_BIN" render short.rsr -o "$f.y4m" $SIZES --quiet --filter $f --hashes "$f.txt" || { echo "filter $f"; return 1; }
+        [ "$(wc -l <"$f.txt")" = 300 ] || return 1
+    done
+    ! cmp -s box.txt lanczos3.txt || { echo "lanczos3 gave the same frames as box"; return 1; }
+    ! cmp -s box.txt nearest.txt || { echo "nearest gave the same frames as box"; return 1; }
+    expect_fail 2 "--filter 'cubic'" "$RS_BIN" render short.rsr -o x.y4m --filter cubic || return 1
+}
+
+t_bench_accuracy_small() {
+    "$RS_BIN" bench accuracy --frames 1 --render-size 320x180 --size 160x90 --csv a.csv >a.txt 2>&1 ||
+        { grep -q "no OpenImageIO" a.txt && t_skip_case "no OpenImageIO in this build"; cat a.txt; return 1; }
+    for f in box bilinear nearest lanczos3 "cpu box"; do
+        grep -Eq "^$f +[0-9]+\.[0-9]+ +[0-9]+\.[0-9]+" a.txt || { echo "no row $f"; cat a.txt; return 1; }
+    done
+    # the filters must rank as filters do: lanczos3 closest to the lanczos3 reference, nearest worst
+    l=$(awk '$1=="lanczos3"{print $2}' a.txt) b=$(awk '$1=="box"{print $2}' a.txt) n=$(awk '$1=="nearest"{print $2}' a.txt)
+    awk -v l="$l" -v b="$b" -v n="$n" 'BEGIN { exit !(l > b && b > n && n > 20) }' || { cat a.txt; return 1; }
+    grep -q "RGB -> YCbCr 4:2:0" a.txt || return 1
+    [ "$(wc -l <a.csv)" = 7 ] || { cat a.csv; return 1; }
+}
+
+t_run filters bench_accuracy_small bench_capture_small async_equals_sequential y4m_plays mp4_exact_timing disk_full bad_input queue_cap_in_report
 t_done

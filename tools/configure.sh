@@ -16,6 +16,7 @@ probe egl egl RS_HAVE_EGL
 probe osmesa osmesa RS_HAVE_OSMESA
 probe glfw glfw3 RS_HAVE_GLFW
 probe ffmpeg "libavformat libavcodec libavutil" RS_HAVE_FFMPEG
+probe oiio OpenImageIO RS_HAVE_OIIO
 case "$have" in
 *egl*|*osmesa*) ;;
 *) echo "configure: neither EGL nor OSMesa found by pkg-config; run tools/deps.sh build" >&2; exit 1 ;;

@@ -13,8 +13,9 @@ set -eu
 group_pkgs() {
     case "$1" in
     # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window,
-    # FFmpeg's libraries for video output (x264 and libvpx come with libavcodec)
-    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev" ;;
+    # FFmpeg's libraries for video output (x264 and libvpx come with libavcodec),
+    # OpenImageIO for image sequences and the reference resize
+    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev" ;;
     # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
     # presses keys in that window to prove a person can play; ffprobe (in
     # ffmpeg) is the independent player that checks our videos

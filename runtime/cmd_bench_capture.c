@@ -1,0 +1,382 @@
+/* ringside bench capture: sequential against asynchronous capture, and each
+ * against the pipeline's slowest stage, measured in one run.
+ *
+ * Every configuration renders the same frames of the same replay (the
+ * dojo demo from tick 600, after the intro) at the same sizes into the same
+ * kind of sink; only the capture path changes. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../capture/cap.h"
+#include "cli.h"
+#include "gl/rgl.h"
+#include "platform/plat.h"
+#include "render/r_game.h"
+#include "replay/rp.h"
+#include "util/rs_chart.h"
+#include "util/rs_file.h"
+#include "util/rs_progress.h"
+
+#define MAX_RUNS 9
+
+typedef struct run {
+    char name[32];
+    double fps_each[MAX_RUNS];
+    cap_mode mode;
+    cap_downscale ds;
+    int pbo, queue; /* queue: CAP_QUEUE_NONE for 0 */
+    int kind;       /* 0 capture, 1 render-only, 2 writer-only */
+    double fps, ms_render, rss_mb;
+    cap_stats st;
+} run;
+
+typedef struct bench {
+    rp_replay rp;
+    uint64_t start;
+    int frames, sw, sh, w, h;
+    const char *out; /* sink path */
+    r_game *r;
+    GLuint fbo, tex, depth;
+    uint8_t *mem; /* frames captured once, for writer-only */
+} bench;
+
+static void reset_peak_rss(void)
+{
+    FILE *f = fopen("/proc/self/clear_refs", "w"); /* "5": reset the peak RSS (Linux) */
+    if (f) {
+        fputs("5", f);
+        fclose(f);
+    }
+}
+
+static double peak_rss_mb(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double kb = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "VmHWM:", 6))
+            kb = atof(line + 6);
+    if (f)
+        fclose(f);
+    return kb / 1024;
+}
+
+/* The state at the first benchmarked tick (simulation only, not timed). */
+static void seek(const bench *b, g_state *st)
+{
+    g_init(st, b->rp.stage, b->rp.seed);
+    for (uint64_t t = 0; t < b->start; t++)
+        g_step(st, &b->rp.inputs[2 * t], NULL);
+}
+
+static double draw_frame(bench *b, g_state *prev, g_state *cur, uint64_t tick)
+{
+    double t0 = rs_now();
+    *prev = *cur;
+    g_step(cur, &b->rp.inputs[2 * tick], NULL);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, b->fbo);
+    r_game_draw(b->r, prev, cur, 1.0f, b->sw, b->sh);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    return (rs_now() - t0) * 1e3;
+}
+
+/* A sink that keeps frames in memory (to feed writer-only). */
+static bool mem_open(cap_sink *s, rs_err *e)
+{
+    (void)s, (void)e;
+    return true;
+}
+static bool mem_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *e)
+{
+    (void)e;
+    bench *b = s->impl;
+    size_t n = cap_frame_bytes(CAP_I420, b->w, b->h);
+    memcpy(b->mem + n * index, frame, n);
+    return true;
+}
+static bool mem_close(cap_sink *s, bool ok, rs_err *e)
+{
+    (void)s, (void)e;
+    return ok;
+}
+static const cap_sink_ops mem_ops = {"memory", mem_open, mem_write, mem_close};
+
+static bool do_run(bench *b, run *r, rs_err *err)
+{
+    g_state prev, cur;
+    seek(b, &cur);
+    reset_peak_rss();
+    double t0 = rs_now(), render_ms = 0;
+    if (r->kind == 1) { /* render only */
+        for (int f = 0; f < b->frames; f++)
+            render_ms += draw_frame(b, &prev, &cur, b->start + (uint64_t)f);
+        gl.Finish();
+    } else if (r->kind == 2) { /* writer only: frames from memory into the sink */
+        cap_sink s;
+        if (!cap_sink_for(b->out, b->w, b->h, &s, err) || !s.ops->open(&s, err))
+            return false;
+        size_t n = cap_frame_bytes(CAP_I420, b->w, b->h);
+        t0 = rs_now();
+        bool ok = true;
+        for (int f = 0; f < b->frames && ok; f++)
+            ok = s.ops->write(&s, b->mem + n * (size_t)f, (uint64_t)f, err);
+        if (!s.ops->close(&s, ok, err) || !ok)
+            return false;
+        r->st.ms_write = (rs_now() - t0) * 1e3;
+        r->st.frames = (uint64_t)b->frames;
+    } else {
+        cap_sink s;
+        bool to_mem = r->kind == 3;
+        if (to_mem) {
+            memset(&s, 0, sizeof s);
+            s.ops = &mem_ops;
+            s.impl = b;
+            s.w = b->w;
+            s.h = b->h;
+        } else if (!cap_sink_for(b->out, b->w, b->h, &s, err)) {
+            return false;
+        }
+        cap *c = cap_open(&(cap_desc){.src_w = b->sw, .src_h = b->sh, .w = b->w, .h = b->h, .mode = r->mode,
+                                      .downscale = r->ds, .pbo = r->pbo, .queue = r->queue},
+                          &s, err);
+        if (!c)
+            return false;
+        bool ok = true;
+        for (int f = 0; f < b->frames && ok; f++) {
+            render_ms += draw_frame(b, &prev, &cur, b->start + (uint64_t)f);
+            ok = cap_frame(c, b->tex, err);
+        }
+        if (!cap_close(c, ok, &r->st, err) || !ok)
+            return false;
+    }
+    double secs = rs_now() - t0;
+    r->fps = b->frames / secs;
+    r->ms_render = render_ms / b->frames;
+    r->rss_mb = peak_rss_mb();
+    if (unlink(b->out) != 0 && strncmp(b->out, "/dev/", 5) != 0) {
+        /* the benchmark's output is scratch */
+    }
+    return true;
+}
+
+static void help(void)
+{
+    printf("usage: ringside bench capture [--frames N] [--runs N] [--size WxH] [--render-size WxH]\n"
+           "                              [--sink mp4|y4m|null] [--csv FILE] [--chart FILE.png] [--quiet]\n\n"
+           "Renders %s same frames of demos/dojo.rsr (from tick 600) through every capture\n"
+           "configuration and prints fps and milliseconds per frame for each stage:\n"
+           "render-only, writer-only (frames from memory to the sink), sequential (CPU\n"
+           "downscale, all on the game thread), and async with PBO rings 1/2/3 and writer\n"
+           "queues 0/8/120.  The ratios async/sequential and async/min(render-only,\n"
+           "writer-only) are measured in the same run (medians of interleaved runs).\n\n"
+           "  --frames N         frames per configuration (default 300)\n"
+           "  --size WxH         output size (default 640x360)\n"
+           "  --render-size WxH  render size (default 1280x720)\n"
+           "  --sink S           mp4 (H.264, default), y4m (raw, disk-bound) or null\n"
+           "  --runs N           repeat every configuration N times, report medians (default 3)\n"
+           "  --csv FILE         the table as CSV (default out/bench-capture.csv)\n"
+           "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n",
+           "the");
+}
+
+int bench_capture(int argc, char **argv)
+{
+    static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
+                                         {"render-size", required_argument, 0, 'r'}, {"sink", required_argument, 0, 'k'},
+                                         {"csv", required_argument, 0, 'c'},    {"chart", required_argument, 0, 'C'},
+                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {"runs", required_argument, 0, 'R'},   {0}};
+    long nrep = 3;
+    bench b = {.frames = 300, .sw = 1280, .sh = 720, .w = 640, .h = 360, .start = 600};
+    const char *sink = "mp4", *csv = "out/bench-capture.csv", *chart = "out/bench-capture.png";
+    bool quiet = false;
+    long v;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'f': if (!cli_int("--frames", optarg, 10, 100000, &v)) return RS_EXIT_USAGE; b.frames = (int)v; break;
+        case 's': if (!cli_size("--size", optarg, 8192, &b.w, &b.h)) return RS_EXIT_USAGE; break;
+        case 'r': if (!cli_size("--render-size", optarg, 8192, &b.sw, &b.sh)) return RS_EXIT_USAGE; break;
+        case 'k':
+            if (strcmp(optarg, "mp4") && strcmp(optarg, "y4m") && strcmp(optarg, "null")) {
+                cli_error("bench", "--sink '%s': expected mp4, y4m or null", optarg);
+                return RS_EXIT_USAGE;
+            }
+            sink = optarg;
+            break;
+        case 'c': csv = optarg; break;
+        case 'C': chart = optarg; break;
+        case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default:
+            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
+            return cli_usage_error("bench");
+        }
+    }
+    rs_err err = {0};
+    if (!cap_check_sizes(b.sw, b.sh, b.w, b.h, &err)) {
+        cli_error("bench", "%s", err.msg);
+        return RS_EXIT_USAGE;
+    }
+    char outpath[64];
+    snprintf(outpath, sizeof outpath, !strcmp(sink, "null") ? "null:" : "out/bench-capture-scratch.%s", sink);
+    b.out = outpath;
+    const char *data = rs_data_dir(&err);
+    char demo[1200];
+    if (data)
+        snprintf(demo, sizeof demo, "%s/demos/dojo.rsr", data);
+    int status = RS_EXIT_FAIL;
+    plat *p = NULL;
+    run runs[16];
+    int nrun = 0;
+    if (!data || !rp_read(demo, &b.rp, &err))
+        goto done;
+    if (b.rp.ticks < b.start + (uint64_t)b.frames) {
+        rs_fail(&err, 1, "%s has %" PRIu64 " ticks; --frames %d from tick %" PRIu64 " needs more", demo, b.rp.ticks,
+                b.frames, b.start);
+        goto done;
+    }
+    cap_sink probe;
+    if (strcmp(sink, "null") && (!rs_mkdirs_for(outpath, &err) || !cap_sink_for(outpath, b.w, b.h, &probe, &err)))
+        goto done;
+    if (!(p = plat_create(&(plat_desc){.hidden = true}, &err)) || !(b.r = r_game_create(&err)))
+        goto done;
+    b.mem = malloc(cap_frame_bytes(CAP_I420, b.w, b.h) * (size_t)b.frames);
+    if (!b.mem) {
+        rs_fail(&err, 1, "out of memory for %d frames", b.frames);
+        goto done;
+    }
+    gl.GenFramebuffers(1, &b.fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, b.fbo);
+    gl.GenTextures(1, &b.tex);
+    gl.BindTexture(GL_TEXTURE_2D, b.tex);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, b.sw, b.sh, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, b.tex, 0);
+    gl.GenRenderbuffers(1, &b.depth);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, b.depth);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, b.sw, b.sh);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, b.depth);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    /* frames for writer-only, captured once (not timed) */
+    run prep = {.kind = 3, .mode = CAP_SEQUENTIAL, .ds = CAP_DS_GPU};
+    if (!do_run(&b, &prep, &err))
+        goto done;
+
+    runs[nrun++] = (run){.name = "render-only", .kind = 1};
+    runs[nrun++] = (run){.name = "writer-only", .kind = 2};
+    runs[nrun++] = (run){.name = "sequential", .mode = CAP_SEQUENTIAL};
+    const int pbos[3] = {1, 2, 3}, queues[3] = {CAP_QUEUE_NONE, 8, 120};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            run *r = &runs[nrun++];
+            *r = (run){.mode = CAP_ASYNC, .pbo = pbos[i], .queue = queues[j]};
+            snprintf(r->name, sizeof r->name, "async pbo%d q%d", pbos[i], queues[j] < 0 ? 0 : queues[j]);
+        }
+    /* the configurations interleaved, nrep times; each figure is the median */
+    for (int rep = 0; rep < nrep; rep++)
+        for (int i = 0; i < nrun; i++) {
+            if (!quiet && isatty(2))
+                fprintf(stderr, "\rbench capture: run %d of %ld, %-16s   ", rep + 1, nrep, runs[i].name);
+            if (!do_run(&b, &runs[i], &err))
+                goto done;
+            runs[i].fps_each[rep] = runs[i].fps;
+        }
+    for (int i = 0; i < nrun; i++) {
+        double v2[MAX_RUNS];
+        memcpy(v2, runs[i].fps_each, sizeof v2);
+        for (int x = 1; x < nrep; x++) /* insertion sort: a handful of values */
+            for (int y = x; y > 0 && v2[y] < v2[y - 1]; y--) {
+                double t = v2[y];
+                v2[y] = v2[y - 1];
+                v2[y - 1] = t;
+            }
+        runs[i].fps = nrep % 2 ? v2[nrep / 2] : (v2[nrep / 2 - 1] + v2[nrep / 2]) / 2;
+    }
+    if (!quiet && isatty(2))
+        fprintf(stderr, "\r%60s\r", "");
+
+    printf("bench capture: %d frames of demos/dojo.rsr, drawn %dx%d, out %dx%d, sink %s, %s\n", b.frames, b.sw, b.sh,
+           b.w, b.h, sink, glcaps.renderer);
+    printf("fps: median of %ld interleaved runs; stage times and peaks: the last run\n", nrep);
+    printf("%-16s %7s %8s %8s %8s %8s %8s %8s %8s %5s %7s\n", "config", "fps", "render", "dscale", "readbk", "fence",
+           "map+cp", "q-wait", "write", "hwm", "rss MB");
+    for (int i = 0; i < nrun; i++) {
+        run *r = &runs[i];
+        double n = (double)b.frames;
+        printf("%-16s %7.1f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %5d %7.0f\n", r->name, r->fps, r->ms_render,
+               r->st.ms_downscale / n, r->st.ms_readback / n, r->st.ms_fence_wait / n, r->st.ms_map_copy / n,
+               r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water, r->rss_mb);
+    }
+    printf("(ms per frame; render = simulate + draw calls on the game thread; write = writer thread in the sink)\n");
+    bool null_sink = !strcmp(sink, "null");
+    double render_only = runs[0].fps, writer_only = null_sink ? 1e300 : runs[1].fps, seq = runs[2].fps;
+    const run *def = &runs[3 + 1 * 3 + 2]; /* pbo 2, queue 120: the defaults */
+    double slowest = render_only < writer_only ? render_only : writer_only;
+    printf("async (pbo 2, queue 120) / sequential:                 %.2fx  (goal >= 1.8x here, >= 4x on a GPU)\n",
+           def->fps / seq);
+    if (null_sink)
+        printf("async / render-only %.1f fps (the null sink has no writer stage): %.2f   (goal >= 0.9)\n", render_only,
+               def->fps / slowest);
+    else
+        printf("async / min(render-only %.1f, writer-only %.1f fps):   %.2f   (goal >= 0.9)\n", render_only,
+               writer_only, def->fps / slowest);
+    if (csv && *csv) {
+        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
+        bool ok = f != NULL;
+        if (ok)
+            ok = fprintf(f, "config,fps,render_ms,downscale_ms,readback_ms,fence_ms,map_copy_ms,queue_wait_ms,write_ms,"
+                            "high_water,rss_mb,frames,render_w,render_h,w,h,sink\n") > 0;
+        for (int i = 0; ok && i < nrun; i++) {
+            run *r = &runs[i];
+            double n = (double)b.frames;
+            ok = fprintf(f, "%s,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%.0f,%d,%d,%d,%d,%d,%s\n", r->name, r->fps,
+                         r->ms_render, r->st.ms_downscale / n, r->st.ms_readback / n, r->st.ms_fence_wait / n,
+                         r->st.ms_map_copy / n, r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water,
+                         r->rss_mb, b.frames, b.sw, b.sh, b.w, b.h, sink) > 0;
+        }
+        if (f && fclose(f) != 0)
+            ok = false;
+        if (!ok) {
+            rs_fail(&err, 1, "%s: cannot write", csv);
+            goto done;
+        }
+    }
+    if (chart && *chart) {
+        rs_bar bars[16];
+        int nb = 0;
+        for (int i = 0; i < nrun; i++)
+            if (!(null_sink && runs[i].kind == 2))
+                bars[nb++] = (rs_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
+        char title[128];
+        snprintf(title, sizeof title, "capture fps, %dx%d to %dx%d, %s", b.sw, b.sh, b.w, b.h, sink);
+        if (!rs_chart_png(chart, title, "fps", bars, nb, &err))
+            goto done;
+    }
+    status = RS_EXIT_OK;
+done:
+    if (status != RS_EXIT_OK)
+        cli_error("bench", "%s", err.msg);
+    if (p) {
+        if (b.fbo) {
+            gl.DeleteFramebuffers(1, &b.fbo);
+            gl.DeleteTextures(1, &b.tex);
+            gl.DeleteRenderbuffers(1, &b.depth);
+        }
+        r_game_destroy(b.r);
+        plat_destroy(p);
+    }
+    free(b.mem);
+    rp_free(&b.rp);
+    return status;
+}
