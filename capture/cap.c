@@ -32,6 +32,7 @@ struct cap {
     cap_sink *sink;
     cap_writer *writer;
     size_t frame_bytes;
+    cap_pixfmt fmt;    /* what the sink takes: I420 planes or RGBA */
     bool gpu;          /* GPU downscale + convert */
     bool failed;
     /* GPU stage */
@@ -47,13 +48,19 @@ struct cap {
     /* CPU path buffers */
     uint8_t *full, *small, *direct;
     cap_stats st;
+    rs_err err; /* GL-side failure (the writer keeps its own) */
 };
 
 bool cap_check_sizes(int sw, int sh, int w, int h, rs_err *err)
 {
+    return cap_check_sizes_for(CAP_I420, sw, sh, w, h, err);
+}
+
+bool cap_check_sizes_for(cap_pixfmt fmt, int sw, int sh, int w, int h, rs_err *err)
+{
     if (w <= 0 || h <= 0 || sw <= 0 || sh <= 0)
         return rs_fail(err, 1, "sizes must be positive (render %dx%d, output %dx%d)", sw, sh, w, h);
-    if ((w | h) & 1)
+    if (fmt == CAP_I420 && ((w | h) & 1))
         return rs_fail(err, 1, "output size %dx%d: width and height must be even for 4:2:0 video", w, h);
     if (w > sw || h > sh)
         return rs_fail(err, 1, "output size %dx%d is larger than the render size %dx%d (downscale only)", w, h, sw,
@@ -109,6 +116,8 @@ static bool gpu_setup(cap *c, rs_err *err)
     c->u_rgb_chroma = gl.GetUniformLocation(c->prog_chroma, "u_rgb");
     gl.GenVertexArrays(1, &c->vao);
     int w = c->d.w, h = c->d.h;
+    if (c->fmt == CAP_RGBA)
+        return make_target(&c->rgb, w, h, 1, GL_RGBA8, GL_RGBA, err);
     return make_target(&c->rgb, w, h, 1, GL_RGBA8, GL_RGBA, err) &&
            make_target(&c->luma, w, h, 1, GL_R8, GL_RED, err) &&
            make_target(&c->chroma, w / 2, h / 2, 2, GL_R8, GL_RED, err);
@@ -118,6 +127,8 @@ static bool gpu_setup(cap *c, rs_err *err)
 static void gpu_convert(cap *c, GLuint src)
 {
     cap_scaler_run(c->scaler, src, c->rgb.fbo);
+    if (c->fmt == CAP_RGBA)
+        return; /* image sequences take the downscaled RGBA as it is */
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.Disable(GL_CULL_FACE);
@@ -148,6 +159,14 @@ static void read_planes(cap *c, uint8_t *dst)
 {
     size_t ny = (size_t)c->d.w * c->d.h, nc = (size_t)(c->d.w / 2) * (c->d.h / 2);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    if (c->fmt == CAP_RGBA) {
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, c->rgb.fbo);
+        gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+        gl.ReadPixels(0, 0, c->d.w, c->d.h, GL_RGBA, GL_UNSIGNED_BYTE, dst);
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+        gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+        return;
+    }
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, c->luma.fbo);
     gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl.ReadPixels(0, 0, c->d.w, c->d.h, GL_RED, GL_UNSIGNED_BYTE, dst);
@@ -176,25 +195,29 @@ static bool map_oldest(cap *c)
     c->st.ms_fence_wait += (rs_now() - t0) * 1e3;
     gl.DeleteSync(c->fence[i]);
     c->fence[i] = 0;
-    if (r == GL_WAIT_FAILED)
+    c->mapped++;
+    if (r == GL_WAIT_FAILED) {
+        rs_fail(&c->err, 1, "capture: waiting for a readback fence failed (GL error)");
         return false;
-    t0 = rs_now();
-    uint8_t *slot = cap_writer_acquire(c->writer);
-    double t1 = rs_now();
-    c->st.ms_queue_wait += (t1 - t0) * 1e3;
+    }
+    uint8_t *slot = cap_writer_acquire(c->writer); /* may wait on a full queue: the writer counts it */
     if (!slot)
         return false;
+    double t1 = rs_now();
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, c->pbo[i]);
     const void *p = gl.MapBufferRange(GL_PIXEL_PACK_BUFFER, 0, (GLsizeiptr)c->frame_bytes, GL_MAP_READ_BIT);
-    bool ok = p != NULL;
-    if (ok) {
+    if (p) {
         memcpy(slot, p, c->frame_bytes);
         gl.UnmapBuffer(GL_PIXEL_PACK_BUFFER);
     }
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     c->st.ms_map_copy += (rs_now() - t1) * 1e3;
-    c->mapped++;
-    return cap_writer_submit(c->writer, slot) && ok;
+    if (!p) { /* never hand a stale slot to the writer */
+        cap_writer_cancel(c->writer, slot);
+        rs_fail(&c->err, 1, "capture: mapping a pixel buffer of %zu bytes failed (GL error)", c->frame_bytes);
+        return false;
+    }
+    return cap_writer_submit(c->writer, slot);
 }
 
 cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
@@ -215,8 +238,9 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
         c->d.queue = CAP_QUEUE_NONE; /* everything on the game thread */
     c->gpu = c->d.downscale == CAP_DS_GPU;
     c->sink = sink;
-    c->frame_bytes = cap_frame_bytes(CAP_I420, c->d.w, c->d.h);
-    if (!cap_check_sizes(c->d.src_w, c->d.src_h, c->d.w, c->d.h, err))
+    c->fmt = sink->fmt;
+    c->frame_bytes = cap_frame_bytes(c->fmt, c->d.w, c->d.h);
+    if (!cap_check_sizes_for(c->fmt, c->d.src_w, c->d.src_h, c->d.w, c->d.h, err))
         goto fail;
     if (c->d.pbo < 1 || c->d.pbo > CAP_MAX_PBO) {
         rs_fail(err, 1, "PBO ring of %d: expected 1..%d", c->d.pbo, CAP_MAX_PBO);
@@ -242,8 +266,10 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
         }
         gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     }
-    if (!sink->ops->open(sink, err))
+    if (!sink->ops->open(sink, err)) {
+        sink->ops->close(sink, false, NULL); /* a half-open sink cleans up too */
         goto fail;
+    }
     c->writer = cap_writer_start(sink, c->frame_bytes, c->d.queue == CAP_QUEUE_NONE ? 0 : c->d.queue, c->d.hashes, err);
     if (!c->writer) {
         sink->ops->close(sink, false, NULL);
@@ -270,10 +296,15 @@ static bool cpu_frame(cap *c, GLuint src)
     double t1 = rs_now();
     c->st.ms_readback += (t1 - t0) * 1e3;
     cap_cpu_downscale(c->full, c->d.src_w, c->d.src_h, c->small, c->d.w, c->d.h);
-    uint8_t *slot = cap_writer_acquire(c->writer);
+    c->st.ms_downscale += (rs_now() - t1) * 1e3;
+    uint8_t *slot = cap_writer_acquire(c->writer); /* inline queue: never waits */
     if (!slot)
         return false;
-    cap_cpu_rgba_to_i420(c->small, c->d.w, c->d.h, slot);
+    t1 = rs_now();
+    if (c->fmt == CAP_RGBA)
+        memcpy(slot, c->small, c->frame_bytes);
+    else
+        cap_cpu_rgba_to_i420(c->small, c->d.w, c->d.h, slot);
     c->st.ms_downscale += (rs_now() - t1) * 1e3;
     return cap_writer_submit(c->writer, slot);
 }
@@ -300,22 +331,20 @@ bool cap_frame(cap *c, GLuint src, rs_err *err)
                 ok = cap_writer_submit(c->writer, slot);
             }
         } else {
-            /* ring full: take the oldest frame out before reusing its PBO */
+            /* read this frame into the next PBO of the ring (its previous
+             * frame was taken out last time), then take out the oldest once
+             * the ring is full: with 2 PBOs, frame N-1 while frame N is in
+             * flight, as in the seed; with 1, this frame right away */
+            double t2 = rs_now();
+            int i = (int)(c->issued % (uint64_t)c->d.pbo);
+            gl.BindBuffer(GL_PIXEL_PACK_BUFFER, c->pbo[i]);
+            read_planes(c, NULL); /* offsets into the PBO: returns at once */
+            gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+            c->fence[i] = gl.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+            gl.Flush(); /* start the transfer now, not at the next sync */
+            c->issued++;
+            c->st.ms_readback += (rs_now() - t2) * 1e3;
             ok = c->issued - c->mapped < (uint64_t)c->d.pbo || map_oldest(c);
-            if (ok) {
-                double t2 = rs_now();
-                int i = (int)(c->issued % (uint64_t)c->d.pbo);
-                gl.BindBuffer(GL_PIXEL_PACK_BUFFER, c->pbo[i]);
-                read_planes(c, NULL); /* offsets into the PBO: returns at once */
-                gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-                c->fence[i] = gl.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-                gl.Flush(); /* start the transfer now, not at the next sync */
-                c->issued++;
-                c->st.ms_readback += (rs_now() - t2) * 1e3;
-                /* with a ring of 1 the frame must come out right away */
-                if (c->d.pbo == 1)
-                    ok = map_oldest(c);
-            }
         }
     }
     if (ok)
@@ -339,17 +368,26 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err)
     cap_writer_stats ws = {0};
     if (c->writer)
         wok = cap_writer_finish(c->writer, &ws, &werr);
+    /* the hash list belongs to this output: it must be whole before the output is committed */
+    if (wok && c->d.hashes && (fflush(c->d.hashes) != 0 || ferror(c->d.hashes))) {
+        wok = false;
+        rs_fail(&werr, 1, "the frame hash list: write failed");
+    }
     bool good = ok && !c->failed && wok;
     rs_err cerr = {0};
     bool cok = true;
     if (c->sink)
         cok = c->sink->ops->close(c->sink, good, &cerr);
-    if (!wok && err)
-        *err = werr;
-    else if (good && !cok && err)
-        *err = cerr;
-    else if (ok && c->failed && err && !err->msg[0])
-        rs_fail(err, 1, "capture failed (GL error while mapping a pixel buffer)");
+    if (err && !err->msg[0]) {
+        if (!wok)
+            *err = werr;
+        else if (c->failed && c->err.msg[0])
+            *err = c->err;
+        else if (good && !cok)
+            *err = cerr;
+        else if (!good || !cok)
+            rs_fail(err, 1, "capture failed");
+    }
     c->st.high_water = ws.high_water;
     c->st.ms_write = ws.write_ms;
     c->st.ms_queue_wait += ws.wait_ms;

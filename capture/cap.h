@@ -6,8 +6,8 @@
  *     game thread;
  *   async: downscale (area average) and convert to YCbCr 4:2:0 on the GPU
  *     (1.5 bytes a pixel instead of 4), glReadPixels into pixel-buffer object
- *     i of a ring, map the oldest one (one frame late with a ring of 2) once
- *     its fence has passed, copy into a frame slot, hand it to the writer
+ *     i of a ring, map the oldest one (ring size - 1 frames late: one with
+ *     the default 2, as in the seed) once its fence has passed, copy into a frame slot, hand it to the writer
  *     thread behind a queue capped at 120 frames.
  * Either path can use either downscale (`downscale`), so outputs can be
  * compared byte for byte: same downscale, same bytes. */
@@ -71,9 +71,14 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err);
 
 /* CPU reference implementations (also used by the sequential path). */
 void cap_cpu_downscale(const uint8_t *src_bottom_up, int sw, int sh, uint8_t *dst_rgba, int w, int h);
+/* The general area average (cap_cpu_downscale takes an integer shortcut at
+ * exactly 2x); exposed so tests can hold the shortcut to it. */
+void cap_cpu_downscale_area(const uint8_t *src_bottom_up, int sw, int sh, uint8_t *dst_rgba, int w, int h);
 void cap_cpu_rgba_to_i420(const uint8_t *rgba, int w, int h, uint8_t *i420);
 
-/* Checks sizes; a clear message for each way they can be wrong. */
+/* Checks sizes; a clear message for each way they can be wrong.  4:2:0
+ * output (video) needs even sizes; RGBA output (image sequences) does not. */
 bool cap_check_sizes(int src_w, int src_h, int w, int h, rs_err *err);
+bool cap_check_sizes_for(cap_pixfmt fmt, int src_w, int src_h, int w, int h, rs_err *err);
 
 #endif

@@ -18,6 +18,11 @@ void cap_cpu_downscale(const uint8_t *src, int sw, int sh, uint8_t *dst, int w, 
         }
         return;
     }
+    cap_cpu_downscale_area(src, sw, sh, dst, w, h);
+}
+
+void cap_cpu_downscale_area(const uint8_t *src, int sw, int sh, uint8_t *dst, int w, int h)
+{
     double sx = (double)sw / w, sy = (double)sh / h;
     for (int y = 0; y < h; y++) {
         double y0 = y * sy, y1 = y0 + sy; /* rows from the top */

@@ -7,12 +7,20 @@
 
 #include "../runtime/util/rs_file.h"
 
+bool cap_out_is_stream(const char *path)
+{
+    struct stat st; /* stat follows links: /dev/stdout is whatever fd 1 is */
+    return stat(path, &st) == 0 && (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode));
+}
+
 bool cap_out_open(cap_out *o, const char *path, rs_err *err)
 {
     memset(o, 0, sizeof *o);
     snprintf(o->path, sizeof o->path, "%s", path);
+    o->device = cap_out_is_stream(path);
     struct stat st;
-    o->device = stat(path, &st) == 0 && S_ISCHR(st.st_mode);
+    if (!o->device && stat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return rs_fail(err, 1, "%s: exists and is not a regular file (nor a device or pipe to stream to)", path);
     snprintf(o->tmp, sizeof o->tmp, o->device ? "%s" : "%s.part", path);
     if (!o->device && !rs_mkdirs_for(path, err))
         return false;

@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cap_out.h"
 #include "cap_sink.h"
 
 size_t cap_frame_bytes(cap_pixfmt fmt, int w, int h)
@@ -20,12 +21,19 @@ bool cap_ffmpeg_check(const char *path, const char *ext, rs_err *err);
 extern const cap_sink_ops cap_sink_ffmpeg;
 #endif
 
+bool cap_images_pattern_ok(const char *path, const char **ext);
+extern const cap_sink_ops cap_sink_images;
+
 const char *cap_sink_formats(void)
 {
-#ifdef RS_HAVE_FFMPEG
-    return ".y4m, .mp4, .mkv (H.264), .webm (VP9)";
+#if defined(RS_HAVE_FFMPEG) && defined(RS_HAVE_OIIO)
+    return ".y4m, .mp4, .mkv (H.264), .webm (VP9), name%06d.png|.exr|.tif";
+#elif defined(RS_HAVE_FFMPEG)
+    return ".y4m, .mp4, .mkv (H.264), .webm (VP9) (no OpenImageIO: no image sequences)";
+#elif defined(RS_HAVE_OIIO)
+    return ".y4m, name%06d.png|.exr|.tif (no FFmpeg: no .mp4/.mkv/.webm)";
 #else
-    return ".y4m (this build has no FFmpeg: no .mp4/.mkv/.webm)";
+    return ".y4m (this build has neither FFmpeg nor OpenImageIO)";
 #endif
 }
 
@@ -37,11 +45,24 @@ bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err)
     s->h = h;
     s->fmt = CAP_I420;
     const char *ext = ext_of(path);
+    const char *iext;
+    if (strchr(path, '%')) {
+        if (!cap_images_pattern_ok(path, &iext))
+            return rs_fail(err, 1, "%s: an image sequence needs one %%d or %%0Nd (two digits at most) in the file name and .png, .exr or .tif (e.g. frame%%06d.png)",
+                           path);
+#ifdef RS_HAVE_OIIO
+        s->ops = &cap_sink_images;
+        s->fmt = CAP_RGBA;
+        return true;
+#else
+        return rs_fail(err, 1, "%s: this build has no OpenImageIO, so no image sequences (use .y4m)", path);
+#endif
+    }
     if (!strcmp(path, "null:")) {
         s->ops = &cap_sink_null;
         return true;
     }
-    if (!strcmp(ext, ".y4m") || !strncmp(path, "/dev/", 5)) {
+    if (!strcmp(ext, ".y4m") || cap_out_is_stream(path)) { /* streams get Y4M, whatever their name */
         s->ops = &cap_sink_y4m;
         return true;
     }

@@ -178,7 +178,10 @@ static bool ff_close(cap_sink *s, bool ok, rs_err *err)
     bool good = ok;
     if (good) {
         int r = avcodec_send_frame(f->enc, NULL); /* flush delayed frames */
-        good = (r >= 0 || r == AVERROR_EOF) && drain(s, f, err);
+        if (r < 0 && r != AVERROR_EOF)
+            good = fail_av(err, s->path, "flushing the encoder", r);
+        else
+            good = drain(s, f, err);
         if (good && (r = av_write_trailer(f->fmt)) < 0)
             good = fail_av(err, s->path, "write failed", r);
     }

@@ -178,6 +178,14 @@ bool cap_writer_submit(cap_writer *w, uint8_t *slot)
     return ok;
 }
 
+void cap_writer_cancel(cap_writer *w, uint8_t *slot)
+{
+    pthread_mutex_lock(&w->mu);
+    w->free_stack[w->nfree++] = slot;
+    pthread_cond_signal(&w->cv_free);
+    pthread_mutex_unlock(&w->mu);
+}
+
 bool cap_writer_finish(cap_writer *w, cap_writer_stats *stats, rs_err *err)
 {
     if (w->threaded) {

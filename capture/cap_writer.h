@@ -32,6 +32,8 @@ cap_writer *cap_writer_start(cap_sink *sink, size_t frame_bytes, int queue_cap, 
 uint8_t *cap_writer_acquire(cap_writer *w);
 /* Hands the filled slot to the writer; false when the writer has failed. */
 bool cap_writer_submit(cap_writer *w, uint8_t *slot);
+/* Gives an acquired slot back unwritten (the frame could not be filled). */
+void cap_writer_cancel(cap_writer *w, uint8_t *slot);
 /* Waits for every queued frame, joins the thread, frees the slots.  Returns
  * the first error of the writer (disk full, encoder failure). */
 bool cap_writer_finish(cap_writer *w, cap_writer_stats *stats, rs_err *err);

@@ -16,6 +16,7 @@
 #include "gl/rgl.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_target.h"
 #include "replay/rp.h"
 #include "util/rs_file.h"
 #include "util/rs_img.h"
@@ -92,7 +93,8 @@ int bench_accuracy(int argc, char **argv)
     plat *p = NULL;
     r_game *r = NULL;
     cap_scaler *sc[CAP_FILTERS] = {0};
-    GLuint fbo = 0, tex = 0, depth = 0, dfbo = 0, dtex = 0;
+    r_target src = {0};
+    GLuint dfbo = 0, dtex = 0;
     size_t npx = (size_t)w * h;
     uint8_t *full = malloc((size_t)sw * sh * 4), *small = malloc(npx * 4), *yuv = malloc(npx * 2);
     float *ref = malloc(npx * 4 * sizeof(float)), *back = malloc(npx * 4 * sizeof(float));
@@ -117,18 +119,8 @@ int bench_accuracy(int argc, char **argv)
     for (int f = 0; f < CAP_FILTERS; f++)
         if (!(sc[f] = cap_scaler_create((cap_filter)f, sw, sh, w, h, &err)))
             goto done;
-    gl.GenTextures(1, &tex);
-    gl.BindTexture(GL_TEXTURE_2D, tex);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, sw, sh, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.GenRenderbuffers(1, &depth);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, depth);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, sw, sh);
-    gl.GenFramebuffers(1, &fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth);
+    if (!r_target_create(&src, sw, sh, &err))
+        goto done;
     gl.GenTextures(1, &dtex);
     gl.BindTexture(GL_TEXTURE_2D, dtex);
     gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
@@ -147,7 +139,7 @@ int bench_accuracy(int argc, char **argv)
             prev = cur;
             g_step(&cur, &rp.inputs[2 * tick++], NULL);
         }
-        gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, src.fbo);
         r_game_draw(r, &prev, &cur, 1.0f, sw, sh);
         gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
         gl.ReadPixels(0, 0, sw, sh, GL_RGBA, GL_UNSIGNED_BYTE, full);
@@ -162,7 +154,7 @@ int bench_accuracy(int argc, char **argv)
             gl.Finish();
             double t0 = rs_now();
             for (int rep = 0; rep < 20; rep++)
-                cap_scaler_run(sc[f], tex, dfbo);
+                cap_scaler_run(sc[f], src.tex, dfbo);
             gl.Finish();
             ms[f] += (rs_now() - t0) * 1e3 / 20;
             gl.BindFramebuffer(GL_READ_FRAMEBUFFER, dfbo);
@@ -216,11 +208,9 @@ done:
     if (p) {
         for (int f = 0; f < CAP_FILTERS; f++)
             cap_scaler_destroy(sc[f]);
-        gl.DeleteFramebuffers(1, &fbo);
+        r_target_destroy(&src);
         gl.DeleteFramebuffers(1, &dfbo);
-        gl.DeleteTextures(1, &tex);
         gl.DeleteTextures(1, &dtex);
-        gl.DeleteRenderbuffers(1, &depth);
         r_game_destroy(r);
         plat_destroy(p);
     }

@@ -16,6 +16,7 @@
 #include "gl/rgl.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_target.h"
 #include "replay/rp.h"
 #include "util/rs_chart.h"
 #include "util/rs_file.h"
@@ -40,7 +41,7 @@ typedef struct bench {
     int frames, sw, sh, w, h;
     const char *out; /* sink path */
     r_game *r;
-    GLuint fbo, tex, depth;
+    r_target t;
     uint8_t *mem; /* frames captured once, for writer-only */
 } bench;
 
@@ -79,7 +80,7 @@ static double draw_frame(bench *b, g_state *prev, g_state *cur, uint64_t tick)
     double t0 = rs_now();
     *prev = *cur;
     g_step(cur, &b->rp.inputs[2 * tick], NULL);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, b->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, b->t.fbo);
     r_game_draw(b->r, prev, cur, 1.0f, b->sw, b->sh);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     return (rs_now() - t0) * 1e3;
@@ -149,7 +150,7 @@ static bool do_run(bench *b, run *r, rs_err *err)
         bool ok = true;
         for (int f = 0; f < b->frames && ok; f++) {
             render_ms += draw_frame(b, &prev, &cur, b->start + (uint64_t)f);
-            ok = cap_frame(c, b->tex, err);
+            ok = cap_frame(c, b->t.tex, err);
         }
         if (!cap_close(c, ok, &r->st, err) || !ok)
             return false;
@@ -254,19 +255,8 @@ int bench_capture(int argc, char **argv)
         rs_fail(&err, 1, "out of memory for %d frames", b.frames);
         goto done;
     }
-    gl.GenFramebuffers(1, &b.fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, b.fbo);
-    gl.GenTextures(1, &b.tex);
-    gl.BindTexture(GL_TEXTURE_2D, b.tex);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, b.sw, b.sh, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, b.tex, 0);
-    gl.GenRenderbuffers(1, &b.depth);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, b.depth);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, b.sw, b.sh);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, b.depth);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!r_target_create(&b.t, b.sw, b.sh, &err))
+        goto done;
 
     /* frames for writer-only, captured once (not timed) */
     run prep = {.kind = 3, .mode = CAP_SEQUENTIAL, .ds = CAP_DS_GPU};
@@ -368,11 +358,7 @@ done:
     if (status != RS_EXIT_OK)
         cli_error("bench", "%s", err.msg);
     if (p) {
-        if (b.fbo) {
-            gl.DeleteFramebuffers(1, &b.fbo);
-            gl.DeleteTextures(1, &b.tex);
-            gl.DeleteRenderbuffers(1, &b.depth);
-        }
+        r_target_destroy(&b.t);
         r_game_destroy(b.r);
         plat_destroy(p);
     }

@@ -16,6 +16,7 @@
 #include "loop.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_target.h"
 #include "replay/rp.h"
 #include "util/rs_file.h"
 #include "util/rs_img.h"
@@ -52,7 +53,7 @@ typedef struct play {
     rp_recorder *rec;
     plat *p;
     r_game *r;
-    GLuint fbo, color, depth; /* headless target */
+    r_target target; /* headless */
     int w, h;
     uint64_t limit;
     bool quit, failed;
@@ -87,7 +88,7 @@ static void on_render(void *user, float alpha)
     int w = s->w, h = s->h;
     if (plat_window(s->p))
         plat_size(s->p, &w, &h);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, s->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
     if (w > 0 && h > 0)
         r_game_draw(s->r, &s->prev, &s->cur, alpha, w, h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -110,26 +111,6 @@ static bool on_running(void *user)
     return !s->limit || s->cur.tick < s->limit;
 }
 
-static bool make_target(play *s, rs_err *err)
-{
-    gl.GenFramebuffers(1, &s->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, s->fbo);
-    gl.GenRenderbuffers(1, &s->color);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, s->color);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, s->w, s->h);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, s->color);
-    gl.GenRenderbuffers(1, &s->depth);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, s->depth);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, s->w, s->h);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, s->depth);
-    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
-    if (st != GL_FRAMEBUFFER_COMPLETE)
-        return rs_fail(err, 1, "%dx%d frame buffer incomplete (%s)", s->w, s->h, rgl_enum_name(st));
-    return true;
-}
-
 /* Renders the final state once more and saves it. */
 static bool screenshot(play *s, const char *path, rs_err *err)
 {
@@ -139,10 +120,10 @@ static bool screenshot(play *s, const char *path, rs_err *err)
     uint8_t *px = malloc((size_t)w * h * 4);
     if (!px)
         return rs_fail(err, 1, "out of memory for a %dx%d screenshot", w, h);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, s->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
     r_game_draw(s->r, &s->prev, &s->cur, 1.0f, w, h);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, s->fbo);
-    if (!s->fbo)
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, s->target.fbo);
+    if (!s->target.fbo)
         gl.ReadBuffer(GL_BACK);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
@@ -256,7 +237,7 @@ int cmd_play(int argc, char **argv)
         goto done;
     }
     s->r = r_game_create(&s->err);
-    if (!s->r || (headless && !make_target(s, &s->err)))
+    if (!s->r || (headless && !r_target_create(&s->target, s->w, s->h, &s->err)))
         goto done;
     g_init(&s->cur, stage, seed);
     s->prev = s->cur;
@@ -291,11 +272,7 @@ done:
     if (status == RS_EXIT_FAIL || (status == RS_EXIT_USAGE && s->err.msg[0]))
         cli_error("play", "%s", s->err.msg);
     if (s->p) {
-        if (s->fbo) {
-            gl.DeleteFramebuffers(1, &s->fbo);
-            gl.DeleteRenderbuffers(1, &s->color);
-            gl.DeleteRenderbuffers(1, &s->depth);
-        }
+        r_target_destroy(&s->target);
         r_game_destroy(s->r);
         plat_destroy(s->p);
     }

@@ -1,6 +1,8 @@
 /* ringside render: a replay to a video, headless, one frame per tick. */
 #include <getopt.h>
 #include <inttypes.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +13,7 @@
 #include "gl/rgl.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_target.h"
 #include "replay/rp.h"
 #include "util/rs_file.h"
 #include "util/rs_progress.h"
@@ -25,7 +28,8 @@ static void help(void)
            "(60 frames a second, exact).  The output type comes from the extension:\n"
            "%s.\n"
            "The output appears only when complete; a failed render leaves nothing.\n\n"
-           "  -o OUT             output file ('/dev/null' and other devices are streamed)\n"
+           "  -o OUT             output file ('/dev/null' and other devices are streamed), or an\n"
+           "                     image sequence pattern such as frames/f%%06d.png\n"
            "  --size WxH         output size, even numbers (default 640x360)\n"
            "  --render-size WxH  size the game is drawn at (default 1280x720)\n"
            "  --capture MODE     async (default): GPU downscale, PBO ring, writer thread;\n"
@@ -41,31 +45,14 @@ static void help(void)
            cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
 }
 
-typedef struct render_target {
-    GLuint fbo, tex, depth;
-} render_target;
+/* Ctrl-C / SIGTERM: the handler only sets a flag; the loop stops, and
+ * cap_close removes the partial output. */
+static volatile sig_atomic_t stop_requested;
 
-static bool make_target(render_target *t, int w, int h, rs_err *err)
+static void on_signal(int sig)
 {
-    gl.GenFramebuffers(1, &t->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    gl.GenTextures(1, &t->tex);
-    gl.BindTexture(GL_TEXTURE_2D, t->tex);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->tex, 0);
-    gl.GenRenderbuffers(1, &t->depth);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, t->depth);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, w, h);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, t->depth);
-    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    gl.BindTexture(GL_TEXTURE_2D, 0);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
-    if (st != GL_FRAMEBUFFER_COMPLETE)
-        return rs_fail(err, 1, "render target %dx%d incomplete (%s)", w, h, rgl_enum_name(st));
-    return true;
+    (void)sig;
+    stop_requested = 1;
 }
 
 int cmd_render(int argc, char **argv)
@@ -142,7 +129,8 @@ int cmd_render(int argc, char **argv)
     }
     const char *replay = argv[optind];
     rs_err err = {0};
-    if (!cap_check_sizes(cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
+    cap_pixfmt fmt = strchr(out, '%') ? CAP_RGBA : CAP_I420;
+    if (!cap_check_sizes_for(fmt, cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
         cli_error("render", "%s", err.msg);
         return RS_EXIT_USAGE;
     }
@@ -152,12 +140,17 @@ int cmd_render(int argc, char **argv)
     cap_sink sink;
     plat *p = NULL;
     r_game *r = NULL;
-    render_target t = {0};
+    r_target t = {0};
     FILE *hf = NULL;
     char hpart[1100] = "";
     /* everything that can be checked without rendering, first */
     if (!rp_read(replay, &rp, &err) || !cap_sink_for(out, cd.w, cd.h, &sink, &err))
         goto done;
+    struct stat hst;
+    if (hashes && stat(hashes, &hst) == 0 && !S_ISREG(hst.st_mode)) {
+        rs_fail(&err, 1, "%s: exists and is not a regular file (--hashes)", hashes);
+        goto done;
+    }
     if (hashes) {
         snprintf(hpart, sizeof hpart, "%s.part", hashes);
         if (!rs_mkdirs_for(hashes, &err) || !(hf = fopen(hpart, "w"))) {
@@ -172,7 +165,7 @@ int cmd_render(int argc, char **argv)
         status = cli_plat_status(&err);
         goto done;
     }
-    if (!(r = r_game_create(&err)) || !make_target(&t, cd.src_w, cd.src_h, &err))
+    if (!(r = r_game_create(&err)) || !r_target_create(&t, cd.src_w, cd.src_h, &err))
         goto done;
     cap *cp = cap_open(&cd, &sink, &err);
     if (!cp)
@@ -183,7 +176,17 @@ int cmd_render(int argc, char **argv)
     rs_progress prog;
     rs_progress_start(&prog, "render", "frames", rp.ticks, quiet);
     bool ok = true;
+    struct sigaction sa = {0}, old_int, old_term;
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
     for (uint64_t tick = 0; tick < rp.ticks && ok; tick++) {
+        if (stop_requested) {
+            ok = false;
+            rs_fail(&err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
+                    out, tick, rp.ticks);
+            break;
+        }
         prev = cur;
         g_step(&cur, &rp.inputs[2 * tick], NULL);
         gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
@@ -193,6 +196,8 @@ int cmd_render(int argc, char **argv)
         rs_progress_update(&prog, tick + 1);
     }
     double secs = rs_progress_end(&prog);
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
     cap_stats st;
     if (!cap_close(cp, ok, &st, &err))
         goto done;
@@ -200,7 +205,11 @@ int cmd_render(int argc, char **argv)
         bool hok = fclose(hf) == 0;
         hf = NULL;
         if (!hok || rename(hpart, hashes) != 0) {
-            rs_fail(&err, 1, "%s: write failed", hashes);
+            /* the video and its hash list go together: without the list, no video */
+            struct stat vst;
+            if (stat(out, &vst) == 0 && S_ISREG(vst.st_mode))
+                unlink(out);
+            rs_fail(&err, 1, "%s: write failed; %s removed with it", hashes, out);
             goto done;
         }
         hpart[0] = 0;
@@ -223,11 +232,7 @@ done:
     if (hpart[0])
         unlink(hpart);
     if (p) {
-        if (t.fbo) {
-            gl.DeleteFramebuffers(1, &t.fbo);
-            gl.DeleteTextures(1, &t.tex);
-            gl.DeleteRenderbuffers(1, &t.depth);
-        }
+        r_target_destroy(&t);
         r_game_destroy(r);
         plat_destroy(p);
     }

@@ -48,5 +48,7 @@ void main()
         sum += texelFetch(u_src, t, 0) * w;
         wsum += w;
     }
-    o_color = clamp(sum / wsum, 0.0, 1.0);
+    // the horizontal pass keeps its under- and overshoot (RGBA16F); only
+    // the final pass is clamped
+    o_color = u_axis.y == 1 ? clamp(sum / wsum, 0.0, 1.0) : sum / wsum;
 }

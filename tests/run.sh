@@ -27,8 +27,10 @@ for t in "$build"/tests/test_* "$here"/test_*.sh; do
     echo "== $name"
     log=$(mktemp)
     ran=$((ran + 1))
-    if [ "${t%.sh}" != "$t" ]; then sh "$t" >"$log" 2>&1; else "$t" >"$log" 2>&1; fi
+    # a hang must fail the run, not stall CI: 20 minutes per test program
+    if [ "${t%.sh}" != "$t" ]; then timeout -k 10 1200 sh "$t" >"$log" 2>&1; else timeout -k 10 1200 "$t" >"$log" 2>&1; fi
     rc=$?
+    [ "$rc" = 124 ] && echo "FAIL $name: timed out after 20 minutes" >>"$log"
     cat "$log"
     line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$log" | tail -1)
     rm -f "$log"

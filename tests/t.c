@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -160,6 +161,14 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
                 alarm(T_TIMEOUT_S);
                 cases[i].fn();
                 fflush(stdout);
+                /* a case may have lowered the file size limit (disk-full
+                 * tests): LeakSanitizer's tracer deadlocks under it */
+                struct rlimit rl;
+                if (getrlimit(RLIMIT_FSIZE, &rl) == 0) {
+                    rl.rlim_cur = rl.rlim_max;
+                    setrlimit(RLIMIT_FSIZE, &rl);
+                }
+                signal(SIGXFSZ, SIG_DFL);
 #ifdef RS_SANITIZE
                 /* _exit skips LeakSanitizer's exit-time check: run it here */
                 if (__lsan_do_recoverable_leak_check())

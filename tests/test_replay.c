@@ -259,13 +259,16 @@ static void t_write_read_back_and_failures(void)
     T_CONTAINS(e.msg, "cannot create");
     /* disk full half way: error, nothing left behind */
     signal(SIGXFSZ, SIG_IGN);
-    struct rlimit rl = {200, 200};
+    struct rlimit old, rl;
+    T_ASSERT(getrlimit(RLIMIT_FSIZE, &old) == 0);
+    rl = (struct rlimit){200, old.rlim_max}; /* soft only: it can be raised back */
     T_ASSERT(setrlimit(RLIMIT_FSIZE, &rl) == 0);
     snprintf(path, sizeof path, "%s/full.rsr", t_tmpdir());
     snprintf(part, sizeof part, "%s.part", path);
     T_ASSERT(!rp_write(path, &rp, &e));
     T_CONTAINS(e.msg, "full.rsr: write failed");
     T_ASSERT(access(path, F_OK) != 0 && access(part, F_OK) != 0);
+    T_ASSERT(setrlimit(RLIMIT_FSIZE, &old) == 0);
     rp_free(&rp);
 }
 

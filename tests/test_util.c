@@ -166,7 +166,9 @@ static void t_png_disk_full(void)
     /* a file size limit makes the write itself fail half way (as a full
      * disk does): an error naming the file, and no .part left behind */
     signal(SIGXFSZ, SIG_IGN);
-    struct rlimit rl = {4096, 4096};
+    struct rlimit old, rl;
+    T_ASSERT(getrlimit(RLIMIT_FSIZE, &old) == 0);
+    rl = (struct rlimit){4096, old.rlim_max}; /* soft only: it can be raised back */
     T_ASSERT(setrlimit(RLIMIT_FSIZE, &rl) == 0);
     static uint8_t px[256 * 256 * 3];
     char path[512], part[600];
@@ -180,6 +182,7 @@ static void t_png_disk_full(void)
     snprintf(path, sizeof path, "%s/big.ppm", t_tmpdir());
     T_ASSERT(!rs_pnm_write(path, 256, 256, 3, px, &e));
     T_CONTAINS(e.msg, "big.ppm: write failed: File too large");
+    T_ASSERT(setrlimit(RLIMIT_FSIZE, &old) == 0);
 }
 
 static void t_pnm_roundtrip(void)

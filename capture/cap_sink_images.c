@@ -1,0 +1,97 @@
+/* Image sequences through OpenImageIO: name%06d.png, .exr or .tif, one
+ * RGBA file per frame.  Each file is written as "<name>.part" and renamed,
+ * so no half-written image ever carries a final name; a failed render
+ * removes the frames it wrote, so no partial sequence looks finished. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../runtime/util/rs_file.h"
+#include "cap_oiio.h"
+#include "cap_sink.h"
+
+typedef struct seq {
+    char ext[8];
+} seq;
+
+/* Accepts exactly one %d / %0Nd conversion (N at most two digits) and no
+ * other '%': the pattern is used as a printf format, so nothing else may
+ * reach it. */
+bool cap_images_pattern_ok(const char *path, const char **ext)
+{
+    const char *p = strchr(path, '%'), *slash = strrchr(path, '/');
+    if (!p || strchr(p + 1, '%') || (slash && slash > p)) /* the number goes in the file name */
+        return false;
+    const char *q = p + 1;
+    if (*q == '0')
+        q++;
+    int digits = 0;
+    while (*q >= '0' && *q <= '9' && digits < 3)
+        q++, digits++;
+    if (*q != 'd' || digits > 2)
+        return false;
+    const char *dot = strrchr(path, '.');
+    if (!dot || dot < q)
+        return false;
+    *ext = dot;
+    return !strcmp(dot, ".png") || !strcmp(dot, ".exr") || !strcmp(dot, ".tif") || !strcmp(dot, ".tiff");
+}
+
+static void frame_path(const cap_sink *s, uint64_t index, char *out, size_t n)
+{
+    snprintf(out, n, s->path, (int)index); /* the pattern was checked by cap_images_pattern_ok */
+}
+
+static bool img_open(cap_sink *s, rs_err *err)
+{
+    seq *q = calloc(1, sizeof *q);
+    const char *ext;
+    if (!q)
+        return rs_fail(err, 1, "out of memory");
+    if (!cap_images_pattern_ok(s->path, &ext)) {
+        free(q);
+        return rs_fail(err, 1, "%s: expected an image sequence pattern like name%%06d.png", s->path);
+    }
+    snprintf(q->ext, sizeof q->ext, "%s", ext);
+    s->impl = q;
+    char first[1100];
+    frame_path(s, 0, first, sizeof first);
+    return rs_mkdirs_for(first, err);
+}
+
+static bool img_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *err)
+{
+    seq *q = s->impl;
+    char path[1100], part[1120], msg[768];
+    frame_path(s, index, path, sizeof path);
+    snprintf(part, sizeof part, "%s.part", path);
+    if (!q)
+        return rs_fail(err, 1, "%s: the image sequence is not open", path);
+    if (!cap_oiio_write(part, q->ext, s->w, s->h, frame, msg, sizeof msg)) {
+        unlink(part);
+        return rs_fail(err, 1, "%s", msg);
+    }
+    if (rename(part, path) != 0) {
+        unlink(part);
+        return rs_fail(err, 1, "%s: cannot rename into place", path);
+    }
+    s->frames = index + 1;
+    return true;
+}
+
+static bool img_close(cap_sink *s, bool ok, rs_err *err)
+{
+    (void)err;
+    free(s->impl);
+    s->impl = NULL;
+    if (!ok) /* a partial sequence must not look finished */
+        for (uint64_t i = 0; i < s->frames; i++) {
+            char path[1100];
+            frame_path(s, i, path, sizeof path);
+            unlink(path);
+        }
+    return ok;
+}
+
+const cap_sink_ops cap_sink_images = {"images", img_open, img_write, img_close};

@@ -1,0 +1,20 @@
+/* An offscreen target for the game renderer: an RGBA8 colour texture
+ * (which capture reads from) and a depth-stencil renderbuffer.  Used by
+ * every headless path: play --headless, render, the benchmarks. */
+#ifndef R_TARGET_H
+#define R_TARGET_H
+
+#include <stdbool.h>
+
+#include "../gl/rgl.h"
+#include "../util/rs_err.h"
+
+typedef struct r_target {
+    GLuint fbo, tex, depth;
+    int w, h;
+} r_target;
+
+bool r_target_create(r_target *t, int w, int h, rs_err *err);
+void r_target_destroy(r_target *t);
+
+#endif
