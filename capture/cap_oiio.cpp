@@ -1,8 +1,10 @@
 // OpenImageIO behind a C interface (see cap_oiio.h).  Kept to what capture
-// needs: a reference resize and image files for sequences.
+// needs: a reference resize, image files for sequences, and float images
+// for image-based lighting (runtime/render/r_ibl.c).
 #include "cap_oiio.h"
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #ifdef RS_HAVE_OIIO
@@ -57,6 +59,43 @@ extern "C" bool cap_oiio_write(const char *path, const char *ext, int w, int h, 
     return ok ? true : fail(err, errn, path, e.empty() ? "write failed" : e);
 }
 
+extern "C" bool cap_oiio_read_float(const char *path, int *w, int *h, float **rgb, char *err, size_t errn)
+{
+    *rgb = nullptr;
+    auto in = ImageInput::open(path);
+    if (!in)
+        return fail(err, errn, path, "cannot read image: " + OIIO::geterror());
+    const ImageSpec &spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
+        return fail(err, errn, path, "not a 2-D image (" + std::to_string(spec.width) + "x" +
+                                         std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
+                                         " channels)");
+    if (spec.width > CAP_OIIO_MAX_SIDE || spec.height > CAP_OIIO_MAX_SIDE)
+        return fail(err, errn, path, std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                         " is larger than " + std::to_string(CAP_OIIO_MAX_SIDE) + "x" +
+                                         std::to_string(CAP_OIIO_MAX_SIDE));
+    size_t npix = (size_t)spec.width * (size_t)spec.height;
+    float *p = (float *)std::malloc(npix * 3 * sizeof(float));
+    if (!p)
+        return fail(err, errn, path, "out of memory for " + std::to_string(spec.width) + "x" +
+                                         std::to_string(spec.height) + " RGB floats");
+    int nch = spec.nchannels >= 3 ? 3 : 1;
+    /* x stride of three floats: a grey image lands in the first of each triple */
+    if (!in->read_image(0, 0, 0, nch, TypeDesc::FLOAT, p, 3 * sizeof(float))) {
+        std::string e = in->geterror();
+        std::free(p);
+        return fail(err, errn, path, e.empty() ? "read failed" : e);
+    }
+    if (nch == 1)
+        for (size_t k = 0; k < npix; k++)
+            p[3 * k + 1] = p[3 * k + 2] = p[3 * k];
+    in->close();
+    *w = spec.width;
+    *h = spec.height;
+    *rgb = p;
+    return true;
+}
+
 extern "C" const char *cap_oiio_version(void)
 {
     static char v[64];
@@ -73,6 +112,13 @@ extern "C" bool cap_oiio_resize(const uint8_t *, int, int, float *, int, int, ch
 extern "C" bool cap_oiio_write(const char *path, const char *, int, int, const uint8_t *, char *err, size_t errn)
 {
     std::snprintf(err, errn, "%s: this build has no OpenImageIO, so no image sequences", path);
+    return false;
+}
+extern "C" bool cap_oiio_read_float(const char *path, int *, int *, float **rgb, char *err, size_t errn)
+{
+    *rgb = nullptr;
+    std::snprintf(err, errn, "%s: built without OpenImageIO, so no image environments (install "
+                             "libopenimageio-dev and rebuild)", path);
     return false;
 }
 extern "C" const char *cap_oiio_version(void)

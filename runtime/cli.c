@@ -8,6 +8,7 @@
 
 #include "game/g_game.h"
 #include "platform/plat.h"
+#include "render/r_stage.h"
 
 void cli_error(const char *cmd, const char *fmt, ...)
 {
@@ -91,4 +92,17 @@ bool cli_stage(const char *arg, int *stage)
 int cli_plat_status(const struct rs_err *err)
 {
     return err->code == PLAT_ERR_UNKNOWN_BACKEND ? RS_EXIT_USAGE : RS_EXIT_FAIL;
+}
+
+bool cli_hdr_format(const char *arg, int *fmt)
+{
+    if (!strcmp(arg, "rgba16f"))
+        *fmt = R_HDR_RGBA16F;
+    else if (!strcmp(arg, "r11g11b10f"))
+        *fmt = R_HDR_R11G11B10F;
+    else {
+        fprintf(stderr, "ringside: --hdr-format '%s': expected rgba16f or r11g11b10f\n", arg);
+        return false;
+    }
+    return true;
 }

@@ -41,6 +41,9 @@ int cmd_replay(int argc, char **argv);
 struct rs_err;
 int cli_plat_status(const struct rs_err *err);
 
+/* "rgba16f" / "r11g11b10f" -> r_hdr_format; prints a usage error. */
+bool cli_hdr_format(const char *arg, int *fmt);
+
 /* Stage by name ("dojo") or number; prints a usage error on failure. */
 bool cli_stage(const char *arg, int *stage);
 

@@ -25,7 +25,8 @@ static void help(void)
 {
     printf("usage: ringside play [--p1 human|cpu] [--p2 human|cpu] [--stage NAME] [--seed S] [--level L]\n"
            "                     [--record FILE] [--replay FILE] [--seconds N] [--screenshot FILE]\n"
-           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n\n"
+           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
+           "                     [--stage-file FILE] [--passes[=summary|frames]] [--hdr-format F]\n\n"
            "Plays the game at a fixed 60 Hz in a window (GLFW; needs X, or xvfb-run -a).\n"
            "Keys: player 1 W A S D, J punch, K kick, L guard; player 2 arrows, numpad\n"
            "1 2 3 (or , . /); gamepads 1 and 2 too.  The 2-3-6 motion + punch is the\n"
@@ -42,7 +43,10 @@ static void help(void)
            "  --fullscreen     primary monitor, its current mode\n"
            "  --no-vsync       do not wait for the display\n"
            "  --headless       no window: EGL/OSMesa, one tick per frame, as fast as possible\n"
-           "  --quiet          no summary line\n");
+           "  --quiet          no summary line\n"
+           "  --stage-file F   the look to use instead of stages/<stage>.stage (docs/stages.md)\n"
+           "  --passes[=MODE]  time every render pass: a table at the end, or one line per frame\n"
+           "  --hdr-format F   the HDR buffer: rgba16f (default) or r11g11b10f\n");
 }
 
 typedef struct play {
@@ -89,8 +93,10 @@ static void on_render(void *user, float alpha)
     if (plat_window(s->p))
         plat_size(s->p, &w, &h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
-    if (w > 0 && h > 0)
-        r_game_draw(s->r, &s->prev, &s->cur, alpha, w, h);
+    if (w > 0 && h > 0 && !r_game_draw(s->r, &s->prev, &s->cur, alpha, w, h)) {
+        rs_fail(&s->err, 1, "%s", r_game_error(s->r));
+        s->failed = true;
+    }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     plat_present(s->p);
 }
@@ -158,6 +164,8 @@ int cmd_play(int argc, char **argv)
         {"screenshot", required_argument, 0, 'o'}, {"size", required_argument, 0, 'z'},
         {"fullscreen", no_argument, 0, 'f'},   {"no-vsync", no_argument, 0, 'v'},
         {"headless", no_argument, 0, 'H'},     {"quiet", no_argument, 0, 'q'},
+        {"stage-file", required_argument, 0, 'T'}, {"passes", optional_argument, 0, 'P'},
+        {"hdr-format", required_argument, 0, 'X'},
         {"help", no_argument, 0, 'h'},         {0}};
     play *s = calloc(1, sizeof *s);
     if (!s)
@@ -171,6 +179,8 @@ int cmd_play(int argc, char **argv)
     uint64_t seed = (uint64_t)time(NULL);
     const char *record = NULL, *replay = NULL, *shot = NULL;
     bool headless = false, quiet = false;
+    r_game_opts go = {.hdr_format = -1};
+    int passes = 0;
     plat_desc pd = {.title = "ringside"};
     rp_replay watch = {0};
     rp_recorder rec;
@@ -191,6 +201,24 @@ int cmd_play(int argc, char **argv)
         case 'f': pd.fullscreen = true; break;
         case 'v': pd.no_vsync = true; break;
         case 'H': headless = true; break;
+        case 'T': go.stage_file = optarg; break;
+        case 'P':
+            if (!optarg || !strcmp(optarg, "summary"))
+                passes = 1;
+            else if (!strcmp(optarg, "frames"))
+                passes = 2;
+            else {
+                cli_error("play", "--passes='%s': expected summary or frames", optarg);
+                status = RS_EXIT_USAGE;
+                goto done;
+            }
+            break;
+        case 'X':
+            if (!cli_hdr_format(optarg, &go.hdr_format)) {
+                status = RS_EXIT_USAGE;
+                goto done;
+            }
+            break;
         case 'q': quiet = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
@@ -236,9 +264,13 @@ int cmd_play(int argc, char **argv)
         status = cli_plat_status(&s->err);
         goto done;
     }
-    s->r = r_game_create(&s->err);
-    if (!s->r || (headless && !r_target_create(&s->target, s->w, s->h, &s->err)))
+    go.quiet = quiet;
+    s->r = r_game_create_opts(&go, &s->err);
+    if (!s->r || !r_game_prepare(s->r, stage, &s->err) ||
+        (headless && !r_target_create(&s->target, s->w, s->h, &s->err)))
         goto done;
+    if (passes)
+        r_game_passes(s->r, passes == 2, stderr);
     g_init(&s->cur, stage, seed);
     s->prev = s->cur;
     g_ai_init(&s->ai[0], 0, (int)level, seed);
@@ -258,6 +290,8 @@ int cmd_play(int argc, char **argv)
         goto done;
     if (shot && !screenshot(s, shot, &s->err))
         goto done;
+    if (passes)
+        r_game_report(s->r, stderr);
     if (s->rec && !rp_rec_save(s->rec, record, &s->err))
         goto done;
     if (!quiet) {

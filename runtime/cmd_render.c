@@ -23,7 +23,9 @@ static void help(void)
     printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
            "                       [--capture async|sequential] [--downscale gpu|cpu] [--filter F]\n"
            "                       [--pbo N] [--queue N]\n"
-           "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n\n"
+           "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
+           "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
+           "                       [--hdr-format rgba16f|r11g11b10f]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension:\n"
            "%s.\n"
@@ -41,6 +43,14 @@ static void help(void)
            "  --queue N          writer queue cap in frames, 0..1000 (default %d; 0: no thread)\n"
            "  --hashes FILE      write \"frame hash\" (64-bit FNV-1a of the frame bytes) per frame\n"
            "  --backend B        GL backend (default egl, falling back to osmesa)\n"
+           "  --stage-file FILE  the look to use instead of stages/<replay's stage>.stage\n"
+           "                     (docs/stages.md)\n"
+           "  --passes[=MODE]    time every render pass: a summary table at the end (default)\n"
+           "                     or one line per frame (frames); skipped passes are listed\n"
+           "  --mask             alpha = the fighters' mask, no HUD: RGBA cut-outs for artwork;\n"
+           "                     needs an image pattern output (.png)\n"
+           "  --no-hud           leave out bars, timer and announcements\n"
+           "  --hdr-format F     the HDR buffer: rgba16f (default) or r11g11b10f (no alpha)\n"
            "  --quiet            no progress line\n",
            cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
 }
@@ -63,11 +73,15 @@ int cmd_render(int argc, char **argv)
         {"downscale", required_argument, 0, 'd'},  {"pbo", required_argument, 0, 'p'},
         {"queue", required_argument, 0, 'Q'},      {"hashes", required_argument, 0, 'H'},
         {"backend", required_argument, 0, 'b'},    {"quiet", no_argument, 0, 'q'},
-        {"filter", required_argument, 0, 'F'},
+        {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
+        {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
+        {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
         {"help", no_argument, 0, 'h'},             {0}};
     const char *out = NULL, *hashes = NULL, *backend = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
+    r_game_opts go = {.hdr_format = -1};
+    int passes = 0; /* 1 summary, 2 per frame */
     long v;
     int c;
     optind = 1;
@@ -109,6 +123,23 @@ int cmd_render(int argc, char **argv)
                 return RS_EXIT_USAGE;
             }
             break;
+        case 'T': go.stage_file = optarg; break;
+        case 'P':
+            if (!optarg || !strcmp(optarg, "summary"))
+                passes = 1;
+            else if (!strcmp(optarg, "frames"))
+                passes = 2;
+            else {
+                cli_error("render", "--passes='%s': expected summary or frames", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case 'M': go.mask = true; break;
+        case 'U': go.no_hud = true; break;
+        case 'X':
+            if (!cli_hdr_format(optarg, &go.hdr_format))
+                return RS_EXIT_USAGE;
+            break;
         case 'H': hashes = optarg; break;
         case 'b': backend = optarg; break;
         case 'q': quiet = true; break;
@@ -130,6 +161,11 @@ int cmd_render(int argc, char **argv)
     const char *replay = argv[optind];
     rs_err err = {0};
     cap_pixfmt fmt = strchr(out, '%') ? CAP_RGBA : CAP_I420;
+    if (go.mask && fmt != CAP_RGBA) {
+        cli_error("render", "--mask writes RGBA images: give -o an image pattern such as cut/f%%04d.png, not %s", out);
+        return RS_EXIT_USAGE;
+    }
+    go.quiet = quiet;
     if (!cap_check_sizes_for(fmt, cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
         cli_error("render", "%s", err.msg);
         return RS_EXIT_USAGE;
@@ -165,8 +201,11 @@ int cmd_render(int argc, char **argv)
         status = cli_plat_status(&err);
         goto done;
     }
-    if (!(r = r_game_create(&err)) || !r_target_create(&t, cd.src_w, cd.src_h, &err))
+    if (!(r = r_game_create_opts(&go, &err)) || !r_game_prepare(r, rp.stage, &err) ||
+        !r_target_create(&t, cd.src_w, cd.src_h, &err))
         goto done;
+    if (passes)
+        r_game_passes(r, passes == 2, stderr);
     cap *cp = cap_open(&cd, &sink, &err);
     if (!cp)
         goto done;
@@ -190,14 +229,18 @@ int cmd_render(int argc, char **argv)
         prev = cur;
         g_step(&cur, &rp.inputs[2 * tick], NULL);
         gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-        r_game_draw(r, &prev, &cur, 1.0f, cd.src_w, cd.src_h);
+        ok = r_game_draw(r, &prev, &cur, 1.0f, cd.src_w, cd.src_h);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-        ok = cap_frame(cp, t.tex, &err);
+        if (!ok)
+            rs_fail(&err, 1, "frame %" PRIu64 ": %s", tick, r_game_error(r));
+        ok = ok && cap_frame(cp, t.tex, &err);
         rs_progress_update(&prog, tick + 1);
     }
     double secs = rs_progress_end(&prog);
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
+    if (passes)
+        r_game_report(r, stderr);
     cap_stats st;
     if (!cap_close(cp, ok, &st, &err))
         goto done;

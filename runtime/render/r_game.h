@@ -1,26 +1,64 @@
-/* The plain game renderer: lit capsule fighters on a ring, and a HUD with
- * health bars, round timer, round wins and announcements.
+/* The game renderer (renderer core, docs/renderer.md): the Virtua
+ * Fighter 5 look of techniques A1-A3 and A5 on a pass graph.
+ *
+ *   shadow_map, silhouette, silhouette_mips   from the key light
+ *   z_prepass, shadow_mask, mask_filter        SSFSM for the fighters
+ *   scene, sky, lens                           HDR (RGBA16F), IBL, alpha = mask
+ *   bloom_bright, bloom_blur                   bloom from the HDR buffer
+ *   sun_visibility                             only when the sun is on screen
+ *   tonemap, hud                               YCbCr curve into the output
  *
  * It reads game state and never writes it.  Draws interpolate between the
- * previous and the current tick (alpha 0..1) so a window running faster or
- * slower than 60 Hz still moves smoothly.  The renderer-core work turns
- * this into the HDR/IBL pass graph; the contract stays: state in, pixels
- * out, into whatever framebuffer is bound. */
+ * previous and the current tick (alpha 0..1).  State in, pixels out, into
+ * whatever framebuffer is bound. */
 #ifndef R_GAME_H
 #define R_GAME_H
 
+#include <stdio.h>
+
 #include "../game/g_game.h"
 #include "../util/rs_err.h"
+#include "r_graph.h"
 #include "r_math.h"
+#include "r_stage.h"
 
 typedef struct r_game r_game;
 
+typedef struct r_game_opts {
+    const char *stage_file; /* NULL: <data>/stages/<game stage>.stage */
+    bool mask;              /* output alpha = the fighters' mask (and no HUD) */
+    bool no_hud;
+    int hdr_format;         /* -1: the stage's; else an r_hdr_format */
+    const char *cache_dir;  /* NULL: r_ibl_cache_dir(); "" = no cache */
+    int lut_size;           /* 0: R_TONE_LUT_DEFAULT */
+    bool quiet;             /* no note when prefiltering takes a while */
+} r_game_opts;
+
 /* Needs a current GL context. */
 r_game *r_game_create(rs_err *err);
+r_game *r_game_create_opts(const r_game_opts *o, rs_err *err);
 void r_game_destroy(r_game *r);
 
-/* Draws into the bound framebuffer, viewport 0,0,w,h. */
-void r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h);
+/* Loads the look of a game stage now (stage file, environment, IBL), so
+ * errors come before the first frame; r_game_draw does it on demand. */
+bool r_game_prepare(r_game *r, int game_stage, rs_err *err);
+/* Uses this stage description (whatever the game stage) from now on. */
+bool r_game_set_stage(r_game *r, const r_stage *st, rs_err *err);
+const r_stage *r_game_stage(const r_game *r);
+
+/* Draws into the bound framebuffer, viewport 0,0,w,h.  Returns false (and
+ * clears to black) when the stage could not be loaded: r_game_error. */
+bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h);
+const char *r_game_error(const r_game *r);
+
+/* --passes: time every pass; per_frame prints one line per frame to out. */
+void r_game_passes(r_game *r, bool per_frame, FILE *out);
+void r_game_report(r_game *r, FILE *out);
+r_graph *r_game_graph(r_game *r);
+
+/* Reads back the HDR buffer of the last frame (w*h*4 floats, bottom-up) or
+ * a named intermediate ("hdr", "bloom", "mask", "silhouette"): tests. */
+bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h);
 
 /* The camera r_game_draw used for this state (tests project with it). */
 r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye);

@@ -1,0 +1,74 @@
+#version 330 core
+// The HDR scene pass (techniques A1, A2, A5): image-based lighting only,
+// no ambient term.  Every surface blends its key-on and key-off IBL
+// results by its shadow factor: the filtered screen-space mask for the
+// fighters (SSFSM), the blurred silhouette mip chain for the stage.
+// Output: linear HDR, alpha = the fighters' mask.
+#include "ibl_common.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec4 v_tangent;
+in vec2 v_uv;
+in vec4 v_color;
+#ifdef STAGE
+in vec3 v_proj;
+in float v_lod;
+uniform sampler2D u_silhouette;
+uniform vec3 u_ring_color;
+#endif
+#ifdef FIGHTER
+uniform sampler2D u_normal_map;
+uniform sampler2D u_spec_map;
+uniform sampler2D u_mask;
+#endif
+uniform vec3 u_eye;
+uniform int u_shadows;   // 1 when this frame's shadow passes ran
+uniform float u_flash;   // lightning: extra light, 0..1
+
+out vec4 o_color;
+
+vec3 hdr_out(vec3 c)
+{
+    // never let a value reach fp16 Inf, nor a NaN through
+    return mix(clamp(c, vec3(0.0), vec3(65504.0)), vec3(0.0), isnan(c));
+}
+
+void main()
+{
+    vec3 n = normalize(v_normal);
+    vec3 v = normalize(u_eye - v_world);
+#ifdef FIGHTER
+    // normal map in tangent space (capsule uv: u around, v along the bone)
+    vec3 t = normalize(v_tangent.xyz - n * dot(n, v_tangent.xyz));
+    vec3 bt = cross(n, t) * v_tangent.w;
+    vec2 uv = v_uv * vec2(3.0, 4.0);
+    vec3 tn = texture(u_normal_map, uv).xyz * 2.0 - 1.0;
+    n = normalize(t * tn.x + bt * tn.y + n * tn.z);
+    vec4 sm = texture(u_spec_map, uv);
+    vec3 spec_color = sm.rgb * v_color.a;
+    float exponent = 16.0 + 112.0 * sm.a;
+    float key = u_shadows == 1 ? texelFetch(u_mask, ivec2(gl_FragCoord.xy), 0).r : 1.0;
+    vec3 albedo = v_color.rgb;
+    float alpha = 1.0;
+#endif
+#ifdef STAGE
+    // planks: a procedural albedo variation, matte with a faint sheen
+    float plank = floor(v_world.x * 2.5);
+    float grain = 0.85 + 0.15 * fract(sin(plank * 12.9898) * 43758.5453);
+    float seam = smoothstep(0.0, 0.02, fract(v_world.x * 2.5)) * 0.3 + 0.7;
+    vec3 albedo = u_ring_color * grain * seam;
+    vec3 spec_color = vec3(0.04);
+    float exponent = 16.0;
+    float key = 1.0;
+    if (u_shadows == 1 && v_proj.z > 0.5)
+        key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
+    float alpha = 0.0;
+#endif
+    vec3 r = reflect(-v, n);
+    float ndv = max(dot(n, v), 0.0);
+    float fresnel = 0.25 + 0.75 * pow(1.0 - ndv, 5.0);
+    vec3 lit = albedo * ibl_diffuse(n, key) + spec_color * fresnel * ibl_specular(r, exponent, key);
+    lit += u_flash * 2.0 * albedo;
+    o_color = vec4(hdr_out(lit), alpha);
+}

@@ -1,0 +1,64 @@
+#version 330 core
+// Scene geometry for every pass that draws it: rigid skinning, one matrix
+// per bone (bone index -1: world space).  Variants by #define:
+//   FIGHTER, STAGE, LENS   the HDR scene pass (scene.frag)
+//   LIGHT_VIEW             shadow map / silhouette from the key light
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec4 a_tangent;
+layout(location = 3) in vec2 a_uv;
+layout(location = 4) in float a_bone;
+
+uniform mat4 u_view_proj; // camera, or the light's projection for LIGHT_VIEW
+uniform mat4 u_bones[16];
+uniform vec4 u_bone_color[16]; // rgb albedo, a: specular strength
+uniform float u_lens_side;     // LENS: +1 / -1, which side of the head is the face
+
+#ifdef STAGE
+uniform mat4 u_light_proj;     // the silhouette projector
+uniform vec3 u_light_dir;      // towards the key light
+uniform vec3 u_waist[2];       // the casters' waists
+uniform float u_lod_start, u_lod_scale;
+out vec3 v_proj;               // projector uv, z: 1 when this vertex may receive
+out float v_lod;
+#endif
+
+out vec3 v_world;
+out vec3 v_normal;
+out vec4 v_tangent;
+out vec2 v_uv;
+out vec4 v_color;
+
+invariant gl_Position; // the z-prepass and the scene pass must agree exactly
+
+void main()
+{
+    int b = int(a_bone + 0.5);
+    mat4 m = a_bone < -0.5 ? mat4(1.0) : u_bones[b];
+    vec3 p = a_pos, n = a_normal, t = a_tangent.xyz;
+#ifdef LENS
+    p.y *= u_lens_side;
+    n.y *= u_lens_side;
+    t.y *= u_lens_side;
+#endif
+    vec4 world = m * vec4(p, 1.0);
+    v_world = world.xyz;
+    v_normal = mat3(m) * n; // rigid: rotation only
+    v_tangent = vec4(mat3(m) * t, a_tangent.w);
+    v_uv = a_uv;
+    v_color = a_bone < -0.5 ? vec4(1.0) : u_bone_color[b];
+#ifdef STAGE
+    // Blurred mipmap projection shadow: the mip level grows with the
+    // distance to the nearest caster's waist (near = sharp, far = soft);
+    // receivers facing away from the light or on its side of the caster
+    // (behind the projector) are rejected here.
+    vec3 w = distance(world.xyz, u_waist[0]) < distance(world.xyz, u_waist[1]) ? u_waist[0] : u_waist[1];
+    float d = distance(world.xyz, w);
+    vec4 lp = u_light_proj * world;
+    bool facing = dot(v_normal, u_light_dir) > 0.0;
+    bool behind = dot(world.xyz - w, u_light_dir) > 0.0;
+    v_proj = vec3(lp.xy * 0.5 + 0.5, facing && !behind ? 1.0 : 0.0);
+    v_lod = clamp((d - u_lod_start) * u_lod_scale, 0.0, 4.0);
+#endif
+    gl_Position = u_view_proj * world;
+}

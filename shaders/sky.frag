@@ -1,0 +1,20 @@
+#version 330 core
+// The stage's environment as seen, plus the sun disc (the sun is a delta
+// light in the prefiltered maps, so it is drawn analytically here).
+in vec3 v_dir;
+uniform samplerCube u_env;
+uniform vec3 u_sun_dir;
+uniform vec3 u_sun_radiance; // 0 when there is no sun
+uniform float u_sun_cos;     // cos of the sun's angular radius
+uniform float u_flash;
+out vec4 o_color;
+void main()
+{
+    vec3 d = normalize(v_dir);
+    vec3 c = texture(u_env, d).rgb;
+    float cs = dot(d, u_sun_dir);
+    c += u_sun_radiance * smoothstep(u_sun_cos - (1.0 - u_sun_cos) * 0.3, u_sun_cos, cs);
+    c += u_flash * vec3(1.5, 1.6, 2.0);
+    c = min(c, vec3(65504.0));
+    o_color = vec4(c, 0.0);
+}
