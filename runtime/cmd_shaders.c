@@ -16,10 +16,59 @@ static void help(void)
            "Compiles every .vert, .frag, .geom and .comp file in the shaders directory\n"
            "(found through RINGSIDE_DATA, the source tree or the install prefix) and\n"
            "prints each error as shaders/FILE:LINE: message.  .glsl files are include\n"
-           "files and are compiled as part of the stages that include them.\n"
+           "files and are compiled as part of the stages that include them.  A file with\n"
+           "a line '// variants: A B+C' is compiled once per variant, with '#define A 1'\n"
+           "and then '#define B 1' and '#define C 1' ('-' is the variant with none).\n"
            "Exit status 1 if any shader fails.\n\n"
            "  --backend B   GL backend (default egl, falling back to osmesa)\n"
            "  --quiet       print only failures\n");
+}
+
+/* The "// variants:" line of shaders/<name>, or NULL when the file has
+ * none (it is then compiled once, without defines). */
+static char *variants_of(const char *root, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/shaders/%s", root, name);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return NULL;
+    char line[512], *out = NULL;
+    for (int n = 0; n < 40 && fgets(line, sizeof line, f); n++) {
+        char *v = strstr(line, "// variants:");
+        if (v == line) {
+            v += strlen("// variants:");
+            v[strcspn(v, "\r\n")] = 0;
+            out = strdup(v);
+            break;
+        }
+    }
+    fclose(f);
+    return out;
+}
+
+/* "B+C" -> "#define B 1\n#define C 1\n"; "-" -> "". */
+static void variant_defines(const char *tok, size_t len, char *out, size_t n)
+{
+    out[0] = 0;
+    size_t at = 0;
+    while (len > 0) {
+        size_t k = 0;
+        while (k < len && tok[k] != '+')
+            k++;
+        if (k > 0 && !(k == 1 && tok[0] == '-')) {
+            int w = snprintf(out + at, n - at, "#define %.*s 1\n", (int)k, tok);
+            if (w < 0 || (size_t)w >= n - at)
+                return;
+            at += (size_t)w;
+        }
+        tok += k;
+        len -= k;
+        if (len > 0) {
+            tok++;
+            len--;
+        }
+    }
 }
 
 static int by_name(const void *a, const void *b)
@@ -90,25 +139,41 @@ int cmd_shaders(int argc, char **argv)
             free(names[i]);
         return cli_plat_status(&err);
     }
-    int failed = 0;
+    int failed = 0, compiled = 0;
     for (int i = 0; i < n; i++) {
-        char *log = NULL, shown[1200];
+        char shown[1200];
         rs_data_path(root, "shaders", shown, sizeof shown);
-        GLuint sh = r_shader_compile(names[i], NULL, &log, &err);
-        if (sh) {
-            if (!quiet)
-                printf("ok      %s/%s\n", shown, names[i]);
-            gl.DeleteShader(sh);
-        } else {
-            failed++;
-            printf("FAILED  %s/%s\n%s", shown, names[i], log ? log : err.msg);
-            if (!log)
-                putchar('\n');
+        char *vars = variants_of(root, names[i]);
+        const char *v = vars ? vars : "-";
+        for (;;) {
+            v += strspn(v, " \t");
+            size_t len = strcspn(v, " \t");
+            if (len == 0)
+                break;
+            char defs[512], label[160] = "";
+            variant_defines(v, len, defs, sizeof defs);
+            if (vars)
+                snprintf(label, sizeof label, " [%.*s]", (int)len, v);
+            char *log = NULL;
+            GLuint sh = r_shader_compile(names[i], defs[0] ? defs : NULL, &log, &err);
+            compiled++;
+            if (sh) {
+                if (!quiet)
+                    printf("ok      %s/%s%s\n", shown, names[i], label);
+                gl.DeleteShader(sh);
+            } else {
+                failed++;
+                printf("FAILED  %s/%s%s\n%s", shown, names[i], label, log ? log : err.msg);
+                if (!log)
+                    putchar('\n');
+            }
+            free(log);
+            v += len;
         }
-        free(log);
+        free(vars);
         free(names[i]);
     }
-    printf("%d shader files, %d failed (%s, GL %d.%d)\n", n, failed, plat_backend_name(p), glcaps.major, glcaps.minor);
+    printf("%d shader files, %d compiles, %d failed (%s, GL %d.%d)\n", n, compiled, failed, plat_backend_name(p), glcaps.major, glcaps.minor);
     plat_destroy(p);
     return failed ? RS_EXIT_FAIL : RS_EXIT_OK;
 }

@@ -1,4 +1,5 @@
 #version 330 core
+// variants: - FACTOR2
 // Area-average downscale (a box filter of the exact footprint).  Output
 // GL row r holds image row r counted from the top (the source is read
 // flipped), so the readback comes out top row first.  Each output pixel

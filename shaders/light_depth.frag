@@ -1,4 +1,5 @@
 #version 330 core
+// variants: - SILHOUETTE
 // Shadow map (depth only) and silhouette (1 where a caster is) from the
 // key light; SILHOUETTE selects the second.
 #ifdef SILHOUETTE

@@ -1,4 +1,5 @@
 #version 330 core
+// variants: FIGHTER STAGE
 // The HDR scene pass (techniques A1, A2, A5): image-based lighting only,
 // no ambient term.  Every surface blends its key-on and key-off IBL
 // results by its shadow factor: the filtered screen-space mask for the

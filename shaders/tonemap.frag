@@ -1,4 +1,5 @@
 #version 330 core
+// variants: - BLOOM FLARE BLOOM+FLARE
 // Tone map (techniques A3), one full-screen pass:
 //   1. RGB -> Y, Cb, Cr (CbCr unnormalised: B - Y and R - Y)
 //   2. Y' from the curve ((1 - exp(-x^2))^1.5)^(1/gamma) in a float table

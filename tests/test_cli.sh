@@ -89,6 +89,21 @@ t_broken_shader_names_file_line() {
     grep -q "^ok .*smoke.vert" sh.txt || { cat sh.txt; return 1; }
 }
 
+t_shader_variants_all_compile() {
+    "$RS_BIN" shaders >sh.txt 2>&1 || { cat sh.txt; return 1; }
+    grep -q "^ok .*tonemap.frag \[BLOOM+FLARE\]" sh.txt || { cat sh.txt; return 1; }
+    grep -q "compiles, 0 failed" sh.txt || { cat sh.txt; return 1; }
+    # an error only the SILHOUETTE variant sees is still found
+    data_copy
+    sed 's/^#ifdef SILHOUETTE$/#ifdef SILHOUETTE\nint broken = ;/' "$SRC/shaders/light_depth.frag" >data/shaders/light_depth.frag
+    grep -q "int broken" data/shaders/light_depth.frag || { echo "sed did not apply"; return 1; }
+    "$RS_BIN" shaders >sh.txt 2>&1
+    [ $? = 1 ] || { echo "shaders: want exit 1"; cat sh.txt; return 1; }
+    grep -q "^ok .*light_depth.frag \[-\]" sh.txt || { cat sh.txt; return 1; }
+    grep -q "^FAILED .*light_depth.frag \[SILHOUETTE\]" sh.txt || { cat sh.txt; return 1; }
+    grep -q "shaders/light_depth.frag:[0-9]*: error" sh.txt || { cat sh.txt; return 1; }
+}
+
 t_wrong_picture_is_caught() {
     data_copy
     sed 's/o_color = u_color;/o_color = u_color.bgra;/' "$SRC/shaders/smoke.frag" >data/shaders/smoke.frag
@@ -114,7 +129,7 @@ t_bench_platform() {
     expect_fail 2 "unknown benchmark 'gpu'" "$RS_BIN" bench gpu || return 1
 }
 
-t_run help usage_errors info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
+t_run help usage_errors shader_variants_all_compile info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
     smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
     installed_layout bench_platform
 t_done
