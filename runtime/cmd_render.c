@@ -51,6 +51,8 @@ static void help(void)
            "                     needs an image pattern output (.png)\n"
            "  --no-hud           leave out bars, timer and announcements\n"
            "  --hdr-format F     the HDR buffer: rgba16f (default) or r11g11b10f (no alpha)\n"
+           "  --ticks A:B        write only ticks A to B-1 (the game still runs from tick 0,\n"
+           "                     so frame A is the same as in a full render)\n"
            "  --quiet            no progress line\n",
            cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
 }
@@ -76,12 +78,13 @@ int cmd_render(int argc, char **argv)
         {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
         {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
         {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
-        {"help", no_argument, 0, 'h'},             {0}};
+        {"ticks", required_argument, 0, 'K'},      {"help", no_argument, 0, 'h'},             {0}};
     const char *out = NULL, *hashes = NULL, *backend = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
     r_game_opts go = {.hdr_format = -1};
     int passes = 0; /* 1 summary, 2 per frame */
+    long first = 0, end = -1; /* --ticks; end -1: the whole replay */
     long v;
     int c;
     optind = 1;
@@ -140,6 +143,23 @@ int cmd_render(int argc, char **argv)
             if (!cli_hdr_format(optarg, &go.hdr_format))
                 return RS_EXIT_USAGE;
             break;
+        case 'K': {
+            char *colon = strchr(optarg, ':'), a[32];
+            if (!colon || (size_t)(colon - optarg) >= sizeof a) {
+                cli_error("render", "--ticks '%s': expected A:B, such as 600:660", optarg);
+                return RS_EXIT_USAGE;
+            }
+            memcpy(a, optarg, (size_t)(colon - optarg));
+            a[colon - optarg] = 0;
+            if (!cli_int("--ticks start", a, 0, 100000000, &first) ||
+                !cli_int("--ticks end", colon + 1, 1, 100000000, &end))
+                return RS_EXIT_USAGE;
+            if (end <= first) {
+                cli_error("render", "--ticks '%s': the end must be after the start", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        }
         case 'H': hashes = optarg; break;
         case 'b': backend = optarg; break;
         case 'q': quiet = true; break;
@@ -180,7 +200,15 @@ int cmd_render(int argc, char **argv)
     FILE *hf = NULL;
     char hpart[1100] = "";
     /* everything that can be checked without rendering, first */
-    if (!rp_read(replay, &rp, &err) || !cap_sink_for(out, cd.w, cd.h, &sink, &err))
+    if (!rp_read(replay, &rp, &err))
+        goto done;
+    if (end > (long)rp.ticks) {
+        rs_fail(&err, RS_EXIT_USAGE, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", replay, first, end,
+                rp.ticks);
+        goto done;
+    }
+    uint64_t t_first = (uint64_t)first, t_end = end < 0 ? rp.ticks : (uint64_t)end;
+    if (!cap_sink_for(out, cd.w, cd.h, &sink, &err))
         goto done;
     struct stat hst;
     if (hashes && stat(hashes, &hst) == 0 && !S_ISREG(hst.st_mode)) {
@@ -213,17 +241,19 @@ int cmd_render(int argc, char **argv)
     g_state prev, cur;
     g_init(&cur, rp.stage, rp.seed);
     rs_progress prog;
-    rs_progress_start(&prog, "render", "frames", rp.ticks, quiet);
+    rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet);
     bool ok = true;
     struct sigaction sa = {0}, old_int, old_term;
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, &old_int);
     sigaction(SIGTERM, &sa, &old_term);
-    for (uint64_t tick = 0; tick < rp.ticks && ok; tick++) {
+    for (uint64_t tick = 0; tick < t_first; tick++)
+        g_step(&cur, &rp.inputs[2 * tick], NULL);
+    for (uint64_t tick = t_first; tick < t_end && ok; tick++) {
         if (stop_requested) {
             ok = false;
             rs_fail(&err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
-                    out, tick, rp.ticks);
+                    out, tick, t_end);
             break;
         }
         prev = cur;
@@ -234,7 +264,7 @@ int cmd_render(int argc, char **argv)
         if (!ok)
             rs_fail(&err, 1, "frame %" PRIu64 ": %s", tick, r_game_error(r));
         ok = ok && cap_frame(cp, t.tex, &err);
-        rs_progress_update(&prog, tick + 1);
+        rs_progress_update(&prog, tick + 1 - t_first);
     }
     double secs = rs_progress_end(&prog);
     sigaction(SIGINT, &old_int, NULL);

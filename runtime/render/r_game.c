@@ -61,6 +61,7 @@ typedef struct frame {
     float flash, saturation, exposure;
     bool sun_on_screen;
     float sun_px[2];
+    int fig_box[4]; /* x, y, w, h: the fighters on screen plus the mask filter's reach */
     GLint out_fbo;
 } frame;
 
@@ -407,6 +408,34 @@ r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye_out)
     return r_mul(r_perspective(0.75f, (float)w / (float)h, 0.1f, 200.0f), r_look_at(eye, at, r_v3(0, 1, 0)));
 }
 
+/* The screen rectangle the fighters can cover: the world box round their
+ * bones (each bone's origin +-0.4 m, which holds the longest limb's far
+ * end too) projected, plus MASK_REACH pixels.  The shadow mask is 1
+ * (lit) outside it, so its passes draw only inside (a scissor). */
+#define MASK_REACH 8 /* grow 1 px + blur 4 px, with room to spare */
+static void fighter_box(frame *f, const float lo[3], const float hi[3])
+{
+    float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+    bool whole = false;
+    for (int k = 0; k < 8 && !whole; k++) {
+        r_vec3 c = r_v3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]);
+        float x, y;
+        if (!r_project(f->vp, c, f->w, f->h, &x, &y)) {
+            whole = true; /* a corner behind the camera: no safe bound */
+            break;
+        }
+        x0 = fminf(x0, x), y0 = fminf(y0, y), x1 = fmaxf(x1, x), y1 = fmaxf(y1, y);
+    }
+    if (whole || !(x0 <= x1) || !(y0 <= y1)) {
+        f->fig_box[0] = f->fig_box[1] = 0, f->fig_box[2] = f->w, f->fig_box[3] = f->h;
+        return;
+    }
+    float bx0 = fmaxf(floorf(x0) - MASK_REACH, 0), by0 = fmaxf(floorf(y0) - MASK_REACH, 0);
+    float bx1 = fminf(ceilf(x1) + MASK_REACH, (float)f->w), by1 = fminf(ceilf(y1) + MASK_REACH, (float)f->h);
+    f->fig_box[0] = (int)bx0, f->fig_box[1] = (int)by0;
+    f->fig_box[2] = bx1 > bx0 ? (int)(bx1 - bx0) : 0, f->fig_box[3] = by1 > by0 ? (int)(by1 - by0) : 0;
+}
+
 /* The key light's orthographic projection, fitted round both fighters. */
 static void light_setup(r_game *r, frame *f)
 {
@@ -429,6 +458,7 @@ static void light_setup(r_game *r, frame *f)
                 hi[a] = fmaxf(hi[a], p[a] + 0.4f);
             }
         }
+    fighter_box(f, lo, hi);
     r_vec3 c = r_v3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
     float rad = 0.5f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
@@ -640,6 +670,16 @@ static void run_z_prepass(void *u)
     draw_fighters(r, r->prog[P_DEPTH]);
 }
 
+/* The bound mask buffer: all 1 (lit), then draws limited to the fighters' box. */
+static void mask_clear_and_scissor(r_game *r)
+{
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.ClearColor(1, 1, 1, 1);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(r->f.fig_box[0], r->f.fig_box[1], r->f.fig_box[2], r->f.fig_box[3]);
+}
+
 static void run_shadow_mask(void *u)
 {
     r_game *r = u;
@@ -648,6 +688,7 @@ static void run_shadow_mask(void *u)
     gl.Viewport(0, 0, r->f.w, r->f.h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
+    mask_clear_and_scissor(r);
     gl.UseProgram(p);
     bind_tex(p, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
     bind_tex(p, "u_shadow_map", 1, GL_TEXTURE_2D, r->shadow_tex);
@@ -656,6 +697,7 @@ static void run_shadow_mask(void *u)
     gl.Uniform2f(loc(p, "u_size"), (float)r->f.w, (float)r->f.h);
     gl.Uniform1f(loc(p, "u_bias"), 0.0015f);
     fullscreen(r);
+    gl.Disable(GL_SCISSOR_TEST);
 }
 
 /* SSFSM step 3: grow dark by a pixel, then blur (mask 0 -> 1 -> 0 -> 1) */
@@ -665,11 +707,14 @@ static void run_mask_filter(void *u)
     GLuint p = r->prog[P_GROW];
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->mask_fbo[1]);
     gl.Viewport(0, 0, r->f.w, r->f.h);
+    mask_clear_and_scissor(r);
     gl.UseProgram(p);
     bind_tex(p, "u_src", 0, GL_TEXTURE_2D, r->mask_tex[0]);
     fullscreen(r);
+    /* outside the box both buffers hold 1, so the blur reads the truth there */
     blur_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->f.w, r->f.h, 1, 0);
     blur_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->f.w, r->f.h, 0, 1);
+    gl.Disable(GL_SCISSOR_TEST);
     r->mask_final = 1;
 }
 
@@ -1306,8 +1351,9 @@ void r_game_passes(r_game *r, bool per_frame, FILE *out)
 void r_game_report(r_game *r, FILE *out)
 {
     r_graph_flush(&r->graph);
-    fprintf(out, "passes (stage %s, %dx%d, %llu frames; gpu: %s):\n", r->have_stage ? r->stage.name : "-", r->tw, r->th,
-            (unsigned long long)r->graph.frame, r->graph.gpu_timer ? "GL_TIME_ELAPSED queries" : "not available, cpu only");
+    fprintf(out, "passes (stage %s, %dx%d, %llu frames; gpu: %s%s):\n", r->have_stage ? r->stage.name : "-", r->tw, r->th,
+            (unsigned long long)r->graph.frame, r->graph.gpu_timer ? "GL_TIMESTAMP queries" : "not available, cpu only",
+            r->graph.serial ? "; software renderer: glFinish after each pass, cpu ms = wall time" : "");
     r_graph_report(&r->graph, out);
 }
 

@@ -60,10 +60,16 @@ void r_graph_timing(r_graph *g, r_graph_frame_fn fn, void *user)
     g->timing = true;
     g->on_frame = fn;
     g->on_frame_user = user;
-    /* GL_TIME_ELAPSED is core in 3.3, the version every backend gives us */
-    g->gpu_timer = gl.GenQueries && gl.GetQueryObjectui64v;
+    /* Timer queries are core in 3.3, the version every backend gives us.
+     * A pair of GL_TIMESTAMP queries per pass rather than GL_TIME_ELAPSED:
+     * llvmpipe (Mesa 22) reports the first TIME_ELAPSED query after a flush
+     * as the absolute clock (hours), and timestamps also need no nesting
+     * rules should a pass ever time itself. */
+    g->gpu_timer = gl.GenQueries && gl.GetQueryObjectui64v && gl.QueryCounter;
+    const char *renderer = (const char *)gl.GetString(GL_RENDERER);
+    g->serial = renderer && (strstr(renderer, "llvmpipe") || strstr(renderer, "softpipe"));
     if (g->gpu_timer)
-        gl.GenQueries(R_GRAPH_LAG * R_GRAPH_MAX, &g->query[0][0]);
+        gl.GenQueries(R_GRAPH_LAG * R_GRAPH_MAX * 2, &g->query[0][0][0]);
 }
 
 static void collect(r_graph *g, int s)
@@ -80,9 +86,10 @@ static void collect(r_graph *g, int s)
         if (c > st->cpu_max_ms)
             st->cpu_max_ms = c;
         if (g->gpu_timer) {
-            GLuint64 ns = 0;
-            gl.GetQueryObjectui64v(g->query[s][i], GL_QUERY_RESULT, &ns);
-            gpu[i] = ns / 1e6;
+            GLuint64 t0 = 0, t1 = 0;
+            gl.GetQueryObjectui64v(g->query[s][i][0], GL_QUERY_RESULT, &t0);
+            gl.GetQueryObjectui64v(g->query[s][i][1], GL_QUERY_RESULT, &t1);
+            gpu[i] = t1 > t0 ? (double)(t1 - t0) / 1e6 : 0.0;
             st->gpu_ms += gpu[i];
             if (gpu[i] > st->gpu_max_ms)
                 st->gpu_max_ms = gpu[i];
@@ -116,10 +123,12 @@ uint32_t r_graph_run(r_graph *g, void *user)
         }
         double t0 = g->timing ? now_ms() : 0;
         if (g->timing && g->gpu_timer)
-            gl.BeginQuery(GL_TIME_ELAPSED, g->query[s][i]);
+            gl.QueryCounter(g->query[s][i][0], GL_TIMESTAMP);
         p->run(user);
+        if (g->timing && g->serial)
+            gl.Finish();
         if (g->timing && g->gpu_timer)
-            gl.EndQuery(GL_TIME_ELAPSED);
+            gl.QueryCounter(g->query[s][i][1], GL_TIMESTAMP);
         if (g->timing)
             g->slot[s].cpu_ms[i] = now_ms() - t0;
         g->stats[i].runs++;
@@ -148,7 +157,7 @@ void r_graph_flush(r_graph *g)
 void r_graph_release(r_graph *g)
 {
     if (g->timing && g->gpu_timer)
-        gl.DeleteQueries(R_GRAPH_LAG * R_GRAPH_MAX, &g->query[0][0]);
+        gl.DeleteQueries(R_GRAPH_LAG * R_GRAPH_MAX * 2, &g->query[0][0][0]);
     g->timing = false;
 }
 

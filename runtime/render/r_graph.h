@@ -12,9 +12,15 @@
  * graph records the error (r_graph_error), which the tests check.
  *
  * Timing (--passes): each pass that runs is bracketed with a
- * GL_TIME_ELAPSED query, read back R_GRAPH_LAG frames later so the CPU
+ * pair of GL_TIMESTAMP queries, read back R_GRAPH_LAG frames later so the CPU
  * never waits for the GPU; CPU time (submission) is measured too, and is
- * what gets reported where timer queries are missing. */
+ * what gets reported where timer queries are missing.
+ *
+ * On a software renderer (llvmpipe, softpipe) work is deferred until a
+ * later pass forces a flush, so a cheap pass that reads a texture gets
+ * billed for the draws queued before it.  There timing finishes each pass
+ * (glFinish) so every pass is billed for its own work; the frame gets a
+ * little slower, which is the price of an honest table. */
 #ifndef R_GRAPH_H
 #define R_GRAPH_H
 
@@ -56,7 +62,8 @@ typedef struct r_graph {
     char error[256];              /* first run-time inconsistency, "" if none */
     /* timing */
     bool timing, gpu_timer;
-    GLuint query[R_GRAPH_LAG][R_GRAPH_MAX];
+    bool serial;                  /* glFinish after each timed pass (software renderers) */
+    GLuint query[R_GRAPH_LAG][R_GRAPH_MAX][2]; /* GL_TIMESTAMP before and after each pass */
     struct {
         bool pending;
         uint64_t frame;
