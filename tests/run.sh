@@ -17,6 +17,15 @@ export LSAN_OPTIONS="suppressions=$here/lsan.supp:print_suppressions=0"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 
+# The IBL cache: a fresh one per run, so no test depends on (or fills) the
+# user's ~/.cache and the second stage load in a run is still served from it.
+RINGSIDE_CACHE=$(mktemp -d "${TMPDIR:-/tmp}/ringside-cache-XXXXXX")
+export RINGSIDE_CACHE
+trap 'rm -rf "$RINGSIDE_CACHE"' EXIT
+# Diff images of failed golden tests land here.
+export RS_TEST_OUT="$(cd "$build" && pwd)/test-output"
+mkdir -p "$RS_TEST_OUT"
+
 pass=0 fail=0 skip=0 ran=0
 start=$(date +%s)
 for t in "$build"/tests/test_* "$here"/test_*.sh; do

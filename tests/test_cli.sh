@@ -120,6 +120,9 @@ t_installed_layout() {
     env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" shaders --quiet >o.txt 2>&1 || { cat o.txt; return 1; }
     grep -q "0 failed" o.txt || return 1
     env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" smoke --size 32x32 -o i.png 2>/dev/null || return 1
+    # the renderer finds its stage files in the prefix too
+    env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" render "$PWD/prefix/share/ringside/demos/temple.rsr" --ticks 60:62 \
+        --size 64x36 --render-size 128x72 -q -o r.y4m >o.txt 2>&1 || { cat o.txt; return 1; }
 }
 
 t_bench_platform() {

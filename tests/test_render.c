@@ -1,11 +1,19 @@
-/* runtime/render/r_game: the plain renderer on llvmpipe (EGL and OSMesa).
+/* runtime/render/r_game: the renderer core on llvmpipe (EGL and OSMesa).
  *
- * Golden image tests/golden/game_dojo_1200.ppm (320x180, the dojo demo at
- * tick 1200).  Tolerance: a pixel "differs" when any channel is more than
- * 24 off; at most 1% of pixels may differ.  That absorbs rasteriser and
- * float differences between drivers (edges, specular) while a missing
- * fighter, a wrong camera or a broken HUD moves far more than 1%.
- * T_GOLDEN_UPDATE=1 rewrites the golden (look at it before committing). */
+ * Golden images tests/golden/render_<demo>_<tick>.ppm: 320x180, the demo
+ * replay at that tick with its own stage file, the IBL cache off.
+ * Tolerance, both must hold:
+ *   - PSNR over RGB >= 30 dB (a shift of the whole picture by about 8
+ *     levels, or a wrong region of a few percent, fails it);
+ *   - at most 1% of pixels with a channel more than 24 off (absorbs edge
+ *     and specular differences between rasterisers; a missing fighter, a
+ *     wrong camera or shadow moves far more).
+ * On failure a diff image (|a - b| x 4) and the frame drawn are written to
+ * $RS_TEST_OUT (tests/run.sh: BUILD/test-output) or /tmp.
+ * Regenerate after looking at the new pictures:
+ *   T_GOLDEN_UPDATE=1 build/tests/test_render golden_egl
+ * (EGL writes them; OSMesa only compares.) */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,20 +21,23 @@
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
+#include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_img.h"
 #include "t.h"
 
 enum { W = 320, H = 180 };
-#define GOLDEN RS_SOURCE_DIR "/tests/golden/game_dojo_1200.ppm"
 
-static void state_at(uint64_t tick, g_state *prev, g_state *cur)
+static void state_at(const char *demo, uint64_t tick, g_state *prev, g_state *cur)
 {
+    char path[1024];
+    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
     rp_replay rp;
     rs_err e = {0};
-    T_ASSERTF(rp_read(RS_SOURCE_DIR "/demos/dojo.rsr", &rp, &e), "%s", e.msg);
+    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
     T_ASSERT(tick <= rp.ticks);
     g_init(cur, rp.stage, rp.seed);
+    *prev = *cur;
     for (uint64_t t = 0; t < tick; t++) {
         *prev = *cur;
         g_step(cur, &rp.inputs[2 * t], NULL);
@@ -34,33 +45,73 @@ static void state_at(uint64_t tick, g_state *prev, g_state *cur)
     rp_free(&rp);
 }
 
-/* Renders into an RGBA8 + depth FBO and reads back top-down. */
-static void render(const g_state *prev, const g_state *cur, uint8_t *px)
-{
-    rs_err e = {0};
-    r_game *r = r_game_create(&e);
-    T_ASSERTF(r, "%s", e.msg);
+/* An RGBA8 + depth framebuffer of W x H. */
+typedef struct fb {
     GLuint fbo, rb[2];
-    gl.GenFramebuffers(1, &fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
-    gl.GenRenderbuffers(2, rb);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+} fb;
+
+static void fb_make(fb *f)
+{
+    gl.GenFramebuffers(1, &f->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    gl.GenRenderbuffers(2, f->rb);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
     gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
     gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
     T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+static void fb_free(fb *f)
+{
+    gl.DeleteFramebuffers(1, &f->fbo);
+    gl.DeleteRenderbuffers(2, f->rb);
+}
+
+static r_game *game_new(const r_game_opts *o)
+{
+    r_game_opts d = {.hdr_format = -1, .cache_dir = "", .quiet = true};
+    if (o) {
+        d = *o;
+        d.cache_dir = "";
+        d.quiet = true;
+    }
+    rs_err e = {0};
+    r_game *r = r_game_create_opts(&d, &e);
+    T_ASSERTF(r, "%s", e.msg);
+    return r;
+}
+
+/* Draws one frame into f and reads it back top-down (px may be NULL). */
+static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
+{
     rgl_error_reset();
-    r_game_draw(r, prev, cur, 1.0f, W, H);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.ReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
-    rs_flip_rows(px, W, H, 4);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
+    if (px) {
+        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+        gl.ReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        rs_flip_rows(px, W, H, 4);
+    }
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     T_EQ(rgl_error_count(), 0);
     T_EQ(gl.GetError(), GL_NO_ERROR);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    gl.DeleteFramebuffers(1, &fbo);
-    gl.DeleteRenderbuffers(2, rb);
+    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
+}
+
+/* One picture of a demo with its stage file, the way render makes it. */
+static void picture(const char *demo, uint64_t tick, const r_game_opts *o, uint8_t *px)
+{
+    g_state prev, cur;
+    state_at(demo, tick, &prev, &cur);
+    r_game *r = game_new(o);
+    fb f;
+    fb_make(&f);
+    draw(r, &f, &prev, &cur, px);
+    fb_free(&f);
     r_game_destroy(r);
 }
 
@@ -69,48 +120,97 @@ static const uint8_t *at(const uint8_t *px, int x, int y_from_bottom)
     return px + ((size_t)(H - 1 - y_from_bottom) * W + (size_t)x) * 4;
 }
 
-static void golden_on(const char *backend)
+/* ---- golden images ---- */
+
+static void write_ppm_rgb(const char *path, const uint8_t *rgba, int scale, const uint8_t *minus)
 {
-    plat *p = t_context(backend);
-    g_state prev, cur;
-    state_at(1200, &prev, &cur);
-    static uint8_t px[W * H * 4];
-    render(&prev, &cur, px);
-    if (getenv("T_GOLDEN_UPDATE") && !strcmp(backend, "egl")) {
-        rs_err e = {0};
-        T_ASSERTF(rs_pnm_write(GOLDEN, W, H, 4, px, &e), "%s", e.msg);
-    }
-    rs_image g;
+    static uint8_t rgb[W * H * 3];
+    for (int i = 0; i < W * H; i++)
+        for (int c = 0; c < 3; c++) {
+            int v = rgba[4 * i + c];
+            if (minus)
+                v = abs(v - minus[3 * i + c]) * scale;
+            rgb[3 * i + c] = (uint8_t)(v > 255 ? 255 : v);
+        }
     rs_err e = {0};
-    T_ASSERTF(rs_pnm_read(GOLDEN, &g, &e), "%s", e.msg);
+    if (!rs_pnm_write(path, W, H, 3, rgb, &e))
+        fprintf(stderr, "    %s\n", e.msg);
+}
+
+static void golden(const char *backend, const char *demo, uint64_t tick)
+{
+    char path[1024];
+    snprintf(path, sizeof path, RS_SOURCE_DIR "/tests/golden/render_%s_%llu.ppm", demo, (unsigned long long)tick);
+    static uint8_t px[W * H * 4];
+    picture(demo, tick, NULL, px);
+    rs_err e = {0};
+    if (getenv("T_GOLDEN_UPDATE") && !strcmp(backend, "egl"))
+        write_ppm_rgb(path, px, 1, NULL);
+    rs_image g;
+    T_ASSERTF(rs_pnm_read(path, &g, &e), "%s", e.msg);
     T_ASSERT(g.w == W && g.h == H && g.channels == 3);
     int bad = 0;
-    for (int i = 0; i < W * H; i++)
-        for (int c = 0; c < 3; c++)
-            if (abs((int)px[4 * i + c] - (int)g.px[3 * i + c]) > 24) {
-                bad++;
-                break;
-            }
+    double se = 0;
+    for (int i = 0; i < W * H; i++) {
+        bool off = false;
+        for (int c = 0; c < 3; c++) {
+            int d = (int)px[4 * i + c] - (int)g.px[3 * i + c];
+            se += (double)d * d;
+            off |= abs(d) > 24;
+        }
+        bad += off;
+    }
+    double mse = se / (W * H * 3), psnr = mse > 0 ? 10 * log10(255.0 * 255.0 / mse) : 99;
+    bool ok = psnr >= 30 && bad <= W * H / 100;
+    if (!ok) {
+        const char *dir = getenv("RS_TEST_OUT");
+        char out[1200];
+        snprintf(out, sizeof out, "%s/render_%s_%llu_%s_diff.ppm", dir && *dir ? dir : "/tmp", demo,
+                 (unsigned long long)tick, backend);
+        write_ppm_rgb(out, px, 4, g.px);
+        fprintf(stderr, "    diff image: %s\n", out);
+        snprintf(out, sizeof out, "%s/render_%s_%llu_%s.ppm", dir && *dir ? dir : "/tmp", demo,
+                 (unsigned long long)tick, backend);
+        write_ppm_rgb(out, px, 1, NULL);
+        fprintf(stderr, "    drawn: %s\n", out);
+    }
     rs_image_free(&g);
-    T_ASSERTF(bad <= W * H / 100, "%s: %d of %d pixels differ from the golden by more than 24", backend, bad, W * H);
+    T_ASSERTF(ok, "%s %s@%llu: PSNR %.1f dB (want >= 30), %d of %d pixels more than 24 off (want <= %d)", backend,
+              demo, (unsigned long long)tick, psnr, bad, W * H, W * H / 100);
+}
+
+static void t_golden_egl(void)
+{
+    plat *p = t_context("egl");
+    golden("egl", "dojo", 1200);   /* low sun on screen: flare, bloom, shadows */
+    golden("egl", "harbor", 900);  /* night, no sun, no bloom */
+    golden("egl", "temple", 900);  /* high sun, shadows under the fighters */
     plat_destroy(p);
 }
 
-static void t_golden_egl(void) { golden_on("egl"); }
-static void t_golden_osmesa(void) { golden_on("osmesa"); }
+static void t_golden_osmesa(void)
+{
+    plat *p = t_context("osmesa");
+    golden("osmesa", "dojo", 1200);
+    plat_destroy(p);
+}
+
+/* ---- placement, HUD, state ---- */
 
 static void t_fighters_where_the_camera_says(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at(1200, &prev, &cur);
+    state_at("temple", 900, &prev, &cur); /* midday: both fighters in full light */
     static uint8_t px[W * H * 4];
-    render(&prev, &cur, px);
+    r_game *r = game_new(NULL);
+    fb f;
+    fb_make(&f);
+    draw(r, &f, &prev, &cur, px);
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
         g_capsule c[G_BONES];
         g_fighter_capsules(&cur, i, c);
-        /* the middle of the chest capsule */
         r_vec3 chest = r_v3(fx_to_float(c[G_CHEST].ax + c[G_CHEST].bx) / 2, fx_to_float(c[G_CHEST].ay + c[G_CHEST].by) / 2,
                             0.0f);
         float sx, sy;
@@ -119,37 +219,39 @@ static void t_fighters_where_the_camera_says(void)
         int main = i == 0 ? q[0] : q[2], other = i == 0 ? q[2] : q[0];
         T_ASSERTF(main > other + 40, "fighter %d's chest at (%.0f,%.0f) is %u,%u,%u", i + 1, sx, sy, q[0], q[1], q[2]);
     }
+    fb_free(&f);
+    r_game_destroy(r);
     plat_destroy(p);
 }
 
-static void t_hud_shows_health_and_intro(void)
+static int gold_in_band(const uint8_t *px)
 {
-    plat *p = t_context("egl");
-    g_state prev, cur;
-    state_at(30, &prev, &cur); /* intro: "ROUND 1", full health */
-    static uint8_t px[W * H * 4];
-    render(&prev, &cur, px);
-    /* P1's bar spans 5%..41% of the width, 3%..6.2% from the top: full health is bright orange-yellow */
-    const uint8_t *bar = px + ((size_t)(H * 45 / 1000) * W + W / 4) * 4;
-    T_ASSERTF(bar[0] > 200 && bar[1] > 150 && bar[2] < 80, "health bar pixel %u,%u,%u", bar[0], bar[1], bar[2]);
-    /* the announcement band (38%..48% of the height) holds gold text */
     int gold = 0;
     for (int y = H * 38 / 100; y < H * 50 / 100; y++)
         for (int x = 0; x < W; x++) {
             const uint8_t *q = px + ((size_t)y * W + x) * 4;
             gold += q[0] > 230 && q[1] > 180 && q[2] < 90;
         }
+    return gold;
+}
+
+static void t_hud_shows_health_and_intro(void)
+{
+    plat *p = t_context("egl");
+    static uint8_t px[W * H * 4];
+    picture("temple", 30, NULL, px); /* intro: "ROUND 1", full health */
+    /* P1's bar spans 5%..41% of the width, 3%..6.2% from the top: full health is bright orange-yellow */
+    const uint8_t *bar = px + ((size_t)(H * 45 / 1000) * W + W / 4) * 4;
+    T_ASSERTF(bar[0] > 200 && bar[1] > 150 && bar[2] < 80, "health bar pixel %u,%u,%u", bar[0], bar[1], bar[2]);
+    int gold = gold_in_band(px);
     T_ASSERTF(gold > 100, "no announcement text (%d gold pixels)", gold);
-    /* and after the intro, no announcement */
-    state_at(200, &prev, &cur);
-    render(&prev, &cur, px);
-    int gold2 = 0;
-    for (int y = H * 38 / 100; y < H * 50 / 100; y++)
-        for (int x = 0; x < W; x++) {
-            const uint8_t *q = px + ((size_t)y * W + x) * 4;
-            gold2 += q[0] > 230 && q[1] > 180 && q[2] < 90;
-        }
+    picture("temple", 200, NULL, px);
+    int gold2 = gold_in_band(px);
     T_ASSERTF(gold2 < gold / 4, "announcement still shown during the fight (%d)", gold2);
+    /* --no-hud leaves it out */
+    picture("temple", 30, &(r_game_opts){.hdr_format = -1, .no_hud = true}, px);
+    bar = px + ((size_t)(H * 45 / 1000) * W + W / 4) * 4;
+    T_ASSERTF(!(bar[0] > 200 && bar[1] > 150 && bar[2] < 80), "health bar drawn with no_hud");
     plat_destroy(p);
 }
 
@@ -157,16 +259,388 @@ static void t_drawing_leaves_state_alone(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at(900, &prev, &cur);
+    state_at("dojo", 900, &prev, &cur);
     uint64_t h0 = g_hash(&prev), h1 = g_hash(&cur);
-    static uint8_t px[W * H * 4];
-    render(&prev, &cur, px);
+    r_game *r = game_new(NULL);
+    fb f;
+    fb_make(&f);
+    draw(r, &f, &prev, &cur, NULL);
     T_EQ(g_hash(&prev), h0);
     T_EQ(g_hash(&cur), h1);
+    /* and the GL state a caller relies on */
+    GLint v = 0;
+    gl.GetIntegerv(GL_FRAMEBUFFER_BINDING, &v);
+    T_EQ(v, 0);
+    T_EQ(gl.IsEnabled(GL_SCISSOR_TEST), GL_FALSE);
+    T_EQ(gl.IsEnabled(GL_BLEND), GL_FALSE);
+    fb_free(&f);
+    r_game_destroy(r);
+    plat_destroy(p);
+}
+
+/* ---- the pass graph on real stages ---- */
+
+static bool pass_ran(r_game *r, const char *name)
+{
+    r_graph *g = r_game_graph(r);
+    int i = r_graph_find(g, name);
+    T_ASSERTF(i >= 0, "no pass '%s'", name);
+    return (g->last_ran >> i) & 1;
+}
+
+/* Counts the draw calls and framebuffer binds a frame makes. */
+static int n_draws, n_binds;
+static PFNGLDRAWARRAYSPROC real_draw_arrays;
+static PFNGLDRAWELEMENTSPROC real_draw_elements;
+static PFNGLBINDFRAMEBUFFERPROC real_bind_fb;
+static void APIENTRY count_draw_arrays(GLenum m, GLint a, GLsizei n)
+{
+    n_draws++;
+    real_draw_arrays(m, a, n);
+}
+static void APIENTRY count_draw_elements(GLenum m, GLsizei n, GLenum t, const void *i)
+{
+    n_draws++;
+    real_draw_elements(m, n, t, i);
+}
+static void APIENTRY count_bind_fb(GLenum t, GLuint f)
+{
+    n_binds++;
+    real_bind_fb(t, f);
+}
+
+static void counted_frame(r_game *r, fb *f, const g_state *prev, const g_state *cur, int *draws, int *binds)
+{
+    real_draw_arrays = gl.DrawArrays, real_draw_elements = gl.DrawElements, real_bind_fb = gl.BindFramebuffer;
+    gl.DrawArrays = count_draw_arrays, gl.DrawElements = count_draw_elements, gl.BindFramebuffer = count_bind_fb;
+    n_draws = n_binds = 0;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    bool ok = r_game_draw(r, prev, cur, 1.0f, W, H);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DrawArrays = real_draw_arrays, gl.DrawElements = real_draw_elements, gl.BindFramebuffer = real_bind_fb;
+    T_ASSERTF(ok, "%s", r_game_error(r));
+    *draws = n_draws, *binds = n_binds;
+}
+
+static void t_sunless_stage_skips_its_passes(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("dojo", 1200, &prev, &cur);
+    fb f;
+    fb_make(&f);
+    /* dojo: the sun is on screen, everything runs */
+    r_game *r = game_new(NULL);
+    int d_all, b_all, d_less, b_less;
+    counted_frame(r, &f, &prev, &cur, &d_all, &b_all);
+    const char *all[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter", "scene",
+                         "sky", "lens", "bloom_bright", "bloom_blur", "sun_visibility", "tonemap", "hud"};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        T_ASSERTF(pass_ran(r, all[i]), "dojo: '%s' did not run", all[i]);
+    r_game_destroy(r);
+    /* sunless: no sun, no bloom, no shadows (stages/sunless.stage) */
+    r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
+    counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
+    const char *skipped[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter",
+                             "bloom_bright", "bloom_blur", "sun_visibility"};
+    for (size_t i = 0; i < sizeof skipped / sizeof skipped[0]; i++)
+        T_ASSERTF(!pass_ran(r, skipped[i]), "sunless: '%s' ran", skipped[i]);
+    const char *kept[] = {"scene", "sky", "lens", "tonemap", "hud"};
+    for (size_t i = 0; i < sizeof kept / sizeof kept[0]; i++)
+        T_ASSERTF(pass_ran(r, kept[i]), "sunless: '%s' did not run", kept[i]);
+    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "%s", r_graph_error(r_game_graph(r)));
+    /* a skipped pass costs nothing: far fewer draws and binds */
+    fprintf(stderr, "    draws %d -> %d, framebuffer binds %d -> %d\n", d_all, d_less, b_all, b_less);
+    T_ASSERTF(d_less + 10 <= d_all, "draws %d -> %d", d_all, d_less);
+    T_ASSERTF(b_less + 8 <= b_all, "binds %d -> %d", b_all, b_less);
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+/* ---- HDR, mask, lens, shadows ---- */
+
+static float luma(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
+/* The mean HDR luminance in a square of half-size rad round (x, y). */
+static float hdr_mean(const float *hdr, float x, float y, int rad)
+{
+    double s = 0;
+    int n = 0;
+    for (int j = (int)y - rad; j <= (int)y + rad; j++)
+        for (int i = (int)x - rad; i <= (int)x + rad; i++)
+            if (i >= 0 && j >= 0 && i < W && j < H)
+                s += luma(hdr + ((size_t)j * W + i) * 4), n++;
+    return n ? (float)(s / n) : 0;
+}
+
+static void t_mask_output_alpha(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("temple", 900, &prev, &cur);
+    static uint8_t px[W * H * 4];
+    r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .mask = true});
+    fb f;
+    fb_make(&f);
+    draw(r, &f, &prev, &cur, px);
+    r_mat4 vp = r_game_camera(&cur, W, H, NULL);
+    for (int i = 0; i < 2; i++) {
+        g_capsule c[G_BONES];
+        g_fighter_capsules(&cur, i, c);
+        float sx, sy;
+        T_ASSERT(r_project(vp, r_v3(fx_to_float(c[G_CHEST].ax + c[G_CHEST].bx) / 2,
+                                    fx_to_float(c[G_CHEST].ay + c[G_CHEST].by) / 2, 0), W, H, &sx, &sy));
+        T_ASSERTF(at(px, (int)sx, (int)sy)[3] == 255, "fighter %d's chest alpha %u", i + 1, at(px, (int)sx, (int)sy)[3]);
+    }
+    /* sky and floor corners: not fighter */
+    T_EQ(at(px, 2, H - 3)[3], 0);
+    T_EQ(at(px, W - 3, 2)[3], 0);
+    /* no HUD in a cut-out: the health bar area is sky */
+    const uint8_t *bar = px + ((size_t)(H * 45 / 1000) * W + W / 4) * 4;
+    T_ASSERTF(bar[3] == 0, "HUD drawn into the mask (alpha %u)", bar[3]);
+    /* and the fighters cover a plausible share of the frame */
+    int covered = 0;
+    for (int k = 0; k < W * H; k++)
+        covered += px[4 * k + 3] > 127;
+    T_ASSERTF(covered > W * H / 100 && covered < W * H / 4, "%d pixels in the mask", covered);
+    fb_free(&f);
+    r_game_destroy(r);
+    plat_destroy(p);
+}
+
+static void lens_stage(r_stage *st, bool sun)
+{
+    r_stage_defaults(st);
+    snprintf(st->name, sizeof st->name, "lens");
+    memset(st->sky_zenith, 0, sizeof st->sky_zenith), memset(st->sky_horizon, 0, sizeof st->sky_horizon);
+    memset(st->ground, 0, sizeof st->ground);
+    st->key.intensity = 0, st->counter.intensity = 0;
+    st->sun = sun;
+    const float d[3] = {1.0f, 0.1f, -0.6f};
+    float n = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int k = 0; k < 3; k++)
+        st->sun_dir[k] = d[k] / n;
+    st->sun_intensity = 20;
+    st->sun_size_deg = 2;
+    st->bloom = 0, st->flare = false, st->shadows = false;
+}
+
+static bool never(void *u)
+{
+    (void)u;
+    return false;
+}
+
+/* A black world lit by a sun off to the side and a little ahead of the
+ * camera, where the visors (alpha 0.15, part cylinders round the face
+ * side of the head) catch it.  The same frame with the lens pass turned
+ * off says what the lens adds. */
+static void t_low_alpha_lens_shows_the_sun(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("temple", 900, &prev, &cur);
+    fb f;
+    fb_make(&f);
+    r_game *r = game_new(NULL);
+    r_stage st;
+    lens_stage(&st, true);
+    rs_err e = {0};
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    static float with[W * H * 4], without[W * H * 4];
+    int w, h;
+    draw(r, &f, &prev, &cur, NULL);
+    T_ASSERT(pass_ran(r, "lens"));
+    T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h) && w == W && h == H);
+    r_graph *g = r_game_graph(r);
+    int lens = r_graph_find(g, "lens");
+    bool (*was)(void *) = g->pass[lens].needed;
+    g->pass[lens].needed = never;
+    draw(r, &f, &prev, &cur, NULL);
+    g->pass[lens].needed = was;
+    T_ASSERT(!pass_ran(r, "lens"));
+    T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
+    float most = 0;
+    int changed = 0, where = 0;
+    for (int k = 0; k < W * H; k++) {
+        float d = luma(with + 4 * (size_t)k) - luma(without + 4 * (size_t)k);
+        changed += d != 0;
+        if (d > most)
+            most = d, where = k;
+    }
+    fprintf(stderr, "    the lens adds up to %.1f (at %d,%d) over %d pixels; sun irradiance %.0f\n", most, where % W,
+            where / W, changed, st.sun_intensity);
+    /* the reflection of a sun of irradiance E in a specular-128 lobe peaks
+     * near 20 E x Fresnel (>= 0.3); scaled by the alpha it would stay
+     * under about 0.15 x 70 = 10 here */
+    T_ASSERTF(changed > 0 && changed < W * H / 50, "the lens covers %d pixels", changed);
+    T_ASSERTF(most > 1.5f * st.sun_intensity, "the lens shows no HDR reflection: it adds at most %.2f", most);
+    /* the mask (alpha) is the fighters', the lens leaves it alone */
+    for (int k = 0; k < W * H; k++)
+        T_ASSERTF(with[4 * (size_t)k + 3] == without[4 * (size_t)k + 3], "the lens changed alpha at %d,%d", k % W, k / W);
+    /* no sun: nothing there (the reflection came from the sun) */
+    lens_stage(&st, false);
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    draw(r, &f, &prev, &cur, NULL);
+    T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
+    float mx = 0;
+    for (int k = 0; k < W * H; k++)
+        mx = fmaxf(mx, luma(with + 4 * (size_t)k));
+    T_ASSERTF(mx < 0.01f, "a black world without a sun has HDR %.3f somewhere", mx);
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+static void t_shadows_darken_the_floor(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("temple", 900, &prev, &cur);
+    fb f;
+    fb_make(&f);
+    r_game *r = game_new(NULL);
+    rs_err e = {0};
+    T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
+    r_stage st = *r_game_stage(r);
+    T_ASSERT(st.shadows && st.sun);
+    static float with[W * H * 4], without[W * H * 4];
+    int w, h;
+    draw(r, &f, &prev, &cur, NULL);
+    T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
+    /* the fighters shade themselves too: the mask has dark texels */
+    static float mask[W * H * 4];
+    T_ASSERT(r_game_read_buffer(r, "mask", mask, &w, &h));
+    int dark = 0;
+    for (int k = 0; k < W * H; k++)
+        dark += mask[4 * k] < 0.5f;
+    T_ASSERTF(dark > 20, "SSFSM mask: only %d shadowed pixels", dark);
+    T_ASSERTF(mask[0] == 1.0f && mask[4 * (W * H - 1)] == 1.0f, "mask corners %.3f %.3f", mask[0], mask[4 * (W * H - 1)]);
+    st.shadows = false;
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    draw(r, &f, &prev, &cur, NULL);
+    T_ASSERT(!pass_ran(r, "silhouette") && !pass_ran(r, "shadow_mask"));
+    T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
+    /* the floor where each waist's shadow falls (the waist projected along the sun) */
+    r_mat4 vp = r_game_camera(&cur, W, H, NULL);
+    for (int i = 0; i < 2; i++) {
+        g_capsule c[G_BONES];
+        g_fighter_capsules(&cur, i, c);
+        fx wx, wy;
+        g_skel_waist(c, &wx, &wy);
+        float t = fx_to_float(wy) / st.sun_dir[1];
+        r_vec3 q = r_v3(fx_to_float(wx) - st.sun_dir[0] * t, 0, -st.sun_dir[2] * t);
+        float sx, sy;
+        T_ASSERT(r_project(vp, q, W, H, &sx, &sy));
+        float a = hdr_mean(with, sx, sy, 1), b = hdr_mean(without, sx, sy, 1);
+        fprintf(stderr, "    floor in fighter %d's shadow: %.3f with shadows, %.3f without\n", i + 1, a, b);
+        T_ASSERTF(a < 0.8f * b, "fighter %d's shadow does not darken the floor: %.3f vs %.3f", i + 1, a, b);
+    }
+    /* far from the fighters nothing changes */
+    float c0 = hdr_mean(with, 6, 6, 3), c1 = hdr_mean(without, 6, 6, 3);
+    T_ASSERTF(fabsf(c0 - c1) <= 0.01f * c1 + 1e-4f, "a far corner changed: %.4f vs %.4f", c0, c1);
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+/* ---- stress: nothing in any buffer is NaN or Inf ---- */
+
+static void check_finite(r_game *r, const char *what)
+{
+    static float buf[512 * 512 * 4];
+    const char *names[] = {"hdr", "bloom", "mask", "silhouette", "silhouette1", "silhouette2", "silhouette3", "silhouette4"};
+    for (size_t n = 0; n < sizeof names / sizeof names[0]; n++) {
+        int w = 0, h = 0;
+        T_ASSERT(r_game_read_buffer(r, names[n], NULL, &w, &h));
+        T_ASSERT((size_t)w * h * 4 <= sizeof buf / sizeof buf[0]);
+        T_ASSERT(r_game_read_buffer(r, names[n], buf, &w, &h));
+        for (size_t k = 0; k < (size_t)w * h * 4; k++)
+            T_ASSERTF(isfinite(buf[k]) && fabsf(buf[k]) <= R_HALF_MAX, "%s: %s[%zu] = %g", what, names[n], k, buf[k]);
+    }
+}
+
+static void t_stress_no_nan_or_inf(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("dojo", 1200, &prev, &cur); /* the sun on screen */
+    fb f;
+    fb_make(&f);
+    r_game *r = game_new(NULL);
+    rs_err e = {0};
+    T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
+    const r_stage base = *r_game_stage(r);
+    static uint8_t px[W * H * 4];
+    struct {
+        const char *what;
+        float sun, sky, gamma, sat, exposure, bloom;
+        int expect; /* 0: mostly black, 1: mostly white, -1: anything */
+    } cases[] = {
+        {"sun 65504", 65504, -1, 2.2f, 1, 1, 0.35f, -1},
+        {"sun 0", 0, -1, 2.2f, 1, 1, 0.35f, -1},
+        {"black world", 0, 0, 2.2f, 1, 1, 0.35f, 0},
+        {"white world 65504", 65504, 65504, 2.2f, 1, 1, 10, 1},
+        {"gamma 0.1", -1, -1, 0.1f, 1, 1, 0.35f, -1},
+        {"gamma 10", -1, -1, 10, 1, 1, 0.35f, -1},
+        {"saturation 0", -1, -1, 2.2f, 0, 1, 0.35f, -1},
+        {"saturation 10", -1, -1, 2.2f, 10, 1, 0.35f, -1},
+        {"exposure 1000", -1, -1, 2.2f, 1, 1000, 0.35f, 1},
+        {"exposure 0.001", -1, -1, 2.2f, 1, 0.001f, 0.35f, 0},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        r_stage st = base;
+        if (cases[k].sun >= 0)
+            st.sun_intensity = cases[k].sun;
+        if (cases[k].sky >= 0) {
+            for (int c = 0; c < 3; c++)
+                st.sky_zenith[c] = st.sky_horizon[c] = st.ground[c] = cases[k].sky;
+            st.key.intensity = st.counter.intensity = cases[k].sky;
+        }
+        st.gamma = cases[k].gamma, st.saturation = cases[k].sat, st.exposure = cases[k].exposure;
+        st.bloom = cases[k].bloom;
+        T_ASSERTF(r_game_set_stage(r, &st, &e), "%s: %s", cases[k].what, e.msg);
+        draw(r, &f, &prev, &cur, px);
+        check_finite(r, cases[k].what);
+        if (cases[k].expect >= 0) {
+            /* the middle band (no HUD): the picture must be what the light says */
+            long sum = 0;
+            int n = 0;
+            for (int y = H / 3; y < 2 * H / 3; y++)
+                for (int x = 0; x < W; x++, n++)
+                    sum += at(px, x, y)[0] + at(px, x, y)[1] + at(px, x, y)[2];
+            double mean = (double)sum / (3.0 * n);
+            T_ASSERTF(cases[k].expect ? mean > 150 : mean < 8, "%s: mean level %.1f", cases[k].what, mean);
+        }
+    }
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+/* The 11:11:10 packed float HDR format draws too (no alpha: no mask). */
+static void t_packed_float_hdr(void)
+{
+    plat *p = t_context("egl");
+    static uint8_t a[W * H * 4], b[W * H * 4];
+    picture("temple", 900, NULL, a);
+    picture("temple", 900, &(r_game_opts){.hdr_format = R_HDR_R11G11B10F}, b);
+    double se = 0;
+    for (int i = 0; i < W * H * 4; i += 4)
+        for (int c = 0; c < 3; c++)
+            se += (double)(a[i + c] - b[i + c]) * (a[i + c] - b[i + c]);
+    double psnr = se > 0 ? 10 * log10(255.0 * 255.0 / (se / (W * H * 3))) : 99;
+    fprintf(stderr, "    r11g11b10f vs rgba16f: PSNR %.1f dB\n", psnr);
+    T_ASSERTF(psnr > 35, "packed float differs too much from half float: %.1f dB", psnr);
     plat_destroy(p);
 }
 
 T_MAIN({"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"fighters_where_the_camera_says", t_fighters_where_the_camera_says},
        {"hud_shows_health_and_intro", t_hud_shows_health_and_intro},
-       {"drawing_leaves_state_alone", t_drawing_leaves_state_alone})
+       {"drawing_leaves_state_alone", t_drawing_leaves_state_alone},
+       {"sunless_stage_skips_its_passes", t_sunless_stage_skips_its_passes},
+       {"mask_output_alpha", t_mask_output_alpha}, {"low_alpha_lens_shows_the_sun", t_low_alpha_lens_shows_the_sun},
+       {"shadows_darken_the_floor", t_shadows_darken_the_floor}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
+       {"packed_float_hdr", t_packed_float_hdr})

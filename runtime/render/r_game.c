@@ -263,8 +263,14 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
     r_ibl_default_params(&ip);
     r_ibl ibl = {0};
     const char *cache = r->opts.cache_dir ? r->opts.cache_dir : r_ibl_cache_dir();
-    if (!r_ibl_build(st, &ip, cache, &ibl, err))
+    if (!r_ibl_build(st, &ip, cache, &ibl, err)) {
+        if (st->env_path[0]) { /* say which stage asked for the file */
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "stage '%s': environment: %s", st->name, err->msg);
+            snprintf(err->msg, sizeof err->msg, "%s", msg);
+        }
         return false;
+    }
     if (!r->opts.quiet && !ibl.from_cache && ibl.ms > 500)
         fprintf(stderr, "ringside: %s: prefiltered the environment in %.1f s (cached for next time)\n", st->name,
                 ibl.ms / 1000);
@@ -1367,8 +1373,10 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
         tex = r->b4_tex[0], tw = half(r->tw, 2), th = half(r->th, 2);
     else if (!strcmp(name, "mask"))
         tex = r->mask_tex[r->mask_final];
-    else if (!strcmp(name, "silhouette"))
-        tex = r->sil_tex, tw = SIL_SIZE, th = SIL_SIZE;
+    else if (!strncmp(name, "silhouette", 10) && (!name[10] || (name[10] >= '1' && name[10] < '0' + SIL_LEVELS && !name[11]))) {
+        level = name[10] ? name[10] - '0' : 0; /* "silhouette2": blurred level 2 */
+        tex = r->sil_tex, tw = SIL_SIZE >> level, th = SIL_SIZE >> level;
+    }
     if (!tex)
         return false;
     if (w)

@@ -1,0 +1,95 @@
+#!/bin/sh
+# End-to-end: the renderer's options through the real binary (--passes,
+# --ticks, --stage-file, --mask, --hdr-format) and their errors.
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/lib.sh"
+SRC=$(cd "$here/.." && pwd)
+SIZES="--render-size 320x180 --size 160x90"
+
+short_replay() { # 300 ticks on the dojo
+    "$RS_BIN" record --ai --quiet --seconds 5 --seed 21 -o short.rsr 2>/dev/null
+}
+
+t_passes_summary_and_frames() {
+    short_replay || return 1
+    "$RS_BIN" render short.rsr --ticks 100:110 $SIZES -q --passes -o a.y4m 2>p.txt || { cat p.txt; return 1; }
+    for pass in shadow_map silhouette_mips shadow_mask mask_filter scene sky lens bloom_blur sun_visibility tonemap hud total; do
+        grep -q "^$pass " p.txt || { echo "no '$pass' row"; cat p.txt; return 1; }
+    done
+    grep -q "passes (stage dojo, 320x180, 10 frames" p.txt || { cat p.txt; return 1; }
+    # dojo's sun is on screen: every pass ran all 10 frames
+    awk '$1 == "scene" && ($2 != 10 || $3 != 0) { exit 1 }' p.txt || { cat p.txt; return 1; }
+    # per frame
+    "$RS_BIN" render short.rsr --ticks 100:104 $SIZES -q --passes=frames -o b.y4m 2>f.txt || { cat f.txt; return 1; }
+    [ "$(grep -c '^frame [0-9]*: shadow_map ' f.txt)" = 4 ] || { cat f.txt; return 1; }
+    # the sunless look skips its passes, every frame, and says so
+    "$RS_BIN" render short.rsr --ticks 100:104 $SIZES -q --passes=frames --stage-file "$SRC/stages/sunless.stage" \
+        -o c.y4m 2>s.txt || { cat s.txt; return 1; }
+    [ "$(grep -c 'skipped: shadow_map silhouette silhouette_mips z_prepass shadow_mask mask_filter bloom_bright bloom_blur sun_visibility$' s.txt)" = 4 ] ||
+        { cat s.txt; return 1; }
+    awk '$1 == "shadow_map" && ($2 != 0 || $3 != 4) { exit 1 }' s.txt || { cat s.txt; return 1; }
+    expect_fail 2 "--passes='often': expected summary or frames" "$RS_BIN" render short.rsr --passes=often -o d.y4m
+}
+
+t_ticks_match_a_full_render() {
+    short_replay || return 1
+    "$RS_BIN" render short.rsr $SIZES -q --hashes all.txt -o all.y4m || return 1
+    "$RS_BIN" render short.rsr $SIZES -q --ticks 200:205 --hashes part.txt -o part.y4m || return 1
+    [ "$(wc -l <part.txt)" = 5 ] || { cat part.txt; return 1; }
+    # the same pictures as frames 200..204 of the whole replay
+    [ "$(sed -n '201,205p' all.txt | cut -d' ' -f2)" = "$(cut -d' ' -f2 part.txt)" ] ||
+        { echo "--ticks frames differ from the full render"; return 1; }
+}
+
+t_ticks_errors() {
+    short_replay || return 1
+    expect_fail 2 "--ticks '5:3': the end must be after the start" "$RS_BIN" render short.rsr --ticks 5:3 -o x.y4m || return 1
+    expect_fail 2 "--ticks '7': expected A:B" "$RS_BIN" render short.rsr --ticks 7 -o x.y4m || return 1
+    expect_fail 2 "--ticks start" "$RS_BIN" render short.rsr --ticks x:9 -o x.y4m || return 1
+    expect_fail 1 "short.rsr: --ticks 10:301 is past the replay's end \(300 ticks\)" \
+        "$RS_BIN" render short.rsr --ticks 10:301 -o x.y4m || return 1
+    [ ! -e x.y4m ] || { echo "output written on error"; return 1; }
+}
+
+t_bad_stage_files() {
+    short_replay || return 1
+    printf 'name = bad\ngame = dojo\nsunn = yes\n' >bad.stage
+    expect_fail 1 "bad.stage:3: unknown key 'sunn' \(did you mean 'sun'\?\)" \
+        "$RS_BIN" render short.rsr --stage-file bad.stage $SIZES -o x.y4m || return 1
+    printf 'name = bad\ngame = dojo\n\nbloom = lots\n' >bad.stage
+    expect_fail 1 "bad.stage:4: bloom: expected a number" "$RS_BIN" render short.rsr --stage-file bad.stage $SIZES -o x.y4m || return 1
+    printf 'name = bad\ngame = dojo\nenvironment = nothere.hdr\n' >bad.stage
+    expect_fail 1 "stage 'bad': environment: .*nothere.hdr: cannot open" \
+        "$RS_BIN" render short.rsr --stage-file bad.stage $SIZES -o x.y4m || return 1
+    expect_fail 1 "nope.stage: cannot open" "$RS_BIN" render short.rsr --stage-file nope.stage $SIZES -o x.y4m || return 1
+    [ ! -e x.y4m ] && [ ! -e x.y4m.part ] || { echo "output written on error"; return 1; }
+    # a file that was there before a failed render is left alone
+    echo keep >x.y4m
+    "$RS_BIN" render short.rsr --stage-file bad.stage $SIZES -o x.y4m 2>/dev/null && return 1
+    [ "$(cat x.y4m)" = keep ] || { echo "existing output clobbered"; return 1; }
+}
+
+t_mask_cutouts() {
+    short_replay || return 1
+    "$RS_BIN" render short.rsr --ticks 200:202 --mask $SIZES -q -o cut/f%02d.png || return 1
+    [ -s cut/f00.png ] && [ -s cut/f01.png ] || { ls cut; return 1; }
+    fmt=$(ffprobe -v error -show_entries stream=pix_fmt -of default=nw=1:nk=1 cut/f00.png)
+    [ "$fmt" = rgba ] || { echo "pix_fmt $fmt, want rgba"; return 1; }
+    expect_fail 2 "--mask writes RGBA images" "$RS_BIN" render short.rsr --mask -o m.y4m || return 1
+    expect_fail 1 "--mask needs an alpha channel" "$RS_BIN" render short.rsr --mask --hdr-format r11g11b10f -o m/f%02d.png || return 1
+    expect_fail 2 "hdr" "$RS_BIN" render short.rsr --hdr-format rgb9e5 -o m.y4m
+}
+
+t_help_lists_the_options() {
+    "$RS_BIN" render --help >h.txt || return 1
+    for o in --stage-file --passes --mask --no-hud --hdr-format --ticks; do
+        grep -q -- "$o" h.txt || { echo "render --help lacks $o"; return 1; }
+    done
+    "$RS_BIN" play --help >h.txt || return 1
+    for o in --stage-file --passes --hdr-format; do
+        grep -q -- "$o" h.txt || { echo "play --help lacks $o"; return 1; }
+    done
+}
+
+t_run passes_summary_and_frames ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
+t_done
