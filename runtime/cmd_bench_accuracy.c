@@ -1,13 +1,17 @@
-/* ringside bench accuracy: run time against error for the downscale
- * filters, measured against OpenImageIO's resize (lanczos3 when
- * downsizing) of the same full-size frames, plus the error of the
- * RGB -> YCbCr 4:2:0 conversion. */
+/* ringside bench accuracy: run time against error
+ *   - the downscale filters, against OpenImageIO's resize (lanczos3 when
+ *     downsizing) of the same full-size frames, plus the error of the
+ *     RGB -> YCbCr 4:2:0 conversion;
+ *   - the IBL prefilter: integration resolution against a brute-force
+ *     integration over a fine cube;
+ *   - the tone-curve table: size against the analytic curve. */
 #include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "../capture/cap.h"
 #include "../capture/cap_oiio.h"
@@ -16,6 +20,9 @@
 #include "gl/rgl.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_ibl.h"
+#include "render/r_stage.h"
+#include "render/r_tone.h"
 #include "render/r_target.h"
 #include "replay/rp.h"
 #include "util/rs_file.h"
@@ -49,26 +56,192 @@ static void i420_to_rgba(const uint8_t *yuv, int w, int h, float *rgba)
         }
 }
 
+/* Stratified sample texels of one map: k x k per face. */
+#define IBL_SAMPLES_PER_EDGE 4
+
+/* IBL prefilter accuracy: each source size against r_ibl_eval over a
+ * reference cube of ref_size texels per face edge (every texel of it is an
+ * integration direction: brute force), at 6 * 4 * 4 texels of each map,
+ * key light on.  Error per sample: the largest channel difference over
+ * the reference luminance. */
+static bool ibl_table(const r_stage *st, const int *sizes, int nsizes, int ref_size, FILE *cf, rs_err *err)
+{
+    r_env ref_env = {0};
+    if (!r_env_build(st, ref_size, &ref_env, err))
+        return false;
+    float key[3];
+    r_ibl_key_dir(st, &ref_env, key);
+    r_ibl_params dp;
+    r_ibl_default_params(&dp);
+    /* the reference, once: per map, per sample texel */
+    enum { NS = 6 * IBL_SAMPLES_PER_EDGE * IBL_SAMPLES_PER_EDGE };
+    static double ref[R_IBL_MAPS][NS][3];
+    static int sf[R_IBL_MAPS][NS], si[R_IBL_MAPS][NS], sj[R_IBL_MAPS][NS];
+    double t0 = rs_now();
+    for (int m = 0; m < R_IBL_MAPS; m++) {
+        int n = dp.out_size[m], k = 0;
+        for (int f = 0; f < 6; f++)
+            for (int a = 0; a < IBL_SAMPLES_PER_EDGE; a++)
+                for (int b = 0; b < IBL_SAMPLES_PER_EDGE; b++, k++) {
+                    sf[m][k] = f;
+                    si[m][k] = (2 * b + 1) * n / (2 * IBL_SAMPLES_PER_EDGE);
+                    sj[m][k] = (2 * a + 1) * n / (2 * IBL_SAMPLES_PER_EDGE);
+                    float d[3];
+                    r_cube_dir(f, si[m][k], sj[m][k], n, d);
+                    r_ibl_eval(st, &ref_env, key, m, R_IBL_KEY_ON, d, ref[m][k]);
+                }
+    }
+    double ref_s = rs_now() - t0;
+    long threads = dp.threads ? dp.threads : sysconf(_SC_NPROCESSORS_ONLN);
+    threads = threads < 1 ? 1 : threads > 8 ? 8 : threads; /* what r_ibl_build uses */
+    r_env_free(&ref_env);
+    printf("\nIBL prefilter (stage %s): source cube size vs a brute-force integration over a %d-per-edge cube\n"
+           "(%d directions per output texel, %d sample texels per map, %.1f s); relative error = largest channel\n"
+           "difference / reference luminance; ms for the whole set of six maps (%ld threads)\n",
+           st->name, ref_size, 6 * ref_size * ref_size, NS, ref_s, threads);
+    printf("%8s %10s %22s %22s %22s\n", "src", "ms/set", "diffuse rms / max", "spec16 rms / max", "spec128 rms / max");
+    for (int z = 0; z < nsizes; z++) {
+        r_ibl_params p = dp;
+        p.src_size = sizes[z];
+        r_ibl ibl = {0};
+        if (!r_ibl_build(st, &p, NULL, &ibl, err))
+            return false;
+        printf("%8d %10.1f", sizes[z], ibl.ms);
+        if (cf)
+            fprintf(cf, "%d,%.3f", sizes[z], ibl.ms);
+        for (int m = 0; m < R_IBL_MAPS; m++) {
+            double se = 0, worst = 0;
+            for (int k = 0; k < NS; k++) {
+                const float *v = ibl.map[m][R_IBL_KEY_ON][sf[m][k]] + ((size_t)sj[m][k] * ibl.size[m] + si[m][k]) * 3;
+                const double *r = ref[m][k];
+                double lum = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2], d = 0;
+                for (int c = 0; c < 3; c++)
+                    d = fmax(d, fabs(v[c] - r[c]));
+                double rel = d / fmax(lum, 1e-6);
+                se += rel * rel;
+                worst = fmax(worst, rel);
+            }
+            printf("      %7.4f / %7.4f", sqrt(se / NS), worst);
+            if (cf)
+                fprintf(cf, ",%.6f,%.6f", sqrt(se / NS), worst);
+        }
+        printf("%s\n", sizes[z] == dp.src_size ? "   <- default" : "");
+        if (cf)
+            fprintf(cf, "\n");
+        r_ibl_free(&ibl);
+    }
+    return true;
+}
+
+/* Tone LUT: size against the analytic curve, in 8-bit output steps. */
+static void tone_table(FILE *cf)
+{
+    static const int sizes[] = {16, 32, 64, 128, 256, 512, 1024, 4096};
+    static const double gammas[] = {1.0, 2.2, 3.0, 10.0};
+    printf("\nTone curve table (Y' = ((1 - exp(-x^2))^1.5)^(1/gamma)): size vs max |table - curve| in 8-bit\n"
+           "output steps, x in 0..%.0f; exact interpolation (what the shader does) and with 8-bit weights\n"
+           "(what a texture unit's linear filter would do); the goal is < 0.1 step at the default size\n",
+           1.25 * R_TONE_X_MAX);
+    printf("%8s", "entries");
+    for (size_t g = 0; g < sizeof gammas / sizeof gammas[0]; g++)
+        printf("   gamma %-4.1f", gammas[g]);
+    printf("   2.2, 8-bit w\n");
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        printf("%8d", sizes[k]);
+        if (cf)
+            fprintf(cf, "%d", sizes[k]);
+        for (size_t g = 0; g < sizeof gammas / sizeof gammas[0]; g++) {
+            double e = r_tone_max_error(sizes[k], gammas[g], 0) * 255;
+            printf("   %10.4f", e);
+            if (cf)
+                fprintf(cf, ",%.6f", e);
+        }
+        double e8 = r_tone_max_error(sizes[k], 2.2, 8) * 255;
+        printf("   %10.4f%s\n", e8, sizes[k] == R_TONE_LUT_DEFAULT ? "   <- default" : "");
+        if (cf)
+            fprintf(cf, ",%.6f\n", e8);
+    }
+}
+
+/* "8,16,32" -> sizes; false on anything else */
+static bool parse_sizes(const char *s, int *out, int *n, int max_n)
+{
+    *n = 0;
+    while (*s) {
+        char *end;
+        long v = strtol(s, &end, 10);
+        if (end == s || v < 1 || v > 512 || *n >= max_n || (*end && *end != ','))
+            return false;
+        out[(*n)++] = (int)v;
+        s = *end ? end + 1 : end;
+    }
+    return *n > 0;
+}
+
 static void help(void)
 {
-    printf("usage: ringside bench accuracy [--frames N] [--size WxH] [--render-size WxH] [--csv FILE]\n\n"
-           "Downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
-           "nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
-           "with OpenImageIO's resize of the same full-size frame (its lanczos3): PSNR in dB\n"
-           "over RGB and milliseconds per frame (glFinish-timed, 20 repetitions).  Also\n"
-           "reports what the RGB -> YCbCr 4:2:0 conversion loses.\n\n"
-           "  --frames N   frames from tick 600 on, 60 ticks apart (default 8)\n"
-           "  --csv FILE   also write the table (default out/bench-accuracy.csv)\n");
+    printf("usage: ringside bench accuracy [--only capture|ibl|tone] [--frames N] [--size WxH]\n"
+           "                               [--render-size WxH] [--ibl-sizes LIST] [--ibl-reference N]\n"
+           "                               [--stage NAME] [--csv FILE]\n\n"
+           "Run time against error, three tables:\n"
+           "  capture  downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
+           "           nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
+           "           with OpenImageIO's resize of the same full-size frame (its lanczos3): PSNR in\n"
+           "           dB over RGB and ms per frame (glFinish-timed, 20 repetitions); also what the\n"
+           "           RGB -> YCbCr 4:2:0 conversion loses.\n"
+           "  ibl      prefilters the stage's environment from cubes of each --ibl-sizes edge and\n"
+           "           compares the six maps' texels with a brute-force integration over a\n"
+           "           --ibl-reference cube: RMS and max relative error, ms per set of maps.\n"
+           "  tone     the tone-curve table's size against the analytic curve, in 8-bit steps.\n\n"
+           "  --only T            one table (default: all three)\n"
+           "  --frames N          capture: frames from tick 600 on, 60 ticks apart (default 8)\n"
+           "  --ibl-sizes LIST    source cube edges, comma-separated (default 8,16,32,64)\n"
+           "  --ibl-reference N   the reference cube's edge (default 128)\n"
+           "  --stage NAME        the stage whose environment the IBL table uses (default dojo)\n"
+           "  --csv FILE          also write the tables (default out/bench-accuracy.csv; the IBL\n"
+           "                      and tone tables go to FILE's name with -ibl and -tone added)\n");
 }
+
+/* out/x.csv + "-ibl" -> out/x-ibl.csv */
+static void csv_name(const char *csv, const char *suffix, char *out, size_t n)
+{
+    const char *dot = strrchr(csv, '.'), *slash = strrchr(csv, '/');
+    if (!dot || (slash && dot < slash))
+        dot = csv + strlen(csv);
+    snprintf(out, n, "%.*s%s%s", (int)(dot - csv), csv, suffix, dot);
+}
+
+static FILE *csv_open(const char *path, const char *header, rs_err *err)
+{
+    FILE *f = rs_mkdirs_for(path, err) ? fopen(path, "w") : NULL;
+    if (!f) {
+        rs_fail(err, 1, "%s: cannot create", path);
+        return NULL;
+    }
+    fprintf(f, "%s\n", header);
+    return f;
+}
+
+static bool csv_close(FILE *f, const char *path, rs_err *err)
+{
+    if (f && fclose(f) != 0)
+        return rs_fail(err, 1, "%s: write failed", path);
+    return true;
+}
+
+static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, const char *csv);
 
 int bench_accuracy(int argc, char **argv)
 {
     static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
                                          {"render-size", required_argument, 0, 'r'}, {"csv", required_argument, 0, 'c'},
+                                         {"only", required_argument, 0, 'o'}, {"ibl-sizes", required_argument, 0, 'I'},
+                                         {"ibl-reference", required_argument, 0, 'R'}, {"stage", required_argument, 0, 'S'},
                                          {"help", no_argument, 0, 'h'},         {0}};
-    int frames = 8, sw = 1280, sh = 720, w = 640, h = 360, c;
+    int frames = 8, sw = 1280, sh = 720, w = 640, h = 360, c, ref_size = 128;
+    int sizes[16] = {8, 16, 32, 64}, nsizes = 4;
     long v;
-    const char *csv = "out/bench-accuracy.csv";
+    const char *csv = "out/bench-accuracy.csv", *only = NULL, *stage = "dojo";
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
@@ -77,17 +250,78 @@ int bench_accuracy(int argc, char **argv)
         case 's': if (!cli_size("--size", optarg, 8192, &w, &h)) return RS_EXIT_USAGE; break;
         case 'r': if (!cli_size("--render-size", optarg, 8192, &sw, &sh)) return RS_EXIT_USAGE; break;
         case 'c': csv = optarg; break;
+        case 'o':
+            if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone")) {
+                cli_error("bench", "--only '%s': expected capture, ibl or tone", optarg);
+                return RS_EXIT_USAGE;
+            }
+            only = optarg;
+            break;
+        case 'I':
+            if (!parse_sizes(optarg, sizes, &nsizes, 16)) {
+                cli_error("bench", "--ibl-sizes '%s': expected up to 16 comma-separated edges in 1..512", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case 'R': if (!cli_int("--ibl-reference", optarg, 4, 512, &v)) return RS_EXIT_USAGE; ref_size = (int)v; break;
+        case 'S': stage = optarg; break;
         case 'h': help(); return RS_EXIT_OK;
         default:
             cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
             return cli_usage_error("bench");
         }
     }
+    if (optind < argc) {
+        cli_error("bench", "unexpected argument '%s'", argv[optind]);
+        return cli_usage_error("bench");
+    }
     rs_err err = {0};
-    if (!cap_check_sizes(sw, sh, w, h, &err)) {
+    if ((!only || !strcmp(only, "capture")) && !cap_check_sizes(sw, sh, w, h, &err)) {
         cli_error("bench", "%s", err.msg);
         return RS_EXIT_USAGE;
     }
+    if (!only || !strcmp(only, "capture")) {
+        int st = bench_capture_accuracy(frames, sw, sh, w, h, csv);
+        if (st != RS_EXIT_OK)
+            return st;
+    }
+    char path[1200];
+    FILE *cf = NULL;
+    if (!only || !strcmp(only, "ibl")) {
+        int gi = 0;
+        r_stage st;
+        if (!cli_stage(stage, &gi))
+            return RS_EXIT_USAGE;
+        csv_name(csv, "-ibl", path, sizeof path);
+        bool ok = r_stage_for_game(&st, gi, &err) &&
+                  (!*csv || (cf = csv_open(path, "src_size,ms_per_set,diffuse_rms,diffuse_max,spec16_rms,spec16_max,"
+                                                 "spec128_rms,spec128_max", &err)));
+        ok = ok && ibl_table(&st, sizes, nsizes, ref_size, cf, &err);
+        ok = csv_close(cf, path, &err) && ok;
+        cf = NULL;
+        if (!ok) {
+            cli_error("bench", "%s", err.msg);
+            return RS_EXIT_FAIL;
+        }
+    }
+    if (!only || !strcmp(only, "tone")) {
+        csv_name(csv, "-tone", path, sizeof path);
+        if (*csv && !(cf = csv_open(path, "entries,gamma_1,gamma_2.2,gamma_3,gamma_10,gamma_2.2_8bit_weights", &err))) {
+            cli_error("bench", "%s", err.msg);
+            return RS_EXIT_FAIL;
+        }
+        tone_table(cf);
+        if (!csv_close(cf, path, &err)) {
+            cli_error("bench", "%s", err.msg);
+            return RS_EXIT_FAIL;
+        }
+    }
+    return RS_EXIT_OK;
+}
+
+static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, const char *csv)
+{
+    rs_err err = {0};
     int status = RS_EXIT_FAIL;
     rp_replay rp = {0};
     plat *p = NULL;

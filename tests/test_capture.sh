@@ -134,7 +134,8 @@ t_filters() {
 }
 
 t_bench_accuracy_small() {
-    "$RS_BIN" bench accuracy --frames 1 --render-size 320x180 --size 160x90 --csv a.csv >a.txt 2>&1 ||
+    "$RS_BIN" bench accuracy --frames 1 --render-size 320x180 --size 160x90 --ibl-sizes 4,8,16 --ibl-reference 32 \
+        --csv a.csv >a.txt 2>&1 ||
         { grep -q "no OpenImageIO" a.txt && t_skip_case "no OpenImageIO in this build"; cat a.txt; return 1; }
     for f in box bilinear nearest lanczos3 "cpu box"; do
         grep -Eq "^$f +[0-9]+\.[0-9]+ +[0-9]+\.[0-9]+" a.txt || { echo "no row $f"; cat a.txt; return 1; }
@@ -144,6 +145,13 @@ t_bench_accuracy_small() {
     awk -v l="$l" -v b="$b" -v n="$n" 'BEGIN { exit !(l > b && b > n && n > 20) }' || { cat a.txt; return 1; }
     grep -q "RGB -> YCbCr 4:2:0" a.txt || return 1
     [ "$(wc -l <a.csv)" = 7 ] || { cat a.csv; return 1; }
+    # IBL: the error falls as the source cube grows, for every map (rms and max)
+    [ "$(wc -l <a-ibl.csv)" = 4 ] || { cat a-ibl.csv; return 1; }
+    awk -F, 'NR > 1 { for (i = 3; i <= 8; i++) { if (NR > 2 && $i >= prev[i]) exit 1; prev[i] = $i } }' a-ibl.csv ||
+        { echo "IBL error does not fall with the source size"; cat a-ibl.csv; return 1; }
+    # tone: the default table (256) meets the goal at gamma 2.2, 16 entries do not
+    awk -F, '$1 == 256 && $3 >= 0.1 { exit 1 } $1 == 16 && $3 < 0.1 { exit 1 }' a-tone.csv || { cat a-tone.csv; return 1; }
+    grep -q "256 .*<- default" a.txt || { cat a.txt; return 1; }
 }
 
 t_image_sequences() {
