@@ -24,53 +24,6 @@ static void help(void)
            "  --quiet       print only failures\n");
 }
 
-/* The "// variants:" line of shaders/<name>, or NULL when the file has
- * none (it is then compiled once, without defines). */
-static char *variants_of(const char *root, const char *name)
-{
-    char path[1200];
-    snprintf(path, sizeof path, "%s/shaders/%s", root, name);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return NULL;
-    char line[512], *out = NULL;
-    for (int n = 0; n < 40 && fgets(line, sizeof line, f); n++) {
-        char *v = strstr(line, "// variants:");
-        if (v == line) {
-            v += strlen("// variants:");
-            v[strcspn(v, "\r\n")] = 0;
-            out = strdup(v);
-            break;
-        }
-    }
-    fclose(f);
-    return out;
-}
-
-/* "B+C" -> "#define B 1\n#define C 1\n"; "-" -> "". */
-static void variant_defines(const char *tok, size_t len, char *out, size_t n)
-{
-    out[0] = 0;
-    size_t at = 0;
-    while (len > 0) {
-        size_t k = 0;
-        while (k < len && tok[k] != '+')
-            k++;
-        if (k > 0 && !(k == 1 && tok[0] == '-')) {
-            int w = snprintf(out + at, n - at, "#define %.*s 1\n", (int)k, tok);
-            if (w < 0 || (size_t)w >= n - at)
-                return;
-            at += (size_t)w;
-        }
-        tok += k;
-        len -= k;
-        if (len > 0) {
-            tok++;
-            len--;
-        }
-    }
-}
-
 static int by_name(const void *a, const void *b)
 {
     return strcmp(*(char *const *)a, *(char *const *)b);
@@ -143,7 +96,7 @@ int cmd_shaders(int argc, char **argv)
     for (int i = 0; i < n; i++) {
         char shown[1200];
         rs_data_path(root, "shaders", shown, sizeof shown);
-        char *vars = variants_of(root, names[i]);
+        char *vars = r_shader_variants(root, names[i]);
         const char *v = vars ? vars : "-";
         for (;;) {
             v += strspn(v, " \t");
@@ -151,7 +104,7 @@ int cmd_shaders(int argc, char **argv)
             if (len == 0)
                 break;
             char defs[512], label[160] = "";
-            variant_defines(v, len, defs, sizeof defs);
+            r_shader_variant_defines(v, len, defs, sizeof defs);
             if (vars)
                 snprintf(label, sizeof label, " [%.*s]", (int)len, v);
             char *log = NULL;

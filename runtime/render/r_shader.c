@@ -360,3 +360,50 @@ GLuint r_program(const r_program_desc *d, rs_err *err)
     }
     return prog;
 }
+
+/* The "// variants:" line of shaders/<name>, or NULL when the file has
+ * none (it is then compiled once, without defines). */
+char *r_shader_variants(const char *root, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/shaders/%s", root, name);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return NULL;
+    char line[512], *out = NULL;
+    for (int n = 0; n < 40 && fgets(line, sizeof line, f); n++) {
+        char *v = strstr(line, "// variants:");
+        if (v == line) {
+            v += strlen("// variants:");
+            v[strcspn(v, "\r\n")] = 0;
+            out = strdup(v);
+            break;
+        }
+    }
+    fclose(f);
+    return out;
+}
+
+/* "B+C" -> "#define B 1\n#define C 1\n"; "-" -> "". */
+void r_shader_variant_defines(const char *tok, size_t len, char *out, size_t n)
+{
+    out[0] = 0;
+    size_t at = 0;
+    while (len > 0) {
+        size_t k = 0;
+        while (k < len && tok[k] != '+')
+            k++;
+        if (k > 0 && !(k == 1 && tok[0] == '-')) {
+            int w = snprintf(out + at, n - at, "#define %.*s 1\n", (int)k, tok);
+            if (w < 0 || (size_t)w >= n - at)
+                return;
+            at += (size_t)w;
+        }
+        tok += k;
+        len -= k;
+        if (len > 0) {
+            tok++;
+            len--;
+        }
+    }
+}

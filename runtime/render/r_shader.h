@@ -66,4 +66,12 @@ GLuint r_program(const r_program_desc *d, rs_err *err);
 /* GL stage for a file name, or 0 when the extension is not a stage. */
 GLenum r_shader_stage(const char *name);
 
+/* Variants: a line "// variants: A B+C -" in the first 40 lines of a
+ * shader file lists the #define sets it is built with (docs/shaders.md).
+ * Returns the list after the colon (free() it), NULL when there is none. */
+char *r_shader_variants(const char *root, const char *name);
+/* One token of that list ("B+C", len bytes) -> "#define B 1\n#define C 1\n";
+ * "-" -> "". */
+void r_shader_variant_defines(const char *tok, size_t len, char *out, size_t n);
+
 #endif
