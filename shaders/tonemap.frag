@@ -18,11 +18,7 @@ uniform sampler2D u_bloom0, u_bloom1;
 uniform float u_bloom;
 #endif
 #ifdef FLARE
-uniform sampler2D u_flare;
-uniform sampler2D u_sun_vis;
-uniform vec2 u_sun_uv;      // the sun's position in uv
-uniform vec3 u_flare_color; // intensity and tint
-uniform float u_aspect;
+uniform sampler2D u_flare_img; // the flare pass's image (quarter size, HDR)
 #endif
 out vec4 o_color;
 
@@ -49,21 +45,7 @@ void main()
     c += u_bloom * (texture(u_bloom0, uv).rgb + texture(u_bloom1, uv).rgb);
 #endif
 #ifdef FLARE
-    float vis = texelFetch(u_sun_vis, ivec2(0), 0).r;
-    if (vis > 0.0) {
-        vec2 axis = vec2(0.5) - u_sun_uv;
-        vec3 f = vec3(0.0);
-        // the glow round the sun, then ghosts along the axis through the centre
-        const float pos[6] = float[6](0.0, 0.45, 0.8, 1.15, 1.5, 2.1);
-        const float size[6] = float[6](0.35, 0.05, 0.09, 0.04, 0.14, 0.07);
-        const vec3 tint[6] = vec3[6](vec3(1.0, 0.9, 0.7), vec3(0.4, 0.8, 1.0), vec3(1.0, 0.6, 0.3),
-                                     vec3(0.5, 1.0, 0.5), vec3(0.6, 0.5, 1.0), vec3(1.0, 0.8, 0.6));
-        for (int k = 0; k < 6; k++) {
-            vec2 d = (uv - (u_sun_uv + axis * pos[k])) * vec2(u_aspect, 1.0) / size[k];
-            f += tint[k] * texture(u_flare, d * 0.5 + 0.5).rgb * (k == 0 ? 1.0 : 0.35);
-        }
-        c += f * u_flare_color * vis;
-    }
+    c += texture(u_flare_img, uv).rgb;
 #endif
     c = mix(clamp(c, vec3(0.0), vec3(65504.0)), vec3(0.0), isnan(c));
     float y = dot(c, LUMA);

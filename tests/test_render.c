@@ -334,7 +334,7 @@ static void t_sunless_stage_skips_its_passes(void)
     int d_all, b_all, d_less, b_less;
     counted_frame(r, &f, &prev, &cur, &d_all, &b_all);
     const char *all[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter", "scene",
-                         "sky", "lens", "bloom_bright", "bloom_blur", "sun_visibility", "tonemap", "hud"};
+                         "sky", "lens", "bloom_bright", "bloom_blur", "sun_visibility", "flare", "tonemap", "hud"};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         T_ASSERTF(pass_ran(r, all[i]), "dojo: '%s' did not run", all[i]);
     r_game_destroy(r);
@@ -342,7 +342,7 @@ static void t_sunless_stage_skips_its_passes(void)
     r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     const char *skipped[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter",
-                             "bloom_bright", "bloom_blur", "sun_visibility"};
+                             "bloom_bright", "bloom_blur", "sun_visibility", "flare"};
     for (size_t i = 0; i < sizeof skipped / sizeof skipped[0]; i++)
         T_ASSERTF(!pass_ran(r, skipped[i]), "sunless: '%s' ran", skipped[i]);
     const char *kept[] = {"scene", "sky", "lens", "tonemap", "hud"};

@@ -13,7 +13,7 @@ short_replay() { # 300 ticks on the dojo
 t_passes_summary_and_frames() {
     short_replay || return 1
     "$RS_BIN" render short.rsr --ticks 100:110 $SIZES -q --passes -o a.y4m 2>p.txt || { cat p.txt; return 1; }
-    for pass in shadow_map silhouette_mips shadow_mask mask_filter scene sky lens bloom_blur sun_visibility tonemap hud total; do
+    for pass in shadow_map silhouette_mips shadow_mask mask_filter scene sky lens bloom_blur sun_visibility flare tonemap hud total; do
         grep -q "^$pass " p.txt || { echo "no '$pass' row"; cat p.txt; return 1; }
     done
     grep -q "passes (stage dojo, 320x180, 10 frames" p.txt || { cat p.txt; return 1; }
@@ -25,7 +25,7 @@ t_passes_summary_and_frames() {
     # the sunless look skips its passes, every frame, and says so
     "$RS_BIN" render short.rsr --ticks 100:104 $SIZES -q --passes=frames --stage-file "$SRC/stages/sunless.stage" \
         -o c.y4m 2>s.txt || { cat s.txt; return 1; }
-    [ "$(grep -c 'skipped: shadow_map silhouette silhouette_mips z_prepass shadow_mask mask_filter bloom_bright bloom_blur sun_visibility$' s.txt)" = 4 ] ||
+    [ "$(grep -c 'skipped: shadow_map silhouette silhouette_mips z_prepass shadow_mask mask_filter bloom_bright bloom_blur sun_visibility flare$' s.txt)" = 4 ] ||
         { cat s.txt; return 1; }
     awk '$1 == "shadow_map" && ($2 != 0 || $3 != 4) { exit 1 }' s.txt || { cat s.txt; return 1; }
     expect_fail 2 "--passes='often': expected summary or frames" "$RS_BIN" render short.rsr --passes=often -o d.y4m
