@@ -10,6 +10,7 @@
 uniform sampler2D u_hdr;
 uniform sampler1D u_lut;
 uniform int u_lut_size;
+uniform float u_lut_inv_power; // 1 / r_tone_index_power(gamma): 0.5 up to gamma 4
 uniform float u_exposure;
 uniform float u_saturation;
 uniform int u_write_mask; // alpha = the fighters' mask, else 1
@@ -27,9 +28,9 @@ const float X_MAX = 4.0; // R_TONE_X_MAX
 
 float curve(float x)
 {
-    // u = sqrt(x / X_MAX); linear interpolation done here in full float
+    // u = (x / X_MAX)^(1/m); linear interpolation done here in full float
     // (texture units filter with 8-bit weights)
-    float f = sqrt(clamp(x / X_MAX, 0.0, 1.0)) * float(u_lut_size - 1);
+    float f = pow(clamp(x / X_MAX, 0.0, 1.0), u_lut_inv_power) * float(u_lut_size - 1);
     int i = min(int(f), u_lut_size - 2);
     float t = f - float(i);
     return mix(texelFetch(u_lut, i, 0).r, texelFetch(u_lut, i + 1, 0).r, t);

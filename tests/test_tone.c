@@ -45,11 +45,18 @@ static void t_lut_entries_are_the_curve(void)
     /* the lookup hits the entries exactly at their x */
     for (int k = 0; k < 256; k += 17) {
         double u = k / 255.0;
-        T_ASSERT(fabs(r_tone_lookup(lut, 256, u * u * R_TONE_X_MAX, 0) - lut[k]) < 1e-6);
+        T_ASSERT(fabs(r_tone_lookup(lut, 256, 2.2, u * u * R_TONE_X_MAX, 0) - lut[k]) < 1e-6);
     }
     /* beyond the table: flat at the last entry */
-    T_ASSERT(r_tone_lookup(lut, 256, 1e9, 0) == lut[255]);
-    T_ASSERT(r_tone_lookup(lut, 256, -5, 0) == 0);
+    T_ASSERT(r_tone_lookup(lut, 256, 2.2, 1e9, 0) == lut[255]);
+    T_ASSERT(r_tone_lookup(lut, 256, 2.2, -5, 0) == 0);
+    /* high gamma: the index power grows (m = gamma / 2 above 4) */
+    T_ASSERT(r_tone_index_power(2.2) == 2 && r_tone_index_power(4) == 2 && r_tone_index_power(10) == 5);
+    r_tone_lut(lut, 256, 10);
+    for (int k = 0; k < 256; k += 15) {
+        double u = k / 255.0;
+        T_ASSERTF(fabs(lut[k] - r_tone_curve(pow(u, 5) * R_TONE_X_MAX, 10)) < 1e-7, "gamma 10 entry %d", k);
+    }
 }
 
 /* The goal: < 0.1 of an 8-bit step at the default size. */
@@ -64,6 +71,19 @@ static void t_default_lut_error_under_a_tenth_step(void)
     /* a texture unit's 8-bit weights would cost more than the table */
     double e8 = r_tone_max_error(R_TONE_LUT_DEFAULT, 2.2, 8);
     T_ASSERTF(e8 > e, "8-bit weights %.6f vs exact %.6f", e8, e);
+}
+
+/* Across the whole gamma range a stage file allows (0.1..10). */
+static void t_every_gamma_meets_the_goal(void)
+{
+    const double gammas[] = {0.1, 0.45, 1.0, 1.8, 2.2, 3.0, 4.0, 5.0, 7.0, 10.0};
+    for (size_t g = 0; g < sizeof gammas / sizeof gammas[0]; g++) {
+        double e = r_tone_max_error(R_TONE_LUT_DEFAULT, gammas[g], 0);
+        fprintf(stderr, "    gamma %4.2f: %.4f steps\n", gammas[g], e / STEP);
+        T_ASSERTF(e < 0.1 * STEP, "gamma %.2f: %.4f of an 8-bit step", gammas[g], e / STEP);
+    }
+    /* the curve itself near 0 at high gamma: x^(3/gamma), no cancellation */
+    T_ASSERTF(fabs(r_tone_curve(1e-9, 10) - pow(1e-9, 0.3)) < 1e-6, "%.9g", r_tone_curve(1e-9, 10));
 }
 
 static void t_small_tables_fail_the_goal(void)
@@ -124,6 +144,7 @@ static void shader_vs_curve(double gamma, float saturation)
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_hdr"), 0);
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_lut"), 1);
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_lut_size"), R_TONE_LUT_DEFAULT);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "u_lut_inv_power"), (float)(1.0 / r_tone_index_power(gamma)));
     gl.Uniform1f(gl.GetUniformLocation(prog, "u_exposure"), 1.0f);
     gl.Uniform1f(gl.GetUniformLocation(prog, "u_saturation"), saturation);
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_write_mask"), 0);
@@ -168,10 +189,13 @@ static void shader_vs_curve(double gamma, float saturation)
 static void t_shader_matches_curve_gamma_22(void) { shader_vs_curve(2.2, 1.0f); }
 static void t_shader_matches_curve_gamma_1(void) { shader_vs_curve(1.0, 1.0f); }
 static void t_shader_saturation_0_is_grey(void) { shader_vs_curve(2.2, 0.0f); }
+static void t_shader_matches_curve_gamma_10(void) { shader_vs_curve(10.0, 1.0f); }
 
 T_MAIN({"curve_shape", t_curve_shape}, {"lut_entries_are_the_curve", t_lut_entries_are_the_curve},
        {"default_lut_error_under_a_tenth_step", t_default_lut_error_under_a_tenth_step},
        {"small_tables_fail_the_goal", t_small_tables_fail_the_goal},
        {"shader_matches_curve_gamma_22", t_shader_matches_curve_gamma_22},
        {"shader_matches_curve_gamma_1", t_shader_matches_curve_gamma_1},
-       {"shader_saturation_0_is_grey", t_shader_saturation_0_is_grey})
+       {"shader_saturation_0_is_grey", t_shader_saturation_0_is_grey},
+       {"shader_matches_curve_gamma_10", t_shader_matches_curve_gamma_10},
+       {"every_gamma_meets_the_goal", t_every_gamma_meets_the_goal})

@@ -879,6 +879,7 @@ static void run_tonemap(void *u)
     bind_tex(p, "u_hdr", 0, GL_TEXTURE_2D, r->hdr_tex);
     bind_tex(p, "u_lut", 1, GL_TEXTURE_1D, r->lut_tex);
     gl.Uniform1i(loc(p, "u_lut_size"), r->lut_size);
+    gl.Uniform1f(loc(p, "u_lut_inv_power"), (float)(1.0 / r_tone_index_power(r->lut_gamma)));
     gl.Uniform1f(loc(p, "u_exposure"), f->exposure);
     gl.Uniform1f(loc(p, "u_saturation"), f->saturation);
     gl.Uniform1i(loc(p, "u_write_mask"), r->opts.mask);

@@ -7,20 +7,28 @@ double r_tone_curve(double x, double gamma)
 {
     if (!(x > 0)) /* also NaN */
         return 0;
-    return pow(pow(1 - exp(-x * x), 1.5), 1 / gamma);
+    /* -expm1: 1 - exp(-x^2) without cancellation, which matters at high
+     * gamma, where the curve near 0 goes like x^(3/gamma) */
+    return pow(pow(-expm1(-x * x), 1.5), 1 / gamma);
+}
+
+double r_tone_index_power(double gamma)
+{
+    return gamma > 4 ? gamma / 2 : 2;
 }
 
 void r_tone_lut(float *lut, int n, double gamma)
 {
+    double m = r_tone_index_power(gamma);
     for (int k = 0; k < n; k++) {
         double u = (double)k / (n - 1);
-        lut[k] = (float)r_tone_curve(u * u * R_TONE_X_MAX, gamma);
+        lut[k] = (float)r_tone_curve(pow(u, m) * R_TONE_X_MAX, gamma);
     }
 }
 
-double r_tone_lookup(const float *lut, int n, double x, int weight_bits)
+double r_tone_lookup(const float *lut, int n, double gamma, double x, int weight_bits)
 {
-    double u = x > 0 ? sqrt(fmin(x, R_TONE_X_MAX) / R_TONE_X_MAX) : 0;
+    double u = x > 0 ? pow(fmin(x, R_TONE_X_MAX) / R_TONE_X_MAX, 1 / r_tone_index_power(gamma)) : 0;
     double f = u * (n - 1);
     int i = (int)f;
     if (i > n - 2)
@@ -44,7 +52,7 @@ double r_tone_max_error(int n, double gamma, int weight_bits)
     for (int s = 0; s <= samples; s++) {
         /* denser near 0, where the curve bends hardest */
         double v = (double)s / samples, x = v * v * top;
-        double e = fabs(r_tone_lookup(lut, n, x, weight_bits) - r_tone_curve(x, gamma));
+        double e = fabs(r_tone_lookup(lut, n, gamma, x, weight_bits) - r_tone_curve(x, gamma));
         if (e > worst)
             worst = e;
     }
