@@ -106,3 +106,16 @@ bool cli_hdr_format(const char *arg, int *fmt)
     }
     return true;
 }
+
+bool cli_passes(const char *cmd, const char *arg, int *mode)
+{
+    if (!arg || !strcmp(arg, "summary"))
+        *mode = 1;
+    else if (!strcmp(arg, "frames"))
+        *mode = 2;
+    else {
+        cli_error(cmd, "--passes='%s': expected summary or frames", arg);
+        return false;
+    }
+    return true;
+}

@@ -43,6 +43,8 @@ int cli_plat_status(const struct rs_err *err);
 
 /* "rgba16f" / "r11g11b10f" -> r_hdr_format; prints a usage error. */
 bool cli_hdr_format(const char *arg, int *fmt);
+/* --passes[=summary|frames]: 1 summary, 2 per frame; prints the error. */
+bool cli_passes(const char *cmd, const char *arg, int *mode);
 
 /* Stage by name ("dojo") or number; prints a usage error on failure. */
 bool cli_stage(const char *arg, int *stage);

@@ -203,12 +203,7 @@ int cmd_play(int argc, char **argv)
         case 'H': headless = true; break;
         case 'T': go.stage_file = optarg; break;
         case 'P':
-            if (!optarg || !strcmp(optarg, "summary"))
-                passes = 1;
-            else if (!strcmp(optarg, "frames"))
-                passes = 2;
-            else {
-                cli_error("play", "--passes='%s': expected summary or frames", optarg);
+            if (!cli_passes("play", optarg, &passes)) {
                 status = RS_EXIT_USAGE;
                 goto done;
             }

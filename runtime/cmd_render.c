@@ -128,14 +128,8 @@ int cmd_render(int argc, char **argv)
             break;
         case 'T': go.stage_file = optarg; break;
         case 'P':
-            if (!optarg || !strcmp(optarg, "summary"))
-                passes = 1;
-            else if (!strcmp(optarg, "frames"))
-                passes = 2;
-            else {
-                cli_error("render", "--passes='%s': expected summary or frames", optarg);
+            if (!cli_passes("render", optarg, &passes))
                 return RS_EXIT_USAGE;
-            }
             break;
         case 'M': go.mask = true; break;
         case 'U': go.no_hud = true; break;

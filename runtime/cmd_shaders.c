@@ -98,15 +98,11 @@ int cmd_shaders(int argc, char **argv)
         rs_data_path(root, "shaders", shown, sizeof shown);
         char *vars = r_shader_variants(root, names[i]);
         const char *v = vars ? vars : "-";
-        for (;;) {
-            v += strspn(v, " \t");
-            size_t len = strcspn(v, " \t");
-            if (len == 0)
-                break;
-            char defs[512], label[160] = "";
-            r_shader_variant_defines(v, len, defs, sizeof defs);
+        char defs[512], var[128];
+        while (r_shader_next_variant(&v, defs, sizeof defs, var, sizeof var)) {
+            char label[160] = "";
             if (vars)
-                snprintf(label, sizeof label, " [%.*s]", (int)len, v);
+                snprintf(label, sizeof label, " [%s]", var);
             char *log = NULL;
             GLuint sh = r_shader_compile(names[i], defs[0] ? defs : NULL, &log, &err);
             compiled++;
@@ -121,7 +117,6 @@ int cmd_shaders(int argc, char **argv)
                     putchar('\n');
             }
             free(log);
-            v += len;
         }
         free(vars);
         free(names[i]);

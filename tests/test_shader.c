@@ -211,18 +211,12 @@ static void t_every_shader_compiles(void)
         /* every variant the file declares (docs/shaders.md), else once */
         char *vars = r_shader_variants(root, de->d_name);
         const char *v = vars ? vars : "-";
-        for (;;) {
-            v += strspn(v, " \t");
-            size_t len = strcspn(v, " \t");
-            if (len == 0)
-                break;
-            char defs[512];
-            r_shader_variant_defines(v, len, defs, sizeof defs);
+        char defs[512], var[128];
+        while (r_shader_next_variant(&v, defs, sizeof defs, var, sizeof var)) {
             GLuint sh = r_shader_compile(de->d_name, defs[0] ? defs : NULL, NULL, &e);
-            T_ASSERTF(sh, "%s [%.*s]: %s", de->d_name, (int)len, v, e.msg);
+            T_ASSERTF(sh, "%s [%s]: %s", de->d_name, var, e.msg);
             gl.DeleteShader(sh);
             n++;
-            v += len;
         }
         free(vars);
     }

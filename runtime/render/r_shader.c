@@ -407,3 +407,15 @@ void r_shader_variant_defines(const char *tok, size_t len, char *out, size_t n)
         }
     }
 }
+
+bool r_shader_next_variant(const char **cursor, char *defs, size_t ndefs, char *name, size_t nname)
+{
+    const char *v = *cursor + strspn(*cursor, " \t");
+    size_t len = strcspn(v, " \t");
+    if (len == 0)
+        return false;
+    r_shader_variant_defines(v, len, defs, ndefs);
+    snprintf(name, nname, "%.*s", (int)len, v);
+    *cursor = v + len;
+    return true;
+}

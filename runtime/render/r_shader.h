@@ -73,5 +73,9 @@ char *r_shader_variants(const char *root, const char *name);
 /* One token of that list ("B+C", len bytes) -> "#define B 1\n#define C 1\n";
  * "-" -> "". */
 void r_shader_variant_defines(const char *tok, size_t len, char *out, size_t n);
+/* Walks a variants list: *cursor starts at the list (or "-" for a file
+ * without one); each call fills defs and the token (name, e.g. "B+C") and
+ * advances; false at the end. */
+bool r_shader_next_variant(const char **cursor, char *defs, size_t ndefs, char *name, size_t nname);
 
 #endif
