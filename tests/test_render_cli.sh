@@ -28,7 +28,12 @@ t_passes_summary_and_frames() {
     [ "$(grep -c 'skipped: shadow_map silhouette silhouette_mips z_prepass shadow_mask mask_filter bloom_bright bloom_blur sun_visibility flare$' s.txt)" = 4 ] ||
         { cat s.txt; return 1; }
     awk '$1 == "shadow_map" && ($2 != 0 || $3 != 4) { exit 1 }' s.txt || { cat s.txt; return 1; }
-    expect_fail 2 "--passes='often': expected summary or frames" "$RS_BIN" render short.rsr --passes=often -o d.y4m
+    expect_fail 2 "--passes='often': expected summary or frames" "$RS_BIN" render short.rsr --passes=often -o d.y4m || return 1
+    # play prints the same table
+    "$RS_BIN" play --headless --replay short.rsr --size 160x90 --passes --quiet 2>q.txt || { cat q.txt; return 1; }
+    grep -q "passes (stage dojo, 160x90, 300 frames" q.txt || { cat q.txt; return 1; }
+    grep -q "^tonemap  *300  *0 " q.txt || { cat q.txt; return 1; }
+    expect_fail 2 "--passes='often'" "$RS_BIN" play --headless --replay short.rsr --passes=often
 }
 
 t_ticks_match_a_full_render() {
