@@ -38,6 +38,10 @@ struct cap_sink {
     int w, h;
     cap_pixfmt fmt;
     uint64_t frames;
+    /* added to frame numbers where they are shown: image-sequence names
+     * and the --hashes list (render --ticks A:B numbers frames from A);
+     * video timestamps still start at 0 */
+    uint64_t index_base;
 };
 
 /* Picks the sink from the output's extension (.y4m, .mp4, .mkv, .webm,

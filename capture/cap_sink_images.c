@@ -40,7 +40,7 @@ bool cap_images_pattern_ok(const char *path, const char **ext)
 
 static void frame_path(const cap_sink *s, uint64_t index, char *out, size_t n)
 {
-    snprintf(out, n, s->path, (int)index); /* the pattern was checked by cap_images_pattern_ok */
+    snprintf(out, n, s->path, (int)(index + s->index_base)); /* the pattern was checked by cap_images_pattern_ok */
 }
 
 static bool img_open(cap_sink *s, rs_err *err)

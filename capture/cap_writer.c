@@ -57,9 +57,10 @@ uint64_t cap_frame_hash(const uint8_t *p, size_t n)
 static bool write_one(cap_writer *w, const uint8_t *frame, uint64_t index, rs_err *err)
 {
     double t0 = rs_now();
-    if (w->hashes && fprintf(w->hashes, "%llu %016llx\n", (unsigned long long)index,
+    if (w->hashes && fprintf(w->hashes, "%llu %016llx\n", (unsigned long long)(index + w->sink->index_base),
                              (unsigned long long)cap_frame_hash(frame, w->frame_bytes)) < 0)
-        return rs_fail(err, 1, "writing the frame hash list failed at frame %llu", (unsigned long long)index);
+        return rs_fail(err, 1, "writing the frame hash list failed at frame %llu",
+                       (unsigned long long)(index + w->sink->index_base));
     bool ok = w->sink->ops->write(w->sink, frame, index, err);
     w->st.write_ms += (rs_now() - t0) * 1e3;
     if (ok)

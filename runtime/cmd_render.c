@@ -52,7 +52,8 @@ static void help(void)
            "  --no-hud           leave out bars, timer and announcements\n"
            "  --hdr-format F     the HDR buffer: rgba16f (default) or r11g11b10f (no alpha)\n"
            "  --ticks A:B        write only ticks A to B-1 (the game still runs from tick 0,\n"
-           "                     so frame A is the same as in a full render)\n"
+           "                     so frame A is the same as in a full render; image names and\n"
+           "                     --hashes lines are numbered A..B-1)\n"
            "  --quiet            no progress line\n",
            cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
 }
@@ -197,13 +198,15 @@ int cmd_render(int argc, char **argv)
     if (!rp_read(replay, &rp, &err))
         goto done;
     if (end > (long)rp.ticks) {
-        rs_fail(&err, RS_EXIT_USAGE, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", replay, first, end,
+        rs_fail(&err, 1, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", replay, first, end,
                 rp.ticks);
+        status = RS_EXIT_USAGE;
         goto done;
     }
     uint64_t t_first = (uint64_t)first, t_end = end < 0 ? rp.ticks : (uint64_t)end;
     if (!cap_sink_for(out, cd.w, cd.h, &sink, &err))
         goto done;
+    sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
     struct stat hst;
     if (hashes && stat(hashes, &hst) == 0 && !S_ISREG(hst.st_mode)) {
         rs_fail(&err, 1, "%s: exists and is not a regular file (--hashes)", hashes);

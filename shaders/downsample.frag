@@ -16,5 +16,5 @@ void main()
     c *= 0.25 * u_scale;
     if (u_threshold >= 0.0)
         c = vec4(max(c.rgb - vec3(u_threshold), vec3(0.0)), 1.0);
-    o_color = c;
+    o_color = min(c, vec4(65504.0)); // exposure up to 1000 must not make Inf in half float
 }

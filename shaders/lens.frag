@@ -28,6 +28,8 @@ void main()
     vec3 tint = vec3(0.05, 0.07, 0.09) * ibl_diffuse(n, 1.0);
     vec3 refl = ibl_specular(r, 128.0, 1.0) * mix(0.3, 1.0, fresnel);
     vec3 c = tint * u_lens_alpha + refl;
-    c = min(c, vec3(65504.0));
+    // blended result = c + (1 - alpha) * dst with dst <= 65504: keeping c
+    // under 65504 * alpha keeps the sum finite in half float on any GPU
+    c = min(c, vec3(65504.0 * u_lens_alpha));
     o_color = vec4(c, u_lens_alpha);
 }

@@ -35,25 +35,28 @@ static void t_validation_at_add(void)
     rs_err e = {0};
     r_graph_init(&g, 0, names, 4);
     /* reading what nobody wrote */
-    T_ASSERT(!r_graph_add(&g, &(r_pass){"blur", R_A, R_B, yes, run0}, &e));
+    T_ASSERT(!r_graph_add(&g, &(r_pass){"blur", R_A, R_B, yes, run0, 0}, &e));
     T_CONTAINS(e.msg, "pass 'blur' reads 'a', which no earlier pass writes");
     /* a persistent resource may be read without a writer */
     r_graph_init(&g, R_A, names, 4);
-    T_ASSERTF(r_graph_add(&g, &(r_pass){"blur", R_A, R_B, yes, run0}, &e), "%s", e.msg);
+    T_ASSERTF(r_graph_add(&g, &(r_pass){"blur", R_A, R_B, yes, run0, 0}, &e), "%s", e.msg);
+    /* an optional read is checked the same way */
+    T_ASSERT(!r_graph_add(&g, &(r_pass){"late", 0, R_OUT, yes, run1, R_C}, &e));
+    T_CONTAINS(e.msg, "pass 'late' reads 'c', which no earlier pass writes");
     /* duplicate names, missing functions */
-    T_ASSERT(!r_graph_add(&g, &(r_pass){"blur", 0, R_C, yes, run1}, &e));
+    T_ASSERT(!r_graph_add(&g, &(r_pass){"blur", 0, R_C, yes, run1, 0}, &e));
     T_CONTAINS(e.msg, "two passes named 'blur'");
-    T_ASSERT(!r_graph_add(&g, &(r_pass){"x", 0, R_C, NULL, run1}, &e));
+    T_ASSERT(!r_graph_add(&g, &(r_pass){"x", 0, R_C, NULL, run1, 0}, &e));
     T_CONTAINS(e.msg, "no name, run or needed");
-    T_ASSERT(!r_graph_add(&g, &(r_pass){NULL, 0, R_C, yes, run1}, &e));
+    T_ASSERT(!r_graph_add(&g, &(r_pass){NULL, 0, R_C, yes, run1, 0}, &e));
     /* capacity */
     r_graph_init(&g, 0, names, 4);
     char nm[R_GRAPH_MAX + 1][8];
     for (int i = 0; i < R_GRAPH_MAX; i++) {
         snprintf(nm[i], sizeof nm[i], "p%d", i);
-        T_ASSERT(r_graph_add(&g, &(r_pass){nm[i], 0, R_A, yes, run0}, &e));
+        T_ASSERT(r_graph_add(&g, &(r_pass){nm[i], 0, R_A, yes, run0, 0}, &e));
     }
-    T_ASSERT(!r_graph_add(&g, &(r_pass){"one_more", 0, R_A, yes, run0}, &e));
+    T_ASSERT(!r_graph_add(&g, &(r_pass){"one_more", 0, R_A, yes, run0, 0}, &e));
     T_CONTAINS(e.msg, "more than");
     T_EQ(r_graph_find(&g, "p3"), 3);
     T_EQ(r_graph_find(&g, "nope"), -1);
@@ -63,10 +66,10 @@ static void build(r_graph *g)
 {
     rs_err e = {0};
     r_graph_init(g, 0, names, 4);
-    T_ASSERT(r_graph_add(g, &(r_pass){"make_a", 0, R_A, yes, run0}, &e));
-    T_ASSERT(r_graph_add(g, &(r_pass){"make_b", R_A, R_B, want_b, run1}, &e));
-    T_ASSERT(r_graph_add(g, &(r_pass){"use_a", R_A, R_C, yes, run2}, &e));
-    T_ASSERT(r_graph_add(g, &(r_pass){"final", R_C, R_OUT, yes, run3}, &e));
+    T_ASSERT(r_graph_add(g, &(r_pass){"make_a", 0, R_A, yes, run0, 0}, &e));
+    T_ASSERT(r_graph_add(g, &(r_pass){"make_b", R_A, R_B, want_b, run1, 0}, &e));
+    T_ASSERT(r_graph_add(g, &(r_pass){"use_a", R_A, R_C, yes, run2, 0}, &e));
+    T_ASSERT(r_graph_add(g, &(r_pass){"final", R_C, R_OUT, yes, run3, 0}, &e));
 }
 
 static void t_skipped_pass_is_not_called(void)
@@ -106,8 +109,8 @@ static void t_inconsistent_needed_is_an_error(void)
     r_graph g;
     rs_err e = {0};
     r_graph_init(&g, 0, names, 4);
-    T_ASSERT(r_graph_add(&g, &(r_pass){"make_b", 0, R_B, b_needed, run0}, &e));
-    T_ASSERT(r_graph_add(&g, &(r_pass){"use_b", R_B, R_OUT, yes, run1}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"make_b", 0, R_B, b_needed, run0, 0}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"use_b", R_B, R_OUT, yes, run1, 0}, &e));
     world w = {0};
     b_needed_flag = true;
     T_EQ(r_graph_run(&g, &w), 3);
@@ -158,9 +161,9 @@ static void t_timing_and_report(void)
     r_graph g;
     rs_err e = {0};
     r_graph_init(&g, 0, names, 4);
-    T_ASSERT(r_graph_add(&g, &(r_pass){"clears", 0, R_A, yes, gl_pass}, &e));
-    T_ASSERT(r_graph_add(&g, &(r_pass){"sometimes", R_A, R_B, want_b, run1}, &e));
-    T_ASSERT(r_graph_add(&g, &(r_pass){"last", R_A, R_OUT, yes, run3}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"clears", 0, R_A, yes, gl_pass, 0}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"sometimes", R_A, R_B, want_b, run1, 0}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"last", R_A, R_OUT, yes, run3, 0}, &e));
     r_graph_timing(&g, on_frame, NULL);
     T_ASSERT(g.gpu_timer); /* GL 3.3+ on every backend we run */
     world w = {0};

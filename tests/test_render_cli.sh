@@ -41,9 +41,12 @@ t_ticks_match_a_full_render() {
     "$RS_BIN" render short.rsr $SIZES -q --hashes all.txt -o all.y4m || return 1
     "$RS_BIN" render short.rsr $SIZES -q --ticks 200:205 --hashes part.txt -o part.y4m || return 1
     [ "$(wc -l <part.txt)" = 5 ] || { cat part.txt; return 1; }
-    # the same pictures as frames 200..204 of the whole replay
-    [ "$(sed -n '201,205p' all.txt | cut -d' ' -f2)" = "$(cut -d' ' -f2 part.txt)" ] ||
-        { echo "--ticks frames differ from the full render"; return 1; }
+    # the same pictures as frames 200..204 of the whole replay, numbered 200..204
+    [ "$(sed -n '201,205p' all.txt)" = "$(cat part.txt)" ] ||
+        { echo "--ticks frames differ from the full render:"; sed -n '201,205p' all.txt; cat part.txt; return 1; }
+    # image sequences are numbered by tick too
+    "$RS_BIN" render short.rsr $SIZES -q --ticks 298:300 -o seq/f%04d.png || return 1
+    [ "$(ls seq | tr '\n' ' ')" = "f0298.png f0299.png " ] || { ls seq; return 1; }
 }
 
 t_ticks_errors() {
@@ -51,7 +54,7 @@ t_ticks_errors() {
     expect_fail 2 "--ticks '5:3': the end must be after the start" "$RS_BIN" render short.rsr --ticks 5:3 -o x.y4m || return 1
     expect_fail 2 "--ticks '7': expected A:B" "$RS_BIN" render short.rsr --ticks 7 -o x.y4m || return 1
     expect_fail 2 "--ticks start" "$RS_BIN" render short.rsr --ticks x:9 -o x.y4m || return 1
-    expect_fail 1 "short.rsr: --ticks 10:301 is past the replay's end \(300 ticks\)" \
+    expect_fail 2 "short.rsr: --ticks 10:301 is past the replay's end \(300 ticks\)" \
         "$RS_BIN" render short.rsr --ticks 10:301 -o x.y4m || return 1
     [ ! -e x.y4m ] || { echo "output written on error"; return 1; }
 }
@@ -76,10 +79,15 @@ t_bad_stage_files() {
 
 t_mask_cutouts() {
     short_replay || return 1
-    "$RS_BIN" render short.rsr --ticks 200:202 --mask $SIZES -q -o cut/f%02d.png || return 1
-    [ -s cut/f00.png ] && [ -s cut/f01.png ] || { ls cut; return 1; }
-    fmt=$(ffprobe -v error -show_entries stream=pix_fmt -of default=nw=1:nk=1 cut/f00.png)
+    "$RS_BIN" render short.rsr --ticks 200:202 --mask $SIZES -q -o cut/f%04d.png || return 1
+    [ -s cut/f0200.png ] && [ -s cut/f0201.png ] || { ls cut; return 1; }
+    fmt=$(ffprobe -v error -show_entries stream=pix_fmt -of default=nw=1:nk=1 cut/f0200.png)
     [ "$fmt" = rgba ] || { echo "pix_fmt $fmt, want rgba"; return 1; }
+    # the alpha is the fighters' mask: mostly 0 (background), some 255 (fighters), a few edges between
+    ffmpeg -v error -i cut/f0200.png -vf alphaextract -f rawvideo -pix_fmt gray - 2>/dev/null | od -An -v -tu1 -w1 |
+        awk '{ n++; if ($1 == 0) z++; else if ($1 == 255) f++ }
+             END { printf "alpha: %d px, %d zero, %d full\n", n, z, f; exit !(n == 160 * 90 && z > n / 2 && f > n / 100 && f < n / 3) }' ||
+        return 1
     expect_fail 2 "--mask writes RGBA images" "$RS_BIN" render short.rsr --mask -o m.y4m || return 1
     expect_fail 1 "--mask needs an alpha channel" "$RS_BIN" render short.rsr --mask --hdr-format r11g11b10f -o m/f%02d.png || return 1
     expect_fail 2 "hdr" "$RS_BIN" render short.rsr --hdr-format rgb9e5 -o m.y4m

@@ -39,6 +39,7 @@ GLF(1, READBUFFER, ReadBuffer)
 GLF(1, DRAWBUFFERS, DrawBuffers)
 GLF(1, FINISH, Finish)
 GLF(1, ISENABLED, IsEnabled)
+GLF(1, GETBOOLEANV, GetBooleanv)
 GLF(1, FLUSH, Flush)
 
 /* textures and samplers */

@@ -76,6 +76,7 @@ struct r_game {
     GLsizei lens_count;
     GLuint ring_vao, ring_vbo, ring_ibo;
     GLsizei ring_count;
+    int ring_stage; /* the game stage the ring mesh has the size of; -1 none */
     GLuint empty_vao;
     GLuint hud_vao, hud_vbo, font_tex;
     hud_vertex *hud;
@@ -83,6 +84,7 @@ struct r_game {
     /* look */
     bool have_stage;
     int stage_game; /* the game stage the look was loaded for; -1 = set by r_game_set_stage */
+    float key_dir[3]; /* the IBL's key direction: shadows are cast from it */
     r_stage stage;
     r_hdr_format hdr_format;
     GLuint ibl_tex[R_IBL_MAPS][2], sky_tex, lut_tex, normal_tex, spec_tex, flare_tex;
@@ -248,8 +250,10 @@ static bool build_ring(r_game *r, int game_stage, rs_err *err)
         r_mesh_free(&m);
         return rs_fail(err, 1, "out of memory for the ring mesh");
     }
+    free_mesh(&r->ring_vao, &r->ring_vbo, &r->ring_ibo);
     upload_mesh(&m, &r->ring_vao, &r->ring_vbo, &r->ring_ibo);
     r->ring_count = (GLsizei)m.ni;
+    r->ring_stage = game_stage;
     r_mesh_free(&m);
     return true;
 }
@@ -266,7 +270,7 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
     r_ibl ibl = {0};
     const char *cache = r->opts.cache_dir ? r->opts.cache_dir : r_ibl_cache_dir();
     if (!r_ibl_build(st, &ip, cache, &ibl, err)) {
-        if (st->env_path[0]) { /* say which stage asked for the file */
+        if (err && st->env_path[0]) { /* say which stage asked for the file */
             char msg[sizeof err->msg];
             snprintf(msg, sizeof msg, "stage '%s': environment: %s", st->name, err->msg);
             snprintf(err->msg, sizeof err->msg, "%s", msg);
@@ -279,13 +283,16 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
     for (int m = 0; m < R_IBL_MAPS; m++)
         for (int k = 0; k < 2; k++)
             r->ibl_tex[m][k] = cube_tex(ibl.size[m], ibl.map[m][k], 1);
+    memcpy(r->key_dir, ibl.key_dir, sizeof r->key_dir);
     r_ibl_free(&ibl);
     r_env sky = {0};
     if (!r_env_build(st, SKY_SIZE, &sky, err))
         return false;
     r->sky_tex = cube_tex(sky.size, sky.face, 1);
     r_env_free(&sky);
-    if (!build_ring(r, st->game_index, err))
+    /* the ring has the size of the match's stage (r_game_draw), which a
+     * --stage-file look for another game stage does not change */
+    if (!build_ring(r, game_stage >= 0 ? game_stage : st->game_index, err))
         return false;
     r->stage_game = game_stage;
     r->have_stage = true;
@@ -449,14 +456,14 @@ static void fighter_box(frame *f, const float lo[3], const float hi[3])
 /* The key light's orthographic projection, fitted round both fighters. */
 static void light_setup(r_game *r, frame *f)
 {
-    float key[3];
-    if (r->stage.sun)
-        memcpy(key, r->stage.sun_dir, sizeof key);
-    else if (r->stage.key.intensity > 0)
-        memcpy(key, r->stage.key.dir, sizeof key);
-    else
-        key[0] = 0, key[1] = 1, key[2] = 0;
-    r_vec3 L = r_norm(r_v3(key[0], key[1], key[2]));
+    /* the direction the IBL's key-light area is centred on (the sun, or
+     * the brightest light of the environment): shadows take away exactly
+     * the light the key-on/key-off maps differ by */
+    const float *key = r->key_dir;
+    float len = sqrtf(key[0] * key[0] + key[1] * key[1] + key[2] * key[2]);
+    r_vec3 L = len > 1e-6f && isfinite(len) ? r_v3(key[0] / len, key[1] / len, key[2] / len) : r_v3(0, 1, 0);
+    if (L.y < 0.05f) /* a key at or below the horizon: lift it so the shadow still lands */
+        L = r_norm(r_v3(L.x, 0.05f, L.z));
     f->light_dir = L;
     float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
     for (int i = 0; i < 2; i++)
@@ -1124,21 +1131,21 @@ static bool build_graph(r_game *r, rs_err *err)
 {
     r_graph_init(&r->graph, RES_ENV, res_names, (int)(sizeof res_names / sizeof res_names[0]));
     const r_pass passes[] = {
-        {"shadow_map", RES_ENV, RES_SHADOW, need_shadows, run_shadow_map},
-        {"silhouette", RES_ENV, RES_SIL, need_shadows, run_silhouette},
-        {"silhouette_mips", RES_SIL, RES_SIL, need_shadows, run_silhouette_mips},
-        {"z_prepass", RES_ENV, RES_DEPTH, need_shadows, run_z_prepass},
-        {"shadow_mask", RES_DEPTH | RES_SHADOW, RES_MASK, need_shadows, run_shadow_mask},
-        {"mask_filter", RES_MASK, RES_MASK, need_shadows, run_mask_filter},
-        {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene},
-        {"sky", RES_ENV | RES_DEPTH, RES_HDR, need_always, run_sky},
-        {"lens", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, need_always, run_lens},
-        {"bloom_bright", RES_HDR, RES_BLOOM, need_bloom, run_bloom_bright},
-        {"bloom_blur", RES_BLOOM, RES_BLOOM, need_bloom, run_bloom_blur},
-        {"sun_visibility", RES_DEPTH, RES_SUNVIS, need_sun, run_sun_visibility},
-        {"flare", RES_SUNVIS, RES_FLARE, need_sun, run_flare},
-        {"tonemap", RES_HDR | RES_ENV, RES_OUT, need_always, run_tonemap},
-        {"hud", RES_OUT, RES_OUT, need_hud, run_hud},
+        {"shadow_map", RES_ENV, RES_SHADOW, need_shadows, run_shadow_map, 0},
+        {"silhouette", RES_ENV, RES_SIL, need_shadows, run_silhouette, 0},
+        {"silhouette_mips", RES_SIL, RES_SIL, need_shadows, run_silhouette_mips, 0},
+        {"z_prepass", RES_ENV, RES_DEPTH, need_shadows, run_z_prepass, 0},
+        {"shadow_mask", RES_DEPTH | RES_SHADOW, RES_MASK, need_shadows, run_shadow_mask, 0},
+        {"mask_filter", RES_MASK, RES_MASK, need_shadows, run_mask_filter, 0},
+        {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene, RES_MASK | RES_SIL},
+        {"sky", RES_ENV | RES_DEPTH, RES_HDR, need_always, run_sky, 0},
+        {"lens", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, need_always, run_lens, 0},
+        {"bloom_bright", RES_HDR, RES_BLOOM, need_bloom, run_bloom_bright, 0},
+        {"bloom_blur", RES_BLOOM, RES_BLOOM, need_bloom, run_bloom_blur, 0},
+        {"sun_visibility", RES_DEPTH, RES_SUNVIS, need_sun, run_sun_visibility, 0},
+        {"flare", RES_SUNVIS, RES_FLARE, need_sun, run_flare, 0},
+        {"tonemap", RES_HDR | RES_ENV, RES_OUT, need_always, run_tonemap, RES_BLOOM | RES_FLARE},
+        {"hud", RES_OUT, RES_OUT, need_hud, run_hud, 0},
     };
     for (size_t i = 0; i < sizeof passes / sizeof passes[0]; i++)
         if (!r_graph_add(&r->graph, &passes[i], err))
@@ -1168,7 +1175,9 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         r->opts.stage_file = r->stage_file;
     }
     r->stage_game = -2;
+    r->ring_stage = -1;
     r->lut_size = r->opts.lut_size > 0 ? r->opts.lut_size : R_TONE_LUT_DEFAULT;
+    r->lut_size = r->lut_size < R_TONE_LUT_MIN ? R_TONE_LUT_MIN : r->lut_size > R_TONE_LUT_MAX ? R_TONE_LUT_MAX : r->lut_size;
     if (!build_programs(r, err) || !build_graph(r, err)) {
         r_game_destroy(r);
         return NULL;
@@ -1328,7 +1337,17 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
         gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         return false;
     }
+    if (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) {
+        snprintf(r->error, sizeof r->error, "%s", err.msg);
+        return false;
+    }
     update_lut(r);
+    /* a known state whatever the caller left: every pass sets what it needs on top */
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_CULL_FACE);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gl.DepthMask(GL_TRUE);
     frame *f = &r->f;
     memset(f, 0, sizeof *f);
     f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = w, f->h = h, f->out_fbo = out;
@@ -1343,6 +1362,11 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     gl.Enable(GL_DEPTH_TEST);
     RGL_CHECK("r_game_draw");
     return true;
+}
+
+int r_game_ring_stage(const r_game *r)
+{
+    return r->ring_stage;
 }
 
 const char *r_game_error(const r_game *r)

@@ -5,7 +5,7 @@
  *   z_prepass, shadow_mask, mask_filter        SSFSM for the fighters
  *   scene, sky, lens                           HDR (RGBA16F), IBL, alpha = mask
  *   bloom_bright, bloom_blur                   bloom from the HDR buffer
- *   sun_visibility                             only when the sun is on screen
+ *   sun_visibility, flare                      only when the sun is on screen
  *   tonemap, hud                               YCbCr curve into the output
  *
  * It reads game state and never writes it.  Draws interpolate between the
@@ -60,6 +60,10 @@ r_graph *r_game_graph(r_game *r);
  * a named intermediate ("hdr", "bloom", "mask", "silhouette", the blurred
  * levels "silhouette1".."silhouette4"): tests.  out NULL: size only. */
 bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h);
+
+/* The game stage whose ring size the last frame drew (the match's, also
+ * under a --stage-file look for another stage); -1 before the first. */
+int r_game_ring_stage(const r_game *r);
 
 /* The camera r_game_draw used for this state (tests project with it). */
 r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye);

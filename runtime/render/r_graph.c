@@ -37,7 +37,7 @@ bool r_graph_add(r_graph *g, const r_pass *p, rs_err *err)
     uint32_t available = g->persistent;
     for (int i = 0; i < g->n; i++)
         available |= g->pass[i].writes;
-    uint32_t missing = p->reads & ~available;
+    uint32_t missing = (p->reads | p->may_read) & ~available;
     if (missing)
         return rs_fail(err, 1, "render graph: pass '%s' reads '%s', which no earlier pass writes", p->name,
                        res_name(g, missing));

@@ -39,6 +39,9 @@ typedef struct r_pass {
     uint32_t reads, writes;
     bool (*needed)(void *user);
     void (*run)(void *user);
+    /* used when their writer ran this frame (the pass asks r_graph_ran):
+     * checked at add like reads, but a skipped writer is no error */
+    uint32_t may_read;
 } r_pass;
 
 typedef struct r_pass_stats {

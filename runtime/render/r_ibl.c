@@ -24,6 +24,7 @@
 #include "../../capture/cap_oiio.h"
 
 #define PI 3.14159265358979323846
+/* The cache key does not cover these: change one, bump R_IBL_FORMAT_VERSION. */
 #define PROC_SUB 4       /* sub-samples per texel edge of the procedural sky */
 #define GROUND_EDGE 2.0  /* degrees of the soft horizon -> ground transition */
 #define KEY_EDGE 5.0     /* degrees of the key-area fade */

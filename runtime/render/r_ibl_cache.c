@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "../util/rs_file.h"
 
@@ -159,6 +160,43 @@ static float get_f32(const uint8_t *b)
     return f;
 }
 
+/* Writes the file under a temporary name of its own (mkstemp in the same
+ * directory) and renames it into place: two processes that miss the same
+ * entry at once each write their own file, and the last rename wins with
+ * a complete one. */
+static bool write_unique(const char *path, const void *data, size_t n, rs_err *err)
+{
+    char tmp[PATH_MAX + 16];
+    snprintf(tmp, sizeof tmp, "%s.XXXXXX", path);
+    int fd = mkstemp(tmp);
+    if (fd < 0)
+        return rs_fail(err, 1, "%s: cannot create: %s", tmp, strerror(errno));
+    const char *p = data;
+    size_t left = n;
+    int saved = 0;
+    while (left > 0) {
+        ssize_t w = write(fd, p, left);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0) {
+            saved = w < 0 ? errno : EIO;
+            break;
+        }
+        p += w, left -= (size_t)w;
+    }
+    if (!saved && fsync(fd) != 0)
+        saved = errno;
+    if (close(fd) != 0 && !saved)
+        saved = errno;
+    if (!saved && rename(tmp, path) != 0)
+        saved = errno;
+    if (saved) {
+        unlink(tmp);
+        return rs_fail(err, 1, "%s: write failed: %s", path, strerror(saved));
+    }
+    return true;
+}
+
 void r_ibl_cache_write(const char *path, const r_ibl_params *p, const r_ibl *ibl)
 {
     size_t len = cache_len(p);
@@ -184,7 +222,7 @@ void r_ibl_cache_write(const char *path, const r_ibl_params *p, const r_ibl *ibl
         fnv(&h, buf, (size_t)(b - buf));
         put_u64(b, h);
     }
-    if (!buf || !rs_mkdirs_for(path, &e) || !rs_write_part(path, buf, len, &e) || !rs_commit_file(path, &e))
+    if (!buf || !rs_mkdirs_for(path, &e) || !write_unique(path, buf, len, &e))
         fprintf(stderr, "ringside: warning: %s (IBL cache not saved; going on without it)\n", e.msg);
     free(buf);
 }
