@@ -587,6 +587,59 @@ static void t_shadows_darken_the_floor(void)
     plat_destroy(p);
 }
 
+/* Without a sun and with the painted key light off, the brightest light
+ * (the counter light) is the IBL's key: the shadows must be cast from it,
+ * since they take away what the key-on/key-off maps differ by. */
+static void t_shadow_follows_the_key_light(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("temple", 900, &prev, &cur);
+    fb f;
+    fb_make(&f);
+    r_game *r = game_new(NULL);
+    rs_err e = {0};
+    T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
+    r_stage st = *r_game_stage(r);
+    st.sun = false;
+    st.key.intensity = 0;
+    const float d[3] = {-0.6f, 0.5f, 0.3f};
+    float n = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int k = 0; k < 3; k++)
+        st.counter.dir[k] = d[k] / n;
+    st.counter.intensity = 40;
+    st.counter.size_deg = 10;
+    for (int k = 0; k < 3; k++) /* a dim sky, so the counter light is most of the light */
+        st.sky_zenith[k] *= 0.05f, st.sky_horizon[k] *= 0.05f, st.ground[k] *= 0.05f;
+    static float with[W * H * 4], without[W * H * 4];
+    int w, h;
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    draw(r, &f, &prev, &cur, NULL);
+    T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
+    st.shadows = false;
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    draw(r, &f, &prev, &cur, NULL);
+    T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
+    r_mat4 vp = r_game_camera(&cur, W, H, NULL);
+    for (int i = 0; i < 2; i++) {
+        g_capsule c[G_BONES];
+        g_fighter_capsules(&cur, i, c);
+        fx wx, wy;
+        g_skel_waist(c, &wx, &wy);
+        float t = fx_to_float(wy) / st.counter.dir[1];
+        r_vec3 q = r_v3(fx_to_float(wx) - st.counter.dir[0] * t, 0, -st.counter.dir[2] * t);
+        float sx, sy;
+        T_ASSERT(r_project(vp, q, W, H, &sx, &sy));
+        float a = hdr_mean(with, sx, sy, 1), b = hdr_mean(without, sx, sy, 1);
+        fprintf(stderr, "    floor where fighter %d's shadow from the counter light falls: %.3f with, %.3f without\n",
+                i + 1, a, b);
+        T_ASSERTF(a < 0.6f * b, "fighter %d: no shadow away from the counter light: %.3f vs %.3f", i + 1, a, b);
+    }
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
 /* ---- stress: nothing in any buffer is NaN or Inf ---- */
 
 static void check_finite(r_game *r, const char *what)
@@ -685,5 +738,6 @@ T_MAIN({"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"stage_file_keeps_the_matchs_ring", t_stage_file_keeps_the_matchs_ring},
        {"sunless_stage_skips_its_passes", t_sunless_stage_skips_its_passes},
        {"mask_output_alpha", t_mask_output_alpha}, {"low_alpha_lens_shows_the_sun", t_low_alpha_lens_shows_the_sun},
-       {"shadows_darken_the_floor", t_shadows_darken_the_floor}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
+       {"shadows_darken_the_floor", t_shadows_darken_the_floor},
+       {"shadow_follows_the_key_light", t_shadow_follows_the_key_light}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
        {"packed_float_hdr", t_packed_float_hdr})
