@@ -13,6 +13,11 @@
 # T=name (make test T=shader runs tests/test_shader only).
 
 BUILD   ?= build
+# One spelling per directory: BUILD=$(CURDIR)/build (tests/test_cli.sh's
+# install check passes it so) must name the same targets as BUILD=build, or
+# the dependency files written under one spelling are ignored under the
+# other and a changed header leaves stale objects behind.
+override BUILD := $(patsubst $(CURDIR)/%,%,$(BUILD))
 PREFIX  ?= /usr/local
 CC      ?= cc
 OPT     ?= -O2

@@ -194,6 +194,16 @@ int cmd_render(int argc, char **argv)
     r_target t = {0};
     FILE *hf = NULL;
     char hpart[1100] = "";
+    /* Ctrl-C and SIGTERM from here on end the render cleanly (nothing
+     * partial left), also during start-up: the GL context, shaders and the
+     * IBL prefilter can take seconds, and outputs are created before the
+     * first frame.  (A background job of a script starts with SIGINT
+     * ignored; the handler replaces that too.) */
+    stop_requested = 0;
+    struct sigaction sa = {0}, old_int, old_term;
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
     /* everything that can be checked without rendering, first */
     if (!rp_read(replay, &rp, &err))
         goto done;
@@ -240,10 +250,6 @@ int cmd_render(int argc, char **argv)
     rs_progress prog;
     rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet);
     bool ok = true;
-    struct sigaction sa = {0}, old_int, old_term;
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
     for (uint64_t tick = 0; tick < t_first; tick++)
         g_step(&cur, &rp.inputs[2 * tick], NULL);
     for (uint64_t tick = t_first; tick < t_end && ok; tick++) {
@@ -264,8 +270,6 @@ int cmd_render(int argc, char **argv)
         rs_progress_update(&prog, tick + 1 - t_first);
     }
     double secs = rs_progress_end(&prog);
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
     if (passes)
         r_game_report(r, stderr);
     cap_stats st;
@@ -295,6 +299,8 @@ int cmd_render(int argc, char **argv)
                 st.high_water, st.fence_waits);
     status = RS_EXIT_OK;
 done:
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
     if (status != RS_EXIT_OK)
         cli_error("render", "%s", err.msg);
     if (hf)

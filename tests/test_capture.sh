@@ -88,7 +88,10 @@ t_streams_and_signals() {
     "$RS_BIN" record --ai --quiet --seconds 60 --seed 22 -o long.rsr 2>/dev/null || return 1
     "$RS_BIN" render long.rsr -o int.mp4 --quiet 2>err.txt &
     pid=$!
-    sleep 1.5
+    # interrupt once the output exists (slow start-ups under ASan included)
+    n=0
+    while [ ! -e int.mp4.part ] && [ $n -lt 600 ]; do sleep 0.1; n=$((n + 1)); done
+    sleep 0.5
     kill -INT $pid
     wait $pid
     rc=$?
