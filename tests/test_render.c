@@ -535,55 +535,75 @@ static void t_low_alpha_lens_shows_the_sun(void)
     plat_destroy(p);
 }
 
-static void t_shadows_darken_the_floor(void)
+/* Draws the temple at tick 900 with `st` (shadows on, then off) and
+ * checks the floor where each fighter's waist casts along L (towards the
+ * light) is darker with shadows: mean HDR ratio under max_ratio.  The
+ * shadowed frame's mask is left in mask (may be NULL). */
+static void floor_shadow_check(const r_stage *st_in, const float L[3], float max_ratio, float *mask)
 {
-    plat *p = t_context("egl");
     g_state prev, cur;
     state_at("temple", 900, &prev, &cur);
     fb f;
     fb_make(&f);
     r_game *r = game_new(NULL);
     rs_err e = {0};
-    T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
-    r_stage st = *r_game_stage(r);
-    T_ASSERT(st.shadows && st.sun);
+    r_stage st = *st_in;
     static float with[W * H * 4], without[W * H * 4];
     int w, h;
+    st.shadows = true;
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
     draw(r, &f, &prev, &cur, NULL);
     T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
-    /* the fighters shade themselves too: the mask has dark texels */
-    static float mask[W * H * 4];
-    T_ASSERT(r_game_read_buffer(r, "mask", mask, &w, &h));
-    int dark = 0;
-    for (int k = 0; k < W * H; k++)
-        dark += mask[4 * k] < 0.5f;
-    T_ASSERTF(dark > 20, "SSFSM mask: only %d shadowed pixels", dark);
-    T_ASSERTF(mask[0] == 1.0f && mask[4 * (W * H - 1)] == 1.0f, "mask corners %.3f %.3f", mask[0], mask[4 * (W * H - 1)]);
+    if (mask)
+        T_ASSERT(r_game_read_buffer(r, "mask", mask, &w, &h));
     st.shadows = false;
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
     draw(r, &f, &prev, &cur, NULL);
     T_ASSERT(!pass_ran(r, "silhouette") && !pass_ran(r, "shadow_mask"));
     T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
-    /* the floor where each waist's shadow falls (the waist projected along the sun) */
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
         g_capsule c[G_BONES];
         g_fighter_capsules(&cur, i, c);
         fx wx, wy;
         g_skel_waist(c, &wx, &wy);
-        float t = fx_to_float(wy) / st.sun_dir[1];
-        r_vec3 q = r_v3(fx_to_float(wx) - st.sun_dir[0] * t, 0, -st.sun_dir[2] * t);
+        float t = fx_to_float(wy) / L[1];
+        r_vec3 q = r_v3(fx_to_float(wx) - L[0] * t, 0, -L[2] * t);
         float sx, sy;
         T_ASSERT(r_project(vp, q, W, H, &sx, &sy));
         float a = hdr_mean(with, sx, sy, 1), b = hdr_mean(without, sx, sy, 1);
         fprintf(stderr, "    floor in fighter %d's shadow: %.3f with shadows, %.3f without\n", i + 1, a, b);
-        T_ASSERTF(a < 0.8f * b, "fighter %d's shadow does not darken the floor: %.3f vs %.3f", i + 1, a, b);
+        T_ASSERTF(a < max_ratio * b, "fighter %d's shadow does not darken the floor: %.3f vs %.3f", i + 1, a, b);
     }
     /* far from the fighters nothing changes */
     float c0 = hdr_mean(with, 6, 6, 3), c1 = hdr_mean(without, 6, 6, 3);
     T_ASSERTF(fabsf(c0 - c1) <= 0.01f * c1 + 1e-4f, "a far corner changed: %.4f vs %.4f", c0, c1);
     r_game_destroy(r);
     fb_free(&f);
+}
+
+static const r_stage *temple_look(void)
+{
+    static r_stage st;
+    rs_err e = {0};
+    T_ASSERTF(r_stage_load(&st, RS_SOURCE_DIR "/stages/temple.stage", &e), "%s", e.msg);
+    T_ASSERT(st.shadows && st.sun);
+    return &st;
+}
+
+/* The temple's high sun: both techniques darken the floor under the
+ * fighters, and SSFSM shades the fighters themselves. */
+static void t_shadows_darken_the_floor(void)
+{
+    plat *p = t_context("egl");
+    const r_stage *st = temple_look();
+    static float mask[W * H * 4];
+    floor_shadow_check(st, st->sun_dir, 0.8f, mask);
+    int dark = 0;
+    for (int k = 0; k < W * H; k++)
+        dark += mask[4 * k] < 0.5f;
+    T_ASSERTF(dark > 20, "SSFSM mask: only %d shadowed pixels", dark);
+    T_ASSERTF(mask[0] == 1.0f && mask[4 * (W * H - 1)] == 1.0f, "mask corners %.3f %.3f", mask[0], mask[4 * (W * H - 1)]);
     plat_destroy(p);
 }
 
@@ -593,14 +613,7 @@ static void t_shadows_darken_the_floor(void)
 static void t_shadow_follows_the_key_light(void)
 {
     plat *p = t_context("egl");
-    g_state prev, cur;
-    state_at("temple", 900, &prev, &cur);
-    fb f;
-    fb_make(&f);
-    r_game *r = game_new(NULL);
-    rs_err e = {0};
-    T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
-    r_stage st = *r_game_stage(r);
+    r_stage st = *temple_look();
     st.sun = false;
     st.key.intensity = 0;
     const float d[3] = {-0.6f, 0.5f, 0.3f};
@@ -611,32 +624,7 @@ static void t_shadow_follows_the_key_light(void)
     st.counter.size_deg = 10;
     for (int k = 0; k < 3; k++) /* a dim sky, so the counter light is most of the light */
         st.sky_zenith[k] *= 0.05f, st.sky_horizon[k] *= 0.05f, st.ground[k] *= 0.05f;
-    static float with[W * H * 4], without[W * H * 4];
-    int w, h;
-    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, NULL);
-    T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
-    st.shadows = false;
-    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, NULL);
-    T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
-    r_mat4 vp = r_game_camera(&cur, W, H, NULL);
-    for (int i = 0; i < 2; i++) {
-        g_capsule c[G_BONES];
-        g_fighter_capsules(&cur, i, c);
-        fx wx, wy;
-        g_skel_waist(c, &wx, &wy);
-        float t = fx_to_float(wy) / st.counter.dir[1];
-        r_vec3 q = r_v3(fx_to_float(wx) - st.counter.dir[0] * t, 0, -st.counter.dir[2] * t);
-        float sx, sy;
-        T_ASSERT(r_project(vp, q, W, H, &sx, &sy));
-        float a = hdr_mean(with, sx, sy, 1), b = hdr_mean(without, sx, sy, 1);
-        fprintf(stderr, "    floor where fighter %d's shadow from the counter light falls: %.3f with, %.3f without\n",
-                i + 1, a, b);
-        T_ASSERTF(a < 0.6f * b, "fighter %d: no shadow away from the counter light: %.3f vs %.3f", i + 1, a, b);
-    }
-    r_game_destroy(r);
-    fb_free(&f);
+    floor_shadow_check(&st, st.counter.dir, 0.6f, NULL);
     plat_destroy(p);
 }
 
