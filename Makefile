@@ -73,7 +73,7 @@ CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(fil
 LDLIBS  = $(CONF_LIBS) -lstdc++ -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
-LIB_SRC := $(wildcard runtime/*/*.c capture/*.c) \
+LIB_SRC := $(wildcard runtime/*/*.c capture/*.c player/*.c) \
            $(filter-out runtime/main.c,$(wildcard runtime/*.c))
 MAIN_SRC := runtime/main.c
 TEST_SRC := $(wildcard tests/test_*.c)

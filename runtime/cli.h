@@ -36,6 +36,9 @@ int cmd_record(int argc, char **argv);
 int cmd_play(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_replay(int argc, char **argv);
+int cmd_movie(int argc, char **argv);
+int cmd_attract(int argc, char **argv);
+int bench_upload(int argc, char **argv);
 
 /* Exit status for a failed plat_create: 2 for an unknown backend name. */
 struct rs_err;

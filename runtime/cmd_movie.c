@@ -1,0 +1,321 @@
+/* ringside movie: one movie on the 60 Hz tick, in a window or headless.
+ *
+ * Headless (--dump, --hashes or --headless) plays every tick as fast as
+ * possible and waits for the decoder, so the output is exact: the frames
+ * the display would have shown, tick by tick.  That is what the colour and
+ * pacing tests read. */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../capture/cap_writer.h"
+#include "../player/mv_csp.h"
+#include "../player/mv_player.h"
+#include "cli.h"
+#include "gl/rgl.h"
+#include "input.h"
+#include "loop.h"
+#include "platform/plat.h"
+#include "render/r_target.h"
+#include "util/rs_file.h"
+#include "util/rs_img.h"
+
+static void help(void)
+{
+    printf("usage: ringside movie FILE [--dump DIR] [--hashes FILE] [--headless] [--ticks N]\n"
+           "                      [--upload pbo|direct|persistent] [--matrix bt601|bt709]\n"
+           "                      [--range limited|full] [--size WxH] [--fullscreen] [--loop] [--quiet]\n\n"
+           "Plays a movie on the 60 Hz tick: Y4M (8-bit 4:2:0, 4:2:2, 4:4:4, mono) or anything\n"
+           "FFmpeg decodes (H.264, VP9, AV1, ...).  Frames are decoded on their own thread,\n"
+           "streamed into Y, Cb, Cr textures and converted with the stream's matrix and range.\n"
+           "A 24 fps movie shows its frames for 2 and 3 ticks in turn; 30 fps for 2 (docs/player.md).\n"
+           "In a window (GLFW; needs X, or xvfb-run -a) Escape quits.\n\n"
+           "  --dump DIR      headless: write each displayed frame as DIR/frameNNNNNN.ppm (NNNNNN is\n"
+           "                  the movie frame number)\n"
+           "  --hashes FILE   headless: one line per tick: TICK FRAME HASH (FNV-1a of the RGB image)\n"
+           "  --headless      no window: EGL/OSMesa, every tick as fast as possible\n"
+           "  --ticks N       stop after N ticks (default: the end of the movie)\n"
+           "  --upload MODE   pbo (two unpack buffers in ping-pong; default), direct (glTexSubImage2D\n"
+           "                  from memory) or persistent (a mapped ring the decoder writes into)\n"
+           "  --matrix M      override the stream's YCbCr matrix: bt601 or bt709\n"
+           "  --range R       override the stream's range: limited or full\n"
+           "  --size WxH      output size (default: the movie's display size)\n"
+           "  --fullscreen    window: primary monitor\n"
+           "  --loop          window: start again at the end (Escape quits)\n"
+           "  --quiet         no summary line\n");
+}
+
+typedef struct mv_cmd {
+    const char *path;
+    mv_player_opts po;
+    mv_player *mp;
+    plat *p;
+    r_target target;
+    int w, h;
+    bool headless, loop, failed, quit;
+    int64_t limit, ticks, last_dumped;
+    const char *dump;
+    FILE *hashes;
+    uint8_t *px;
+    int ended; /* tick returned 0 */
+    rs_err err;
+} mv_cmd;
+
+static void on_input(void *user, g_input in[2])
+{
+    (void)user;
+    in[0] = in[1] = 0;
+}
+
+static void on_step(void *user, const g_input in[2])
+{
+    (void)in;
+    mv_cmd *s = user;
+    int r = mv_player_tick(s->mp, &s->err);
+    if (r < 0) {
+        s->failed = true;
+        return;
+    }
+    if (r == 0) {
+        if (s->loop && !s->headless) {
+            mv_player_close(s->mp);
+            if (!(s->mp = mv_player_open(s->path, &s->po, &s->err))) {
+                s->failed = true;
+                return;
+            }
+            if (mv_player_tick(s->mp, &s->err) < 0)
+                s->failed = true;
+            return;
+        }
+        s->ended = 1;
+        return;
+    }
+    s->ticks++;
+}
+
+static bool write_outputs(mv_cmd *s)
+{
+    int64_t tick = s->ticks - 1, frame = mv_player_frame(s->mp);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, s->target.fbo);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, s->w, s->h, GL_RGB, GL_UNSIGNED_BYTE, s->px);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    rs_flip_rows(s->px, s->w, s->h, 3);
+    if (s->hashes)
+        fprintf(s->hashes, "%" PRId64 " %" PRId64 " %016" PRIx64 "\n", tick, frame,
+                cap_frame_hash(s->px, (size_t)s->w * s->h * 3));
+    if (s->dump && frame >= 0 && frame != s->last_dumped) {
+        char path[1100];
+        snprintf(path, sizeof path, "%s/frame%06" PRId64 ".ppm", s->dump, frame);
+        if (!rs_image_write(path, s->w, s->h, 3, s->px, &s->err))
+            return false;
+        s->last_dumped = frame;
+    }
+    return true;
+}
+
+static void on_render(void *user, float alpha)
+{
+    (void)alpha;
+    mv_cmd *s = user;
+    if (s->failed || s->ended)
+        return;
+    int w = s->w, h = s->h;
+    if (plat_window(s->p))
+        plat_size(s->p, &w, &h);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
+    if (w > 0 && h > 0)
+        mv_player_draw(s->mp, w, h);
+    if (s->headless && s->ticks > 0 && (s->dump || s->hashes) && !write_outputs(s))
+        s->failed = true;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    plat_present(s->p);
+}
+
+static bool on_running(void *user)
+{
+    mv_cmd *s = user;
+    if (s->failed || s->ended || s->quit)
+        return false;
+    if (plat_window(s->p) && (!plat_poll(s->p) || in_quit(plat_window(s->p)))) {
+        s->quit = true;
+        return false;
+    }
+    return !s->limit || s->ticks < s->limit;
+}
+
+static const char *siting_name(int loc)
+{
+    return loc == MV_CHROMA_CENTER ? "centre" : loc == MV_CHROMA_LEFT ? "left" : "top-left";
+}
+
+static void summary(mv_cmd *s, const lp_stats *ls)
+{
+    const mv_info *i = mv_player_info(s->mp);
+    mv_stats st;
+    mv_player_stats(s->mp, &st);
+    char frames[32] = "?";
+    if (i->frames >= 0)
+        snprintf(frames, sizeof frames, "%" PRId64, i->frames);
+    fprintf(stderr,
+            "ringside movie: %s: %s %s %dx%d, %s%s %s range, chroma %s, %d/%d fps, %s frames\n"
+            "ringside movie: %" PRId64 " ticks in %.1f s: %" PRId64 " frames shown, %" PRId64
+            " repeated (cadence), %" PRId64 " late, %" PRId64 " dropped\n"
+            "ringside movie: upload %s: %.3f ms copy + %.3f ms GL per frame (%" PRId64
+            " staged a tick ahead); decode %.2f ms per frame\n",
+            s->path, i->codec, i->pixfmt, i->w, i->h, mv_matrix_name(i->matrix), i->matrix_guessed ? " (guessed)" : "",
+            i->full_range ? "full" : "limited", i->mono ? "none" : siting_name(i->chroma_loc), i->fps_num, i->fps_den,
+            frames, st.ticks, ls->seconds, st.shown, st.repeats, st.late, st.dropped, mv_up_name(mv_player_upload(s->mp)),
+            st.up.uploads ? st.up.copy_ms / (double)st.up.uploads : 0.0,
+            st.up.uploads ? st.up.upload_ms / (double)st.up.uploads : 0.0, st.up.staged,
+            st.decoded ? st.decode_ms / (double)st.decoded : 0.0);
+}
+
+int cmd_movie(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"dump", required_argument, 0, 'd'},    {"hashes", required_argument, 0, 'x'},
+        {"headless", no_argument, 0, 'H'},      {"ticks", required_argument, 0, 'n'},
+        {"upload", required_argument, 0, 'u'},  {"matrix", required_argument, 0, 'm'},
+        {"range", required_argument, 0, 'r'},   {"size", required_argument, 0, 'z'},
+        {"fullscreen", no_argument, 0, 'f'},    {"loop", no_argument, 0, 'L'},
+        {"quiet", no_argument, 0, 'q'},         {"help", no_argument, 0, 'h'},
+        {0}};
+    mv_cmd *s = calloc(1, sizeof *s);
+    if (!s)
+        return RS_EXIT_FAIL;
+    s->last_dumped = -1;
+    int c, status = RS_EXIT_USAGE;
+    long n;
+    bool quiet = false;
+    const char *hashes = NULL;
+    plat_desc pd = {.title = "ringside movie"};
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'd': s->dump = optarg; s->headless = true; break;
+        case 'x': hashes = optarg; s->headless = true; break;
+        case 'H': s->headless = true; break;
+        case 'n':
+            if (!cli_int("--ticks", optarg, 1, 1L << 40, &n))
+                goto done;
+            s->limit = n;
+            break;
+        case 'u':
+            if ((s->po.upload = mv_up_parse(optarg)) < 0) {
+                cli_error("movie", "--upload '%s': expected pbo, direct or persistent", optarg);
+                goto done;
+            }
+            break;
+        case 'm':
+            if (!strcmp(optarg, "bt601") || !strcmp(optarg, "601"))
+                s->po.matrix = MV_OVERRIDE_601;
+            else if (!strcmp(optarg, "bt709") || !strcmp(optarg, "709"))
+                s->po.matrix = MV_OVERRIDE_709;
+            else {
+                cli_error("movie", "--matrix '%s': expected bt601 or bt709", optarg);
+                goto done;
+            }
+            break;
+        case 'r':
+            if (!strcmp(optarg, "limited") || !strcmp(optarg, "tv"))
+                s->po.range = MV_OVERRIDE_LIMITED;
+            else if (!strcmp(optarg, "full") || !strcmp(optarg, "pc"))
+                s->po.range = MV_OVERRIDE_FULL;
+            else {
+                cli_error("movie", "--range '%s': expected limited or full", optarg);
+                goto done;
+            }
+            break;
+        case 'z': if (!cli_size("--size", optarg, 8192, &s->w, &s->h)) goto done; break;
+        case 'f': pd.fullscreen = true; break;
+        case 'L': s->loop = true; break;
+        case 'q': quiet = true; break;
+        case 'h': help(); status = RS_EXIT_OK; goto done;
+        default:
+            cli_error("movie", "bad option or missing value '%s'", argv[optind - 1]);
+            status = cli_usage_error("movie");
+            goto done;
+        }
+    }
+    if (optind != argc - 1) {
+        cli_error("movie", optind >= argc ? "no movie file given" : "unexpected argument '%s'",
+                  optind < argc ? argv[optind + 1] : "");
+        status = cli_usage_error("movie");
+        goto done;
+    }
+    s->path = argv[optind];
+    s->po.wait = s->headless;
+    status = RS_EXIT_FAIL;
+    if (s->dump) {
+        char probe[1100];
+        snprintf(probe, sizeof probe, "%s/.", s->dump);
+        if (!rs_mkdirs_for(probe, &s->err))
+            goto done;
+    }
+    if (hashes) {
+        if (!rs_mkdirs_for(hashes, &s->err))
+            goto done;
+        if (!(s->hashes = fopen(hashes, "w"))) {
+            rs_fail(&s->err, 1, "%s: cannot write: %s", hashes, strerror(errno));
+            goto done;
+        }
+    }
+    pd.backend = s->headless ? NULL : "glfw";
+    pd.width = s->w ? s->w : 1280;
+    pd.height = s->h ? s->h : 720;
+    if (!(s->p = plat_create(&pd, &s->err))) {
+        status = cli_plat_status(&s->err);
+        goto done;
+    }
+    if (!(s->mp = mv_player_open(s->path, &s->po, &s->err)))
+        goto done;
+    if (!s->w) {
+        const mv_info *i = mv_player_info(s->mp);
+        s->w = (int)((double)i->w * i->sar_num / i->sar_den + 0.5);
+        s->h = i->h;
+        if (s->w < 1 || s->w > 16384)
+            s->w = i->w;
+    }
+    if (s->headless) {
+        if (!r_target_create(&s->target, s->w, s->h, &s->err))
+            goto done;
+        if (!(s->px = malloc((size_t)s->w * s->h * 3))) {
+            rs_fail(&s->err, 1, "out of memory for a %dx%d frame", s->w, s->h);
+            goto done;
+        }
+    }
+    lp_game g = {s, on_input, on_step, on_render, on_running};
+    lp_stats ls;
+    lp_run(&(lp_desc){.headless = s->headless}, &g, &ls);
+    if (!quiet)
+        summary(s, &ls);
+    if (s->failed)
+        goto done;
+    if (s->hashes) {
+        int e = ferror(s->hashes) | fclose(s->hashes);
+        s->hashes = NULL;
+        if (e) {
+            rs_fail(&s->err, 1, "%s: write failed", hashes);
+            goto done;
+        }
+    }
+    status = RS_EXIT_OK;
+done:
+    if (status == RS_EXIT_FAIL && s->err.msg[0])
+        cli_error("movie", "%s", s->err.msg);
+    if (s->hashes)
+        fclose(s->hashes);
+    if (s->p) {
+        mv_player_close(s->mp);
+        r_target_destroy(&s->target);
+        plat_destroy(s->p);
+    }
+    free(s->px);
+    free(s);
+    return status;
+}
