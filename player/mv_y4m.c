@@ -402,7 +402,7 @@ static int frame_header(y4m_src *s)
     char line[FRAME_HDR_MAX];
     size_t n;
     const char *path = s->base.path;
-    long long no = (long long)s->base.index + 1;
+    long long no = (long long)s->base.index; /* 0-based, as --dump and --hashes number frames */
     int r = read_line(s->f, line, sizeof line, &n);
     if (r < 0)
         return read_fail(s, MV_ERR_OPEN, "%s: frame %lld: read error: %s", path, no, strerror(errno));
@@ -425,7 +425,7 @@ static int frame_data(y4m_src *s, uint8_t *dst)
 {
     size_t want = mv_frame_bytes(&s->base.info);
     size_t got = fread(dst, 1, want, s->f);
-    long long no = (long long)s->base.index + 1;
+    long long no = (long long)s->base.index; /* 0-based, as --dump and --hashes number frames */
     if (got == want)
         return 1;
     if (ferror(s->f))

@@ -265,6 +265,11 @@ int cmd_movie(int argc, char **argv)
             goto done;
         }
     }
+    /* A file we cannot play is reported as such, before any window opens. */
+    mv_src *probe = mv_open(s->path, &s->err);
+    if (!probe)
+        goto done;
+    mv_close(probe);
     pd.backend = s->headless ? NULL : "glfw";
     pd.width = s->w ? s->w : 1280;
     pd.height = s->h ? s->h : 720;

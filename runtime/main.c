@@ -14,6 +14,7 @@ static const cli_cmd commands[] = {
     {"play", cmd_play, "play in a window (or watch a replay), fixed 60 Hz"},
     {"render", cmd_render, "render a replay to a video (.y4m, .mp4, ...), headless"},
     {"record", cmd_record, "record a CPU-vs-CPU match headless to a replay"},
+    {"attract", cmd_attract, "the cabinet's attract loop: movies and demos until a button starts a match"},
     {"movie", cmd_movie, "play a movie (Y4M or anything FFmpeg decodes) on the 60 Hz tick"},
     {"replay", cmd_replay, "replay info FILE, replay verify FILE"},
     {"bench", cmd_bench, "run a benchmark (bench platform, bench sim)"},

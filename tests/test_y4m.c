@@ -497,17 +497,17 @@ static void t_file_empty_stream(void)
 static void t_file_truncated_data(void)
 {
     buf b = small_file(3, NULL);
-    size_t cut = strlen(SMALL_HDR) + 6 + SMALL_FRAME + 6 + 10; /* 10 bytes into frame 2 */
+    size_t cut = strlen(SMALL_HDR) + 6 + SMALL_FRAME + 6 + 10; /* 10 bytes into frame 1 (0-based) */
     const char *p = write_file("cut.y4m", b.p, cut);
     mv_src *s = open_ok(p);
     T_EQ(s->info.frames, -1);
     read_small(s, 0);
-    read_fails(s, MV_ERR_TRUNCATED, "frame 2 truncated (got 10 of 27 bytes)");
+    read_fails(s, MV_ERR_TRUNCATED, "frame 1 truncated (got 10 of 27 bytes)");
     mv_close(s);
     /* cut right after the frame header: no data at all */
     p = write_file("cut0.y4m", b.p, strlen(SMALL_HDR) + 6);
     s = open_ok(p);
-    read_fails(s, MV_ERR_TRUNCATED, "frame 1 truncated (got 0 of 27 bytes)");
+    read_fails(s, MV_ERR_TRUNCATED, "frame 0 truncated (got 0 of 27 bytes)");
     mv_close(s);
     free(b.p);
     out_done();
@@ -523,7 +523,7 @@ static void t_file_truncated_header(void)
         const char *p = write_file("cuthdr.y4m", b.p, cuts[k]);
         mv_src *s = open_ok(p);
         read_small(s, 0);
-        read_fails(s, MV_ERR_TRUNCATED, "frame 2 truncated");
+        read_fails(s, MV_ERR_TRUNCATED, "frame 1 truncated");
         mv_close(s);
     }
     free(b.p);
@@ -539,7 +539,7 @@ static void t_file_bad_frame_header(void)
         const char *p = write_file("bad.y4m", b.p, b.n);
         mv_src *s = open_ok(p);
         read_small(s, 0);
-        read_fails(s, MV_ERR_FORMAT, "frame 2: bad frame header");
+        read_fails(s, MV_ERR_FORMAT, "frame 1: bad frame header");
         mv_close(s);
         free(b.p);
     }
@@ -557,7 +557,7 @@ static void t_file_bad_frame_header(void)
     strcpy(line + 1024, "\n");
     b = small_file(1, hdrs);
     s = open_ok(write_file("long.y4m", b.p, b.n));
-    read_fails(s, MV_ERR_FORMAT, "frame 1: bad frame header");
+    read_fails(s, MV_ERR_FORMAT, "frame 0: bad frame header");
     mv_close(s);
     free(b.p);
     out_done();
