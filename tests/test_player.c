@@ -25,6 +25,7 @@
 #include "../player/mv_dec.h"
 #include "../player/mv_player.h"
 #include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
 #include "../runtime/render/r_target.h"
 #include "t.h"
 
@@ -325,7 +326,7 @@ static void check_case(const ccase *cc)
     T_ASSERT(run(cmd));
 
     /* ours */
-    t_context("egl");
+    struct plat *ctx = t_context("egl");
     rs_err err = {0};
     mv_player_opts o = {.wait = true};
     if (!strcmp(cc->codec, "y4m")) /* Y4M has no matrix tag: say it */
@@ -457,6 +458,7 @@ static void check_case(const ccase *cc)
     free(ours);
     r_target_destroy(&tg);
     mv_player_close(mp);
+    plat_destroy(ctx);
 }
 
 #define CASE(n, codec, pf, w, h, m, full)                                                \
