@@ -152,6 +152,15 @@ t_attract_window_xvfb() {
         grep -q "no input for 2 s: back to the attract loop" e.txt || return 1
 }
 
-t_run pacing_24fps pacing_30_and_60 upload_paths_agree bad_files attract_headless attract_match_over attract_nothing_playable \
+t_bench_upload() {
+    "$RS_BIN" bench upload --frames 8 --runs 1 --size 320x192 --csv b.csv >o.txt 2>e.txt || { cat o.txt e.txt; return 1; }
+    for m in direct pbo persistent; do
+        grep -q "^$m " o.txt || { echo "no $m row"; cat o.txt; return 1; }
+    done
+    [ "$(wc -l <b.csv)" = 4 ] || { cat b.csv; return 1; }
+    expect_fail 2 "unknown mode 'warp'" "$RS_BIN" bench upload --modes direct,warp || return 1
+}
+
+t_run bench_upload pacing_24fps pacing_30_and_60 upload_paths_agree bad_files attract_headless attract_match_over attract_nothing_playable \
     attract_usage attract_window_xvfb
 t_done
