@@ -176,6 +176,7 @@ bench: $(BUILD)/ringside
 	$(BUILD)/ringside bench platform --csv out/bench-platform.csv
 	$(BUILD)/ringside bench sim --csv out/bench-sim.csv
 	$(BUILD)/ringside bench capture --csv out/bench-capture.csv --chart out/bench-capture.png
+	$(BUILD)/ringside bench upload --csv out/bench-upload.csv
 
 # The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
 # same commands must reproduce them byte for byte (tests/test_replay.sh).
