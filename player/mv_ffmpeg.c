@@ -7,8 +7,8 @@
  * component by its descriptor and rounds it to 8 bits.  RGB, paletted,
  * alpha and hardware formats are refused with the format's name.
  *
- * The matrix, range and chroma siting come from the stream (codec
- * parameters, then each frame); unspecified matrix -> guessed by size as
+ * The matrix, range and chroma siting come from the stream's codec
+ * parameters (a frame that changes size or format is an error); unspecified matrix -> guessed by size as
  * mpv does, unspecified range -> limited, unspecified siting -> left (the
  * MPEG-2/H.264 default). */
 #include <stdlib.h>
@@ -43,6 +43,7 @@ typedef struct ff_src {
     bool fast;     /* 8-bit planar: row copies */
     bool draining; /* the demuxer ended; the decoder is being flushed */
     bool ended;
+    bool cut_short; /* the demuxer met the end of the file inside a packet */
     int bad_packets; /* consecutive packets the decoder refused */
 } ff_src;
 
@@ -171,10 +172,13 @@ static int ff_read(mv_src *base, uint8_t *dst, rs_err *err)
             return 1;
         }
         if (r == AVERROR_EOF) {
+            /* nb_frames counts packets (an edit list may hide some), so a
+             * short count is no error; a file cut short is, and the demuxer
+             * says so with an I/O error at the end of the file. */
             s->ended = true;
-            if (base->info.frames > 0 && base->index < base->info.frames) {
-                rs_fail(err, MV_ERR_TRUNCATED, "%s: stream ended at frame %lld of %lld (truncated?)", base->path,
-                        (long long)base->index, (long long)base->info.frames);
+            if (s->cut_short) {
+                rs_fail(err, MV_ERR_TRUNCATED, "%s: the file ends inside frame %lld (truncated)", base->path,
+                        (long long)base->index);
                 return -1;
             }
             return 0;
@@ -192,6 +196,7 @@ static int ff_read(mv_src *base, uint8_t *dst, rs_err *err)
         for (;;) {
             r = av_read_frame(s->fmt, s->pkt);
             if (r == AVERROR_EOF || (r == AVERROR(EIO) && s->fmt->pb && avio_feof(s->fmt->pb))) {
+                s->cut_short = r != AVERROR_EOF;
                 s->draining = true;
                 avcodec_send_packet(s->dec, NULL);
                 break;
@@ -276,6 +281,7 @@ mv_src *mv_ffmpeg_open(const char *path, rs_err *err)
         rs_fail(err, MV_ERR_NOMEM, "%s: out of memory", path);
         goto fail;
     }
+    s->dec->thread_count = 0; /* as many as the machine has: HD H.264 must keep up with 60 Hz */
     if ((r = avcodec_parameters_to_context(s->dec, cp)) < 0 || (r = avcodec_open2(s->dec, codec, NULL)) < 0) {
         rs_fail(err, MV_ERR_UNSUPPORTED, "%s: cannot open the %s decoder: %s", path, codec->name, av_msg(r, m, sizeof m));
         goto fail;

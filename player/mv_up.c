@@ -68,6 +68,11 @@ mv_up *mv_up_create(const mv_info *info, int mode, int nslots, rs_err *err)
                 glcaps.major, glcaps.minor);
         return NULL;
     }
+    if (info->w > glcaps.max_texture_size || info->h > glcaps.max_texture_size) {
+        rs_fail(err, MV_ERR_UNSUPPORTED, "%dx%d frames are larger than this GL's textures (%d)", info->w, info->h,
+                glcaps.max_texture_size);
+        return NULL;
+    }
     mv_up *u = calloc(1, sizeof *u);
     if (!u) {
         rs_fail(err, MV_ERR_NOMEM, "upload: out of memory");

@@ -14,7 +14,7 @@
  * padding.  That is the layout mv_src delivers, so a frame is one fread
  * straight into the destination, which may be mapped GPU memory.
  *
- * Errors name the file and number frames from 1 ("frame 1" is the first). */
+ * Errors name the file and number frames from 0, as --dump and --hashes do. */
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>

@@ -3,7 +3,7 @@
  * Loops the movies and demo replays given (in command-line order) until a
  * player presses a button; then a match, that player against the CPU.
  * When the match is over, or nobody has touched the controls for --idle
- * seconds, back to the loop where it left off.  A movie or replay that
+ * seconds, back to the loop, with the item after the one interrupted.  A movie or replay that
  * cannot be opened or breaks mid-way is logged once and skipped from then
  * on; with nothing playable left the loop shows CPU-vs-CPU matches.  The
  * loop never stops on a bad file: only Escape (or --ticks) ends it.
@@ -347,6 +347,9 @@ static void on_step(void *user, const g_input in[2])
             int r = mv_player_tick(a->mp, &e);
             if (r < 0) {
                 logf_(a, "skipping %s from now on: %s", a->items[a->cur].path, e.msg);
+                a->items[a->cur].bad = true;
+            } else if (r == 0 && mv_player_frame(a->mp) < 0) {
+                logf_(a, "skipping %s from now on: it has no frames", a->items[a->cur].path);
                 a->items[a->cur].bad = true;
             }
             if (r <= 0 && !loop_next(a))

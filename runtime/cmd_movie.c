@@ -80,7 +80,7 @@ static void on_step(void *user, const g_input in[2])
         return;
     }
     if (r == 0) {
-        if (s->loop && !s->headless) {
+        if (s->loop && !s->headless && mv_player_frame(s->mp) >= 0) {
             mv_player_close(s->mp);
             if (!(s->mp = mv_player_open(s->path, &s->po, &s->err))) {
                 s->failed = true;
@@ -297,7 +297,7 @@ int cmd_movie(int argc, char **argv)
     lp_game g = {s, on_input, on_step, on_render, on_running};
     lp_stats ls;
     lp_run(&(lp_desc){.headless = s->headless}, &g, &ls);
-    if (!quiet)
+    if (!quiet && s->mp)
         summary(s, &ls);
     if (s->failed)
         goto done;

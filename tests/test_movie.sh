@@ -75,6 +75,11 @@ t_bad_files() {
     expect_fail 1 "rgb.mkv: pixel format bgr0 is not played" "$RS_BIN" movie rgb.mkv || return 1
     printf 'YUV4MPEG2 W64 H48 F30:1 C420p10\nFRAME\n' >deep.y4m
     expect_fail 1 "deep.y4m: .*(10|bit)" "$RS_BIN" movie deep.y4m || return 1
+    # an MP4 whose container counts more frames than its edit list shows
+    # plays to its end without an error
+    clip long.mp4 30 60 64x48 -pix_fmt yuv420p -c:v libx264 -preset ultrafast -g 10 || return 1
+    ffmpeg -nostdin -hide_banner -loglevel error -y -ss 0.5 -i long.mp4 -c copy edit.mp4 || return 1
+    "$RS_BIN" movie edit.mp4 --hashes e.txt -q || { echo "a clean edit-list MP4 failed"; return 1; }
     expect_fail 2 "--upload 'fast': expected pbo, direct or persistent" "$RS_BIN" movie c.y4m --upload fast || return 1
     expect_fail 2 "no movie file given" "$RS_BIN" movie || return 1
 }
@@ -116,6 +121,10 @@ t_attract_match_over() {
 }
 
 t_attract_nothing_playable() {
+    printf 'YUV4MPEG2 W64 H48 F30:1\n' >empty.y4m # a movie without a frame is broken too
+    "$RS_BIN" attract empty.y4m --headless --ticks 30 --size 64x36 2>e0.txt || { cat e0.txt; return 1; }
+    [ "$(grep -c "movie empty.y4m" e0.txt)" = 1 ] || { echo "empty.y4m reopened"; cat e0.txt; return 1; }
+    grep -q "skipping empty.y4m from now on: it has no frames" e0.txt || { cat e0.txt; return 1; }
     printf 'x' >bad.mp4
     "$RS_BIN" attract bad.mp4 --headless --ticks 30 --size 64x36 2>e.txt || { cat e.txt; return 1; }
     grep -q "skipping bad.mp4" e.txt && grep -q "nothing playable: a CPU-vs-CPU match" e.txt || { cat e.txt; return 1; }
