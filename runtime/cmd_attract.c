@@ -444,14 +444,8 @@ static bool screenshot(attract *a, const char *path)
         return rs_fail(&a->err, 1, "out of memory for a %dx%d screenshot", w, h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, a->target.fbo);
     draw(a, 1.0f, w, h);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, a->target.fbo);
-    if (!a->target.fbo)
-        gl.ReadBuffer(GL_BACK);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.ReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, px);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    r_read_pixels(a->target.fbo, w, h, 3, px);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    rs_flip_rows(px, w, h, 3);
     bool ok = rs_mkdirs_for(path, &a->err) && rs_image_write(path, w, h, 3, px, &a->err);
     free(px);
     return ok;

@@ -99,11 +99,7 @@ static void on_step(void *user, const g_input in[2])
 static bool write_outputs(mv_cmd *s)
 {
     int64_t tick = s->ticks - 1, frame = mv_player_frame(s->mp);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, s->target.fbo);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.ReadPixels(0, 0, s->w, s->h, GL_RGB, GL_UNSIGNED_BYTE, s->px);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    rs_flip_rows(s->px, s->w, s->h, 3);
+    r_read_pixels(s->target.fbo, s->w, s->h, 3, s->px);
     if (s->hashes)
         fprintf(s->hashes, "%" PRId64 " %" PRId64 " %016" PRIx64 "\n", tick, frame,
                 cap_frame_hash(s->px, (size_t)s->w * s->h * 3));

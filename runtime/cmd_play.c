@@ -128,14 +128,8 @@ static bool screenshot(play *s, const char *path, rs_err *err)
         return rs_fail(err, 1, "out of memory for a %dx%d screenshot", w, h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
     r_game_draw(s->r, &s->prev, &s->cur, 1.0f, w, h);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, s->target.fbo);
-    if (!s->target.fbo)
-        gl.ReadBuffer(GL_BACK);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    r_read_pixels(s->target.fbo, w, h, 4, px);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    rs_flip_rows(px, w, h, 4);
     bool ok = rs_mkdirs_for(path, err) && rs_image_write(path, w, h, 4, px, err);
     free(px);
     return ok;

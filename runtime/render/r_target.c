@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "../util/rs_img.h"
+
 bool r_target_create(r_target *t, int w, int h, rs_err *err)
 {
     memset(t, 0, sizeof *t);
@@ -39,4 +41,16 @@ void r_target_destroy(r_target *t)
     if (t->depth)
         gl.DeleteRenderbuffers(1, &t->depth);
     memset(t, 0, sizeof *t);
+}
+
+void r_read_pixels(GLuint fbo, int w, int h, int channels, uint8_t *px)
+{
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    if (!fbo)
+        gl.ReadBuffer(GL_BACK);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, w, h, channels == 3 ? GL_RGB : GL_RGBA, GL_UNSIGNED_BYTE, px);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    rs_flip_rows(px, w, h, channels);
 }
