@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../capture/cap.h"
@@ -54,7 +55,13 @@ static void help(void)
            "  --ticks A:B        write only ticks A to B-1 (the game still runs from tick 0,\n"
            "                     so frame A is the same as in a full render; image names and\n"
            "                     --hashes lines are numbered A..B-1)\n"
-           "  --quiet            no progress line\n",
+           "  --progress-fd N    also report progress on file descriptor N, for programs\n"
+           "                     (ringside serve): 'frames DONE TOTAL' lines, and 'desync TICK'\n"
+           "                     if the replay's state hashes stop matching\n"
+           "  --quiet            no progress line\n"
+           "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
+           "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
+           "tick that differs, and nothing is written.\n",
            cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
 }
 
@@ -68,6 +75,41 @@ static void on_signal(int sig)
     stop_requested = 1;
 }
 
+/* The replay's own proof: after `done` ticks, the state hash must match
+ * the checkpoint (every interval ticks) and, at the end, the final hash. */
+static bool check_sync(const rp_replay *rp, const g_state *st, uint64_t done, size_t *next, const char *name,
+                       uint64_t *desync, rs_err *err)
+{
+    bool at_check = done % (uint64_t)rp->interval == 0 && *next < rp->ncheck;
+    bool last = done == rp->ticks;
+    if (!at_check && !last)
+        return true;
+    uint64_t h = g_hash(st), want = at_check ? rp->checkpoints[(*next)++] : rp->final_hash;
+    if (h == want && (!last || h == rp->final_hash))
+        return true;
+    if (h == want)
+        want = rp->final_hash;
+    *desync = done;
+    return rs_fail(err, RP_ERR_DESYNC,
+                   "%s: desync at tick %" PRIu64 ": the game's state hash %016" PRIx64 " is not the replay's %016" PRIx64
+                   " (its inputs no longer reproduce the recorded match); nothing written",
+                   name, done, h, want);
+}
+
+/* --progress-fd: machine-readable progress, at most 4 lines a second. */
+static void report_progress(int fd, uint64_t done, uint64_t total, double *last)
+{
+    if (fd < 0)
+        return;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    double now = (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+    if (done < total && now - *last < 0.25)
+        return;
+    *last = now;
+    dprintf(fd, "frames %" PRIu64 " %" PRIu64 "\n", done, total);
+}
+
 int cmd_render(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -79,13 +121,15 @@ int cmd_render(int argc, char **argv)
         {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
         {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
         {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
-        {"ticks", required_argument, 0, 'K'},      {"help", no_argument, 0, 'h'},             {0}};
+        {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
+        {"help", no_argument, 0, 'h'},             {0}};
     const char *out = NULL, *hashes = NULL, *backend = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
     r_game_opts go = {.hdr_format = -1};
     int passes = 0; /* 1 summary, 2 per frame */
     long first = 0, end = -1; /* --ticks; end -1: the whole replay */
+    long progress_fd = -1;
     long v;
     int c;
     optind = 1;
@@ -158,6 +202,7 @@ int cmd_render(int argc, char **argv)
         case 'H': hashes = optarg; break;
         case 'b': backend = optarg; break;
         case 'q': quiet = true; break;
+        case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
         default:
             cli_error("render", "bad option or missing value '%s'", argv[optind - 1]);
@@ -250,8 +295,14 @@ int cmd_render(int argc, char **argv)
     rs_progress prog;
     rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet);
     bool ok = true;
-    for (uint64_t tick = 0; tick < t_first; tick++)
+    size_t next_check = 0;
+    uint64_t desync_at = 0;
+    double last_report = 0;
+    report_progress((int)progress_fd, 0, t_end - t_first, &last_report);
+    for (uint64_t tick = 0; tick < t_first && ok; tick++) {
         g_step(&cur, &rp.inputs[2 * tick], NULL);
+        ok = check_sync(&rp, &cur, tick + 1, &next_check, replay, &desync_at, &err);
+    }
     for (uint64_t tick = t_first; tick < t_end && ok; tick++) {
         if (stop_requested) {
             ok = false;
@@ -261,6 +312,8 @@ int cmd_render(int argc, char **argv)
         }
         prev = cur;
         g_step(&cur, &rp.inputs[2 * tick], NULL);
+        if (!(ok = check_sync(&rp, &cur, tick + 1, &next_check, replay, &desync_at, &err)))
+            break;
         gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
         ok = r_game_draw(r, &prev, &cur, 1.0f, cd.src_w, cd.src_h);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -268,7 +321,10 @@ int cmd_render(int argc, char **argv)
             rs_fail(&err, 1, "frame %" PRIu64 ": %s", tick, r_game_error(r));
         ok = ok && cap_frame(cp, t.tex, &err);
         rs_progress_update(&prog, tick + 1 - t_first);
+        report_progress((int)progress_fd, tick + 1 - t_first, t_end - t_first, &last_report);
     }
+    if (desync_at && progress_fd >= 0)
+        dprintf((int)progress_fd, "desync %" PRIu64 "\n", desync_at);
     double secs = rs_progress_end(&prog);
     if (passes)
         r_game_report(r, stderr);
