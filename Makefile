@@ -73,7 +73,7 @@ CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(fil
 LDLIBS  = $(CONF_LIBS) -lstdc++ -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
-LIB_SRC := $(wildcard runtime/*/*.c capture/*.c player/*.c) \
+LIB_SRC := $(wildcard runtime/*/*.c capture/*.c player/*.c service/*.c) \
            $(filter-out runtime/main.c,$(wildcard runtime/*.c))
 MAIN_SRC := runtime/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
@@ -95,6 +95,8 @@ $(STAMPS)/build: tools/deps.sh
 	@tools/deps.sh build
 $(STAMPS)/test: tools/deps.sh
 	@tools/deps.sh test
+$(STAMPS)/service: tools/deps.sh
+	@tools/deps.sh service
 deps: $(STAMPS)/build $(STAMPS)/test
 
 $(BUILD)/config.mk: tools/configure.sh $(STAMPS)/build

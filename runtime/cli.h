@@ -39,6 +39,7 @@ int cmd_replay(int argc, char **argv);
 int cmd_movie(int argc, char **argv);
 int cmd_attract(int argc, char **argv);
 int bench_upload(int argc, char **argv);
+int cmd_serve(int argc, char **argv);
 
 /* Exit status for a failed plat_create: 2 for an unknown backend name. */
 struct rs_err;

@@ -17,6 +17,7 @@ static const cli_cmd commands[] = {
     {"attract", cmd_attract, "the cabinet's attract loop: movies and demos until a button starts a match"},
     {"movie", cmd_movie, "play a movie (Y4M or anything FFmpeg decodes) on the 60 Hz tick"},
     {"replay", cmd_replay, "replay info FILE, replay verify FILE"},
+    {"serve", cmd_serve, "the replay-to-video daemon: HTTP API, dashboard, queue, workers"},
     {"bench", cmd_bench, "run a benchmark (bench platform, bench sim)"},
 };
 

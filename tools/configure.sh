@@ -17,6 +17,10 @@ probe osmesa osmesa RS_HAVE_OSMESA
 probe glfw glfw3 RS_HAVE_GLFW
 probe ffmpeg "libavformat libavcodec libavutil" RS_HAVE_FFMPEG
 probe oiio OpenImageIO RS_HAVE_OIIO
+# the replay-to-video service (ringside serve): queue stores and HTTP
+probe sqlite sqlite3 RS_HAVE_SQLITE
+probe postgres libpq RS_HAVE_PQ
+probe microhttpd libmicrohttpd RS_HAVE_MHD
 case "$have" in
 *egl*|*osmesa*) ;;
 *) echo "configure: neither EGL nor OSMesa found by pkg-config; run tools/deps.sh build" >&2; exit 1 ;;

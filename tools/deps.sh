@@ -14,13 +14,17 @@ group_pkgs() {
     case "$1" in
     # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window,
     # FFmpeg's libraries for video output (x264 and libvpx come with libavcodec),
-    # OpenImageIO for image sequences and the reference resize
-    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev" ;;
+    # OpenImageIO for image sequences and the reference resize; SQLite, libpq and
+    # libmicrohttpd for the service (ringside serve)
+    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev libsqlite3-dev libpq-dev libmicrohttpd-dev" ;;
     # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
     # presses keys in that window to prove a person can play; ffprobe (in
     # ffmpeg) is the independent player that checks our videos
     test) echo "xvfb xauth xdotool ffmpeg" ;;
-    *) echo "deps.sh: unknown group '$1' (known: build test)" >&2; return 1 ;;
+    # make test-service: a real PostgreSQL server for the two-daemon test,
+    # Debian's Chromium for the dashboard test (driven by playwright-core from npm)
+    service) echo "postgresql chromium" ;;
+    *) echo "deps.sh: unknown group '$1' (known: build test service)" >&2; return 1 ;;
     esac
 }
 

@@ -1,0 +1,252 @@
+/* svc_config: the table of settings and its three sources. */
+#include "svc_config.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../runtime/util/rs_file.h"
+
+typedef enum { C_INT, C_BYTES, C_STR, C_SIZE, C_CHOICE, C_LISTEN } c_type;
+
+typedef struct c_row {
+    const char *name;
+    c_type type;
+    size_t off, off2; /* off2: the height of a C_SIZE */
+    long lo, hi;      /* C_INT, C_BYTES: value; C_SIZE: each side; C_STR: length */
+    const char *def;
+    const char *choices; /* C_CHOICE: "a|b|c" (the index is stored, or the text for format/backend) */
+    const char *help;
+} c_row;
+
+#define OFF(f) offsetof(svc_config, f)
+static const c_row rows[] = {
+    {"listen", C_LISTEN, OFF(listen), 0, 0, sizeof((svc_config *)0)->listen, "127.0.0.1:8080", NULL,
+     "address:port for the HTTP API and dashboard (loopback unless told otherwise)"},
+    {"workers", C_INT, OFF(workers), 0, 1, 64, "1", NULL, "render processes running at once"},
+    {"data", C_STR, OFF(data), 0, 1, sizeof((svc_config *)0)->data - 64, "ringside-data", NULL,
+     "directory for the queue database, work files and (by default) videos"},
+    {"queue", C_STR, OFF(queue), 0, 0, sizeof((svc_config *)0)->queue - 1, "", NULL,
+     "sqlite:PATH or postgres://user@host:port/db (default: sqlite:DATA/queue.db)"},
+    {"output", C_STR, OFF(output), 0, 0, sizeof((svc_config *)0)->output - 32, "", NULL,
+     "directory for finished videos (default: DATA/videos; shared by every machine of a PostgreSQL queue)"},
+    {"max_upload", C_BYTES, OFF(max_upload), 0, 1024, 64L << 20, "1M", NULL, "largest replay accepted (K and M suffixes)"},
+    {"max_attempts", C_INT, OFF(max_attempts), 0, 1, 100, "3", NULL, "attempts before a job is failed for good"},
+    {"lease", C_INT, OFF(lease), 0, 3, 3600, "30", NULL,
+     "seconds a claimed job stays claimed without a heartbeat (heartbeats come every lease/6 s)"},
+    {"watchdog", C_INT, OFF(watchdog), 0, 5, 86400, "120", NULL,
+     "seconds a render may go without progress before it is killed and retried"},
+    {"grace", C_INT, OFF(grace), 0, 0, 3600, "30", NULL,
+     "seconds running jobs get to finish after SIGTERM before they are re-queued"},
+    {"size", C_SIZE, OFF(width), OFF(height), 16, 8192, "640x360", NULL, "a job's video size unless it asks"},
+    {"max_size", C_SIZE, OFF(max_width), OFF(max_height), 16, 8192, "1920x1080", NULL,
+     "the largest video size a job may ask for"},
+    {"render_size", C_SIZE, OFF(render_width), OFF(render_height), 16, 8192, "1280x720", NULL,
+     "the size the game is drawn at before the GPU downscale"},
+    {"format", C_CHOICE, OFF(format), 0, 0, 0, "mp4", "mp4|webm|mkv", "a job's video format unless it asks"},
+    {"backend", C_CHOICE, OFF(backend), 0, 0, 0, "egl", "egl|osmesa", "GL backend of the render processes"},
+    {"log_level", C_CHOICE, OFF(log_level), 0, 0, 0, "info", "debug|info|warn|error", "least important log line shown"},
+};
+#define NROWS (sizeof rows / sizeof rows[0])
+
+static const c_row *find(const char *name)
+{
+    for (size_t i = 0; i < NROWS; i++)
+        if (!strcmp(rows[i].name, name))
+            return &rows[i];
+    return NULL;
+}
+
+/* strtol with the whole string consumed and no overflow */
+static bool parse_long(const char *s, long *out, const char **rest)
+{
+    if (!*s || isspace((unsigned char)*s))
+        return false;
+    errno = 0;
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s)
+        return false;
+    *out = v;
+    *rest = end;
+    return true;
+}
+
+static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
+{
+    char *base = (char *)c;
+    const char *rest;
+    long n;
+    switch (r->type) {
+    case C_INT:
+        if (!parse_long(v, &n, &rest) || *rest)
+            return rs_fail(err, 1, "%s: '%s' is not a whole number", r->name, v);
+        if (n < r->lo || n > r->hi)
+            return rs_fail(err, 1, "%s: %ld is out of range (expected %ld..%ld)", r->name, n, r->lo, r->hi);
+        *(int *)(base + r->off) = (int)n;
+        return true;
+    case C_BYTES: {
+        if (!parse_long(v, &n, &rest))
+            return rs_fail(err, 1, "%s: '%s' is not a size (expected bytes, or a number with K or M)", r->name, v);
+        long mul = 1;
+        if (*rest == 'K' || *rest == 'k')
+            mul = 1024, rest++;
+        else if (*rest == 'M' || *rest == 'm')
+            mul = 1024 * 1024, rest++;
+        if (*rest || n < 0 || n > r->hi / mul || n * mul < r->lo)
+            return rs_fail(err, 1, "%s: '%s' is out of range (expected %ldK..%ldM)", r->name, v, r->lo / 1024,
+                           r->hi >> 20);
+        *(long *)(base + r->off) = n * mul;
+        return true;
+    }
+    case C_STR:
+        if (strlen(v) > (size_t)r->hi)
+            return rs_fail(err, 1, "%s: longer than %ld characters", r->name, r->hi);
+        if (r->lo && !*v)
+            return rs_fail(err, 1, "%s: must not be empty", r->name);
+        snprintf(base + r->off, (size_t)r->hi + 1, "%s", v);
+        return true;
+    case C_SIZE: {
+        long w, h;
+        if (!parse_long(v, &w, &rest) || (*rest != 'x' && *rest != 'X') || !parse_long(rest + 1, &h, &rest) || *rest)
+            return rs_fail(err, 1, "%s: '%s' is not a size (expected WxH, such as 640x360)", r->name, v);
+        if (w < r->lo || h < r->lo || w > r->hi || h > r->hi || (w | h) & 1)
+            return rs_fail(err, 1, "%s: %ldx%ld: each side must be even and %ld..%ld", r->name, w, h, r->lo, r->hi);
+        *(int *)(base + r->off) = (int)w;
+        *(int *)(base + r->off2) = (int)h;
+        return true;
+    }
+    case C_CHOICE: {
+        size_t len = strlen(v);
+        int idx = 0;
+        for (const char *p = r->choices; *p; idx++) {
+            const char *bar = strchr(p, '|');
+            size_t k = bar ? (size_t)(bar - p) : strlen(p);
+            if (k == len && !strncmp(p, v, k)) {
+                if (r->off == OFF(log_level))
+                    *(int *)(base + r->off) = idx;
+                else
+                    snprintf(base + r->off, 16 > len + 1 ? len + 1 : 16, "%s", v);
+                return true;
+            }
+            p += k + (bar != NULL);
+        }
+        return rs_fail(err, 1, "%s: '%s' is not one of %s", r->name, v, r->choices);
+    }
+    case C_LISTEN: {
+        const char *colon = strrchr(v, ':');
+        if (!colon || colon == v || strlen(v) >= (size_t)r->hi)
+            return rs_fail(err, 1, "%s: '%s' is not address:port (such as 127.0.0.1:8080)", r->name, v);
+        if (!parse_long(colon + 1, &n, &rest) || *rest || n < 0 || n > 65535)
+            return rs_fail(err, 1, "%s: '%s': the port must be 0..65535", r->name, v);
+        snprintf(base + r->off, (size_t)r->hi, "%s", v);
+        return true;
+    }
+    }
+    return false;
+}
+
+void svc_config_defaults(svc_config *c)
+{
+    memset(c, 0, sizeof *c);
+    for (size_t i = 0; i < NROWS; i++)
+        if (!set_row(c, &rows[i], rows[i].def, NULL))
+            abort(); /* a default outside its own bounds is a bug here */
+}
+
+bool svc_config_set(svc_config *c, const char *name, const char *value, rs_err *err)
+{
+    const c_row *r = find(name);
+    if (!r) {
+        char known[512] = "";
+        for (size_t i = 0; i < NROWS; i++)
+            snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", i ? ", " : "", rows[i].name);
+        return rs_fail(err, 1, "unknown setting '%s' (known: %s)", name, known);
+    }
+    return set_row(c, r, value, err);
+}
+
+static char *trim(char *s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    char *e = s + strlen(s);
+    while (e > s && isspace((unsigned char)e[-1]))
+        *--e = 0;
+    return s;
+}
+
+bool svc_config_load(svc_config *c, const char *path, rs_err *err)
+{
+    size_t len;
+    char *text = rs_read_file(path, 1 << 20, &len, err);
+    if (!text)
+        return false;
+    bool ok = true;
+    int line = 0;
+    if (strlen(text) != len) {
+        ok = rs_fail(err, 1, "%s: contains a NUL byte (not a text file)", path);
+        goto out;
+    }
+    /* strtok_r would skip empty lines and so miscount; walk by hand */
+    for (char *p = text; p && ok;) {
+        char *nl = strchr(p, '\n');
+        if (nl)
+            *nl = 0;
+        line++;
+        char *s = p;
+        p = nl ? nl + 1 : NULL;
+        char *hash = strchr(s, '#');
+        if (hash)
+            *hash = 0;
+        s = trim(s);
+        if (!*s)
+            continue;
+        char *eq = strchr(s, '=');
+        if (!eq) {
+            ok = rs_fail(err, 1, "%s:%d: expected 'name = value', got '%s'", path, line, s);
+            break;
+        }
+        *eq = 0;
+        char *name = trim(s), *value = trim(eq + 1);
+        if (!svc_config_set(c, name, value, err)) {
+            rs_err_prefix(err, "%s:%d", path, line);
+            ok = false;
+        }
+    }
+out:
+    free(text);
+    return ok;
+}
+
+bool svc_config_finish(svc_config *c, rs_err *err)
+{
+    if (!c->queue[0])
+        snprintf(c->queue, sizeof c->queue, "sqlite:%s/queue.db", c->data);
+    if (!c->output[0])
+        snprintf(c->output, sizeof c->output, "%s/videos", c->data);
+    if (c->width > c->max_width || c->height > c->max_height)
+        return rs_fail(err, 1, "size %dx%d is larger than max_size %dx%d", c->width, c->height, c->max_width,
+                       c->max_height);
+    return true;
+}
+
+void svc_config_print_table(FILE *f)
+{
+    for (size_t i = 0; i < NROWS; i++)
+        fprintf(f, "  %-13s %-16s %s\n", rows[i].name, rows[i].def[0] ? rows[i].def : "(see text)", rows[i].help);
+}
+
+void svc_config_dump(const svc_config *c, FILE *f)
+{
+    static const char *const levels[] = {"debug", "info", "warn", "error"};
+    fprintf(f,
+            "listen = %s\nworkers = %d\ndata = %s\nqueue = %s\noutput = %s\nmax_upload = %ld\nmax_attempts = %d\n"
+            "lease = %d\nwatchdog = %d\ngrace = %d\nsize = %dx%d\nmax_size = %dx%d\nrender_size = %dx%d\n"
+            "format = %s\nbackend = %s\nlog_level = %s\n",
+            c->listen, c->workers, c->data, c->queue, c->output, c->max_upload, c->max_attempts, c->lease, c->watchdog,
+            c->grace, c->width, c->height, c->max_width, c->max_height, c->render_width, c->render_height, c->format,
+            c->backend, levels[c->log_level & 3]);
+}

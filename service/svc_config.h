@@ -1,0 +1,49 @@
+/* svc_config: the daemon's settings, one table of typed, bounded rows
+ * (Redis's config.c habit).  A setting comes from its default, then the
+ * config file (`name = value` lines, # comments), then the command line;
+ * each source is checked against the same row, so a bad value reads
+ * "file:line: name: message" or "--name: message". */
+#ifndef SVC_CONFIG_H
+#define SVC_CONFIG_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "../runtime/util/rs_err.h"
+
+enum { SVC_LOG_DEBUG, SVC_LOG_INFO, SVC_LOG_WARN, SVC_LOG_ERROR };
+
+typedef struct svc_config {
+    char listen[128];     /* host:port; loopback unless told otherwise */
+    int workers;          /* render processes at once */
+    char data[512];       /* queue database, work files, default output */
+    char queue[1024];     /* sqlite:PATH or postgres://...; "" = sqlite:<data>/queue.db */
+    char output[512];     /* where videos go; "" = <data>/videos */
+    long max_upload;      /* bytes */
+    int max_attempts;     /* claims before a job is failed for good */
+    int lease;            /* seconds a claim lasts without a heartbeat */
+    int watchdog;         /* seconds without progress before a render is killed */
+    int grace;            /* seconds running jobs get to finish on SIGTERM */
+    int width, height;    /* a job's output size unless it asks for one */
+    int max_width, max_height; /* the largest output a job may ask for */
+    int render_width, render_height; /* the size the game is drawn at */
+    char format[8];       /* mp4, webm or mkv */
+    char backend[16];     /* egl or osmesa */
+    int log_level;
+} svc_config;
+
+void svc_config_defaults(svc_config *c);
+/* One setting by name; the message names the value and what was expected. */
+bool svc_config_set(svc_config *c, const char *name, const char *value, rs_err *err);
+/* A config file; errors read "path:line: ...". */
+bool svc_config_load(svc_config *c, const char *path, rs_err *err);
+/* Fills the derived defaults (queue, output from data) and checks the
+ * settings against each other. */
+bool svc_config_finish(svc_config *c, rs_err *err);
+/* The table, for --help and docs: name, default, meaning. */
+void svc_config_print_table(FILE *f);
+/* Every setting's current value, one "name = value" line each (a config
+ * file that reproduces c). */
+void svc_config_dump(const svc_config *c, FILE *f);
+
+#endif

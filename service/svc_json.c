@@ -1,0 +1,158 @@
+/* svc_json: see svc_json.h. */
+#include "svc_json.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+void svc_buf_free(svc_buf *b)
+{
+    free(b->p);
+    memset(b, 0, sizeof *b);
+}
+
+static bool reserve(svc_buf *b, size_t n)
+{
+    if (b->oom)
+        return false;
+    if (b->len + n + 1 <= b->cap)
+        return true;
+    size_t cap = b->cap ? b->cap : 256;
+    while (cap < b->len + n + 1)
+        cap *= 2;
+    char *p = realloc(b->p, cap);
+    if (!p) {
+        b->oom = true;
+        return false;
+    }
+    b->p = p;
+    b->cap = cap;
+    return true;
+}
+
+void svc_buf_add(svc_buf *b, const char *s, size_t n)
+{
+    if (!reserve(b, n))
+        return;
+    memcpy(b->p + b->len, s, n);
+    b->len += n;
+    b->p[b->len] = 0;
+}
+
+void svc_buf_printf(svc_buf *b, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0 || !reserve(b, (size_t)n))
+        return;
+    va_start(ap, fmt);
+    vsnprintf(b->p + b->len, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)n;
+}
+
+/* Length of a valid UTF-8 sequence at s (1..4), or 0. */
+static int utf8_len(const unsigned char *s)
+{
+    if (s[0] < 0x80)
+        return 1;
+    int n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 && s[0] < 0xe0 ? 2 : 0;
+    for (int i = 1; i < n; i++)
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+    if (n == 3 && ((s[0] == 0xe0 && s[1] < 0xa0) || (s[0] == 0xed && s[1] >= 0xa0)))
+        return 0; /* overlong, or a UTF-16 surrogate */
+    if (n == 4 && ((s[0] == 0xf0 && s[1] < 0x90) || (s[0] == 0xf4 && s[1] >= 0x90)))
+        return 0;
+    return n;
+}
+
+void svc_json_str(svc_buf *b, const char *str)
+{
+    const unsigned char *s = (const unsigned char *)(str ? str : "");
+    svc_buf_add(b, "\"", 1);
+    while (*s) {
+        int n = utf8_len(s);
+        if (n == 0) {
+            svc_buf_add(b, "\\ufffd", 6);
+            s++;
+        } else if (n > 1) {
+            svc_buf_add(b, (const char *)s, (size_t)n);
+            s += n;
+        } else {
+            unsigned char c = *s++;
+            if (c == '"' || c == '\\') {
+                char e[2] = {'\\', (char)c};
+                svc_buf_add(b, e, 2);
+            } else if (c == '\n')
+                svc_buf_add(b, "\\n", 2);
+            else if (c < 0x20 || c == 0x7f)
+                svc_buf_printf(b, "\\u%04x", c);
+            else
+                svc_buf_add(b, (const char *)&c, 1);
+        }
+    }
+    svc_buf_add(b, "\"", 1);
+}
+
+static void json_time(svc_buf *b, const char *key, int64_t t)
+{
+    if (t <= 0) {
+        svc_buf_printf(b, ",\"%s\":null", key);
+        return;
+    }
+    time_t tt = (time_t)t;
+    struct tm tm;
+    char s[32];
+    gmtime_r(&tt, &tm);
+    strftime(s, sizeof s, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    svc_buf_printf(b, ",\"%s\":\"%s\"", key, s);
+}
+
+void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts)
+{
+    svc_buf_printf(b, "{\"id\":%lld,\"state\":\"%s\",\"name\":", (long long)j->id, svc_state_name(j->state));
+    svc_json_str(b, j->name);
+    svc_buf_printf(b, ",\"size\":\"%dx%d\",\"format\":", j->width, j->height);
+    svc_json_str(b, j->format);
+    int64_t done = j->state == SVC_DONE ? j->frames_total : j->frames_done;
+    double progress = j->frames_total > 0 ? (double)done / (double)j->frames_total : 0.0;
+    svc_buf_printf(b, ",\"frames_done\":%lld,\"frames_total\":%lld,\"progress\":%.4f,\"fps\":%.2f", (long long)done,
+                   (long long)j->frames_total, progress, j->state == SVC_RUNNING ? j->fps : 0.0);
+    if (j->state == SVC_RUNNING && j->fps > 0 && j->frames_total >= done)
+        svc_buf_printf(b, ",\"eta_s\":%.1f", (double)(j->frames_total - done) / j->fps);
+    else
+        svc_buf_add(b, ",\"eta_s\":null", 13);
+    svc_buf_printf(b, ",\"attempts\":%d,\"max_attempts\":%d,\"error\":", j->attempts, max_attempts);
+    if (j->error[0])
+        svc_json_str(b, j->error);
+    else
+        svc_buf_add(b, "null", 4);
+    if (j->desync_tick >= 0)
+        svc_buf_printf(b, ",\"desync_tick\":%lld", (long long)j->desync_tick);
+    else
+        svc_buf_add(b, ",\"desync_tick\":null", 19);
+    if (j->state == SVC_RUNNING && j->owner[0]) {
+        svc_buf_add(b, ",\"worker\":", 10);
+        svc_json_str(b, j->owner);
+    }
+    json_time(b, "created", j->created);
+    json_time(b, "started", j->started);
+    json_time(b, "finished", j->finished);
+    svc_buf_printf(b, ",\"url\":\"/jobs/%lld\"", (long long)j->id);
+    if (j->state == SVC_DONE)
+        svc_buf_printf(b, ",\"video\":\"/jobs/%lld/video\",\"hashes\":\"/jobs/%lld/hashes\"", (long long)j->id,
+                       (long long)j->id);
+    svc_buf_add(b, "}", 1);
+}
+
+void svc_json_error(svc_buf *b, const char *msg)
+{
+    svc_buf_add(b, "{\"error\":", 9);
+    svc_json_str(b, msg);
+    svc_buf_add(b, "}\n", 2);
+}

@@ -1,0 +1,64 @@
+/* The daemon's shared state: what the supervisor loop (svc_daemon.c) and
+ * the HTTP threads (svc_http.c) both see.
+ *
+ * DESIGN (threads):
+ *  - the supervisor thread (main) owns workers[], the supervisor's store
+ *    handle and every child process: it claims jobs, spawns and reaps
+ *    renders, reads their pipes, sends heartbeats and runs the watchdog;
+ *  - libmicrohttpd's threads answer requests through their own store
+ *    handle (svc_store handles lock themselves) and read the live numbers
+ *    below under mu: the supervisor publishes them, HTTP only reads;
+ *  - signals only set stop (Redis's habit); the supervisor notices it
+ *    within one poll interval and drains. */
+#ifndef SVC_LOCAL_H
+#define SVC_LOCAL_H
+
+#include <pthread.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <sys/types.h>
+
+#include "svc_config.h"
+#include "svc_store.h"
+
+typedef struct svc_live {
+    int64_t job;     /* 0: idle */
+    pid_t pid;
+    int64_t done, total;
+    double fps;
+} svc_live;
+
+typedef struct svc_daemon {
+    svc_config cfg;
+    svc_store *store;      /* the supervisor's handle */
+    svc_store *http_store; /* the HTTP threads' handle */
+    char owner[SVC_OWNER_MAX]; /* "host:pid": who holds our leases */
+    char exe[1024];        /* this binary: the workers run `ringside render` */
+    char dashboard[1024];  /* service/dashboard.html under the data root ("" if not found) */
+    volatile sig_atomic_t stop; /* 1: drain; 2: a second signal, stop now */
+    unsigned short port;   /* the port actually bound */
+
+    pthread_mutex_t mu;    /* guards everything below */
+    bool draining;         /* POST /jobs answers 503 */
+    svc_live *live;        /* cfg.workers entries */
+    uint64_t frames_rendered, jobs_done, jobs_failed, jobs_retried, worker_crashes, watchdog_kills;
+    uint64_t uploads_rejected;
+} svc_daemon;
+
+/* svc_http.c */
+struct MHD_Daemon;
+struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err);
+void svc_http_stop(struct MHD_Daemon *h);
+/* Checks an upload and fills the job (frames_total from the replay); the
+ * message says what is wrong.  Exposed for tests. */
+bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, const char *name, svc_job *j,
+                      rs_err *err);
+/* "bytes=A-B" against a file of size len: 1 ok (*first..*last), 0 no
+ * usable range (serve it all), -1 unsatisfiable (416). */
+int svc_parse_range(const char *h, uint64_t len, uint64_t *first, uint64_t *last);
+
+/* svc_daemon.c */
+int svc_run(svc_daemon *d);
+
+#endif

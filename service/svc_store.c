@@ -1,0 +1,53 @@
+/* svc_store: what the backends share (names, the open dispatch). */
+#include "svc_store.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *svc_state_name(int st)
+{
+    static const char *const names[] = {
+#define X(id, s) s,
+        SVC_STATES(X)
+#undef X
+    };
+    return st >= 0 && st < SVC_NSTATES ? names[st] : "unknown";
+}
+
+void svc_job_free(svc_job *j)
+{
+    free(j->replay);
+    j->replay = NULL;
+    j->replay_len = 0;
+}
+
+void svc_dead_letter(char *out, size_t n, int attempts, const char *why)
+{
+    snprintf(out, n, "gave up after %d attempt%s: %s", attempts, attempts == 1 ? "" : "s", why);
+}
+
+static bool has_prefix(const char *s, const char *p)
+{
+    return strncmp(s, p, strlen(p)) == 0;
+}
+
+svc_store *svc_store_open(const char *spec, rs_err *err)
+{
+    if (has_prefix(spec, "postgres://") || has_prefix(spec, "postgresql://"))
+        return svc_store_pg_open(spec, err);
+    if (has_prefix(spec, "sqlite:"))
+        spec += strlen("sqlite:");
+    else {
+        size_t n = strlen(spec);
+        if (n < 3 || strcmp(spec + n - 3, ".db") != 0) {
+            rs_fail(err, 1, "queue '%s': expected sqlite:PATH, a path ending in .db, or postgres://...", spec);
+            return NULL;
+        }
+    }
+    if (!*spec) {
+        rs_fail(err, 1, "queue 'sqlite:': the database path is missing");
+        return NULL;
+    }
+    return svc_store_sqlite_open(spec, err);
+}
