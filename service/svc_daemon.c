@@ -353,7 +353,9 @@ static void tend(svc_daemon *d, worker *w, double now)
         pthread_mutex_unlock(&d->mu);
     }
     if (now - w->fps_t0 >= 1.0) {
-        w->fps = (double)(w->done - w->fps_d0) / (now - w->fps_t0);
+        /* smoothed over a few seconds, so the ETA does not jump about */
+        double f = (double)(w->done - w->fps_d0) / (now - w->fps_t0);
+        w->fps = w->fps > 0 && f > 0 ? 0.7 * w->fps + 0.3 * f : f;
         w->fps_t0 = now;
         w->fps_d0 = w->done;
     }
@@ -433,9 +435,9 @@ int svc_run(svc_daemon *d)
             int busy = 0;
             for (int i = 0; i < n; i++)
                 busy += ws[i].busy;
-            svc_log(SVC_LOG_INFO, -1, "stopping: no new jobs; %d running job%s get %d s to finish (a second "
-                                      "signal re-queues them now)",
-                    busy, busy == 1 ? "" : "s", d->cfg.grace);
+            svc_log(SVC_LOG_INFO, -1, "stopping: no new jobs; %d running job%s %s %d s to finish (a second "
+                                      "signal re-queues %s now)",
+                    busy, busy == 1 ? "" : "s", busy == 1 ? "gets" : "get", d->cfg.grace, busy == 1 ? "it" : "them");
         }
         if (draining && (d->stop > 1 || now - drain_start >= d->cfg.grace)) {
             for (int i = 0; i < n; i++)

@@ -332,10 +332,12 @@ static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, int64
 static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
 {
     long limit = 50;
-    int64_t before = 0;
+    int64_t before = 0, lim;
     const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "limit");
-    if (v && (!cli_int("limit", v, 1, 500, &limit)))
+    if (v && (!parse_id(v, strlen(v), &lim) || lim > 500))
         return reply_error(c, 400, "limit '%s': expected 1..500", v);
+    if (v)
+        limit = (long)lim;
     v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "before");
     if (v && !parse_id(v, strlen(v), &before))
         return reply_error(c, 400, "before '%s': expected a job id", v);

@@ -116,7 +116,10 @@ static bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
     sqlite3_bind_int(st, 3, j->height);
     sqlite3_bind_text(st, 4, j->format, -1, SQLITE_TRANSIENT);
     sqlite3_bind_int64(st, 5, j->frames_total);
-    sqlite3_bind_blob64(st, 6, j->replay, j->replay_len, SQLITE_TRANSIENT);
+    if (j->replay_len)
+        sqlite3_bind_blob64(st, 6, j->replay, j->replay_len, SQLITE_TRANSIENT);
+    else
+        sqlite3_bind_zeroblob(st, 6, 0); /* a NULL pointer would bind SQL NULL */
     if (sqlite3_step(st) != SQLITE_ROW) {
         sq_fail(s, err, "insert job");
         goto out;
@@ -165,7 +168,8 @@ static int sq_claim(svc_store *bs, const char *owner, int lease_s, svc_job *out,
         rs_fail(err, 1, "out of memory reading job %lld's replay", (long long)out->id);
         goto out;
     }
-    memcpy(out->replay, sqlite3_column_blob(st, 17), (size_t)n);
+    if (n > 0)
+        memcpy(out->replay, sqlite3_column_blob(st, 17), (size_t)n);
     out->replay_len = (size_t)n;
     rc = sqlite3_step(st) == SQLITE_DONE ? 1 : (sq_fail(s, err, "claim"), svc_job_free(out), -1);
 out:
@@ -200,7 +204,7 @@ static int sq_heartbeat(svc_store *bs, int64_t id, const char *owner, int lease_
         sqlite3_bind_int(st, 3, lease_s);
         sqlite3_bind_int64(st, 4, done);
         sqlite3_bind_int64(st, 5, total);
-        sqlite3_bind_double(st, 6, fps);
+        sqlite3_bind_double(st, 6, fps == fps && fps < 1e300 && fps > -1e300 ? fps : 0.0); /* NaN binds NULL */
         rc = step_changes(s, st, err, "heartbeat");
     }
     sqlite3_finalize(st);
@@ -410,14 +414,37 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
         goto fail;
     }
     sqlite3_busy_timeout(s->db, 10000);
-    /* WAL: HTTP readers never wait for the supervisor's writes.
-     * synchronous=FULL: a job acknowledged to a client survives power loss. */
-    if (!exec(s, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;", err) || !exec(s, schema, err))
+    /* a file that is not ours (another program's database): refuse it
+     * before changing anything in it */
+    sqlite3_stmt *st = prep(s, "SELECT COUNT(*) FROM sqlite_master WHERE name NOT LIKE 'sqlite_%'"
+                               " AND name NOT IN ('jobs', 'jobs_state')", err);
+    if (!st)
         goto fail;
-    /* a file that is not ours (another program's database) */
-    sqlite3_stmt *st = prep(s, "SELECT id, state, replay, claimed_until FROM jobs LIMIT 0", err);
+    int foreign = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int(st, 0) : -1;
+    sqlite3_finalize(st);
+    if (foreign != 0) {
+        rs_fail(err, 1, "%s: not a ringside queue (it holds other tables)", path);
+        goto fail;
+    }
+    /* WAL: HTTP readers never wait for the supervisor's writes.  Setting it
+     * answers SQLITE_BUSY at once (busy_timeout does not apply) while
+     * another connection opens the same new file: retry for a while.
+     * synchronous=FULL: a job acknowledged to a client survives power loss. */
+    for (int tries = 0;; tries++) {
+        rs_err_clear(err);
+        if (exec(s, "PRAGMA journal_mode=WAL", err))
+            break;
+        if (sqlite3_errcode(s->db) != SQLITE_BUSY || tries == 200)
+            goto fail;
+        sqlite3_sleep(25);
+    }
+    if (!exec(s, "PRAGMA synchronous=FULL", err) || !exec(s, schema, err))
+        goto fail;
+    st = prep(s, "SELECT id, state, name, width, height, format, frames_done, frames_total, fps, attempts,"
+                 " desync_tick, error, owner, created, started, finished, claimed_until, replay FROM jobs LIMIT 0",
+              err);
     if (!st) {
-        rs_err_prefix(err, "%s is not a ringside queue", path);
+        rs_err_prefix(err, "%s: not a ringside queue", path);
         goto fail;
     }
     sqlite3_finalize(st);
