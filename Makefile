@@ -2,6 +2,7 @@
 #
 #   make            build (installs missing Debian packages first)
 #   make test       build and run every test; ends with "N passed, N failed, N skipped"
+#   make test-service  the service end to end (PostgreSQL, Chromium; docs/service.md)
 #   make asan       the test suite again under AddressSanitizer + UBSan (build-asan/)
 #   make debug      -O0 build with GL error checks in build-debug/
 #   make demo       the main job on the bundled default (see README)
@@ -83,7 +84,7 @@ LIB_CXX  := $(wildcard capture/*.cpp)
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
-.PHONY: all test asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
+.PHONY: all test test-service asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -159,6 +160,11 @@ $(BUILD)/tests/simhash-clang: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/rep
 # --- tests ---
 test: $(STAMPS)/test $(BUILD)/ringside $(TEST_BIN) $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2 $(SIMHASH_CLANG)
 	@tests/run.sh $(BUILD) $(T)
+
+# the service end to end: real HTTP, SQLite, a PostgreSQL server started by
+# the tests, headless Chromium on the dashboard (docs/service.md)
+test-service: $(STAMPS)/test $(STAMPS)/service $(BUILD)/ringside $(BUILD)/tests/test_svc_store $(BUILD)/tests/simhash-O2
+	@RS_SUITE=service tests/run.sh $(BUILD) $(T)
 
 asan:
 	@$(MAKE) --no-print-directory BUILD=build-asan SAN=1 test

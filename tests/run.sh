@@ -2,6 +2,8 @@
 # Runs every test binary in BUILD/tests and every tests/test_*.sh, and sums
 # their "N passed, N failed, N skipped" lines into one final line.
 #   tests/run.sh BUILD [NAME]    NAME: run only tests/test_NAME*
+#   RS_SUITE=service tests/run.sh BUILD   the service's end-to-end tests
+#                                         (tests/service/test_*.sh: make test-service)
 set -u
 # One X server for the whole run, so the GLFW backend is tested too; tests
 # that need "no display" unset DISPLAY themselves.
@@ -28,7 +30,12 @@ mkdir -p "$RS_TEST_OUT"
 
 pass=0 fail=0 skip=0 ran=0
 start=$(date +%s)
-for t in "$build"/tests/test_* "$here"/test_*.sh; do
+if [ -n "${RS_SUITE:-}" ]; then
+    set -- "$here/$RS_SUITE"/test_*.sh
+else
+    set -- "$build"/tests/test_* "$here"/test_*.sh
+fi
+for t in "$@"; do
     [ -e "$t" ] || continue
     name=$(basename "$t" .sh)
     case "$name" in *.d|*.o) continue ;; esac

@@ -1,0 +1,209 @@
+#!/usr/bin/env node
+// Browser test of the `ringside serve` dashboard (service/dashboard.html).
+//
+//   node tests/service/dashboard.mjs --url http://127.0.0.1:PORT --replay FILE.rsr \
+//        --shot OUT.png [--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]
+//
+// Opens the page in headless Chromium, uploads the replay, waits for the job's
+// row to reach data-state="done" (failing fast on "failed"/"cancelled"), checks
+// the row's <progress> moved, clicks "watch", waits for the <video> to load its
+// metadata (videoWidth > 0, duration > 0), saves a full-page screenshot and
+// prints one result line.  Exit 0 on success, 1 on any failure (with the reason),
+// 2 on bad usage.
+//
+// Needs playwright-core (cd tests/service && npm ci) and a Chromium binary
+// (default /usr/bin/chromium, Debian's; or $CHROMIUM / --chromium).  The default
+// format is webm (VP9): every Chromium build plays it, while H.264 mp4 needs a
+// build with proprietary codecs (Debian's has them; Playwright's own does not).
+
+import fs from 'node:fs';
+import path from 'node:path';
+
+const USAGE = 'usage: node tests/service/dashboard.mjs --url URL --replay FILE --shot OUT.png ' +
+  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]';
+
+function parseArgs(argv) {
+  const o = { timeout: 120, size: '320x180', format: 'webm', chromium: process.env.CHROMIUM || '/usr/bin/chromium' };
+  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium']);
+  for (let i = 0; i < argv.length; i++) {
+    let a = argv[i], v;
+    if (a === '-h' || a === '--help') { console.log(USAGE); process.exit(0); }
+    if (!a.startsWith('--')) usage(`unexpected argument '${a}'`);
+    a = a.slice(2);
+    const eq = a.indexOf('=');
+    if (eq >= 0) { v = a.slice(eq + 1); a = a.slice(0, eq); } else v = argv[++i];
+    if (!keys.has(a)) usage(`unknown option --${a}`);
+    if (v === undefined) usage(`--${a} needs a value`);
+    o[a] = v;
+  }
+  for (const k of ['url', 'replay', 'shot']) if (!o[k]) usage(`--${k} is required`);
+  o.timeout = Number(o.timeout);
+  if (!(o.timeout > 0)) usage('--timeout must be a positive number of seconds');
+  if (!/^\d+x\d+$/.test(o.size)) usage('--size must be WxH');
+  o.url = o.url.replace(/\/+$/, '');
+  return o;
+}
+function usage(msg) { console.error(`dashboard: ${msg}\n${USAGE}`); process.exit(2); }
+
+class Fail extends Error {}
+const fail = (msg) => { throw new Fail(msg); };
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+async function main() {
+  const opt = parseArgs(process.argv.slice(2));
+  if (!fs.existsSync(opt.replay)) fail(`replay ${opt.replay} not found`);
+  if (!fs.existsSync(opt.chromium)) fail(`no Chromium at ${opt.chromium} (use --chromium PATH or $CHROMIUM)`);
+
+  let chromium;
+  try {
+    ({ chromium } = await import('playwright-core'));
+  } catch (e) {
+    fail(`cannot load playwright-core (${e.code || e.message}); run: cd tests/service && npm ci`);
+  }
+
+  const t0 = Date.now();
+  const deadline = t0 + opt.timeout * 1000;
+  const left = () => deadline - Date.now();
+  const checkTime = (what) => { if (left() <= 0) fail(`timed out after ${opt.timeout} s ${what}`); };
+
+  const browser = await chromium.launch({
+    executablePath: opt.chromium,
+    headless: true,
+    args: ['--no-sandbox', '--disable-dev-shm-usage', '--disable-gpu', '--mute-audio',
+      '--autoplay-policy=no-user-gesture-required'],
+  });
+  const pageErrors = [];
+  try {
+    const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+    page.setDefaultTimeout(Math.max(1000, Math.min(30_000, left())));
+    page.on('pageerror', (e) => pageErrors.push(String(e && e.message || e)));
+    const checkPageErrors = () => { if (pageErrors.length) fail(`JavaScript error in the page: ${pageErrors[0]}`); };
+
+    // 1. open the page
+    let resp;
+    try {
+      resp = await page.goto(opt.url + '/', { waitUntil: 'load', timeout: Math.min(15_000, left()) });
+    } catch (e) {
+      fail(`cannot open ${opt.url}/: ${e.message.split('\n')[0]}`);
+    }
+    if (!resp || !resp.ok()) fail(`GET ${opt.url}/ answered ${resp ? resp.status() : 'nothing'}`);
+    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-button', '#upload-status', '#jobs', '#player']) {
+      if (await page.locator(sel).count() !== 1) fail(`page has no single ${sel}`);
+    }
+
+    // 2. fill in the form
+    await page.setInputFiles('#upload-file', opt.replay);
+    for (const [sel, val] of [['#upload-size', opt.size], ['#upload-format', opt.format]]) {
+      const vals = await page.$$eval(`${sel} option`, (os) => os.map((o) => o.value));
+      if (!vals.includes(val)) fail(`${sel} has no option '${val}' (has ${vals.join(', ')})`);
+      await page.selectOption(sel, val);
+    }
+    if (opt.format === 'mp4') {
+      const can = await page.evaluate(() => document.createElement('video').canPlayType('video/mp4; codecs="avc1.640028"'));
+      if (!can) fail('this Chromium cannot play H.264 mp4; use --format webm');
+    }
+    // record loadedmetadata on the player before anything can load into it
+    await page.evaluate(() => {
+      const v = document.getElementById('player');
+      window.__rsMeta = 0;
+      v.addEventListener('loadedmetadata', () => { window.__rsMeta++; });
+    });
+
+    // 3. upload, read the job id
+    const tUpload = Date.now();
+    await page.click('#upload-button');
+    let id = null;
+    for (;;) {
+      checkPageErrors();
+      checkTime('waiting for the upload to be accepted');
+      const st = await page.$eval('#upload-status', (el) => ({ text: el.textContent.trim(), error: el.classList.contains('error') }));
+      const m = /queued as job (\d+)/.exec(st.text);
+      if (m) { id = Number(m[1]); break; }
+      if (st.error) fail(`upload refused: ${st.text}`);
+      await sleep(100);
+    }
+
+    // 4. wait for the row to be done, watching its progress bar
+    const rowSel = `#jobs tr[data-job-id="${id}"]`;
+    let samples = 0, increases = 0, last = null, lastState = null, sawRow = false;
+    for (;;) {
+      checkPageErrors();
+      if (left() <= 0) {
+        fail(`timed out after ${opt.timeout} s waiting for job ${id} to finish (state ${lastState || 'no row'}, ` +
+          `progress ${last ? `${last.value}/${last.max}` : '-'})`);
+      }
+      const row = await page.evaluate((sel) => {
+        const tr = document.querySelector(sel);
+        if (!tr) return null;
+        const bar = tr.querySelector('progress');
+        const err = tr.querySelector('td.err');
+        return {
+          state: tr.dataset.state || '',
+          value: bar ? (bar.hasAttribute('value') ? bar.value : null) : undefined,
+          max: bar ? bar.max : undefined,
+          error: err ? err.textContent.trim() : '',
+          text: tr.innerText.replace(/\s+/g, ' ').trim(),
+        };
+      }, rowSel);
+      if (!row) {
+        if (!sawRow && Date.now() - tUpload > 10_000) fail(`job ${id} has no row in #jobs after 10 s`);
+        await sleep(200);
+        continue;
+      }
+      sawRow = true;
+      if (row.value === undefined) fail(`job ${id}'s row has no <progress>`);
+      lastState = row.state;
+      if (row.value !== null) {
+        samples++;
+        if (last && last.value !== null && row.value > last.value) increases++;
+      }
+      last = row;
+      if (row.state === 'failed' || row.state === 'cancelled') {
+        fail(`job ${id} ${row.state}: ${row.error || '(no error text)'} [row: ${row.text}]`);
+      }
+      if (row.state === 'done') {
+        if (!(row.max > 0 && row.value === row.max) && increases === 0) {
+          fail(`job ${id} is done but its progress bar never moved (value ${row.value}, max ${row.max})`);
+        }
+        break;
+      }
+      await sleep(250);
+    }
+    const tDone = Date.now();
+
+    // 5. watch it
+    await page.click(`${rowSel} button.watch`);
+    let meta = null;
+    for (;;) {
+      checkPageErrors();
+      checkTime(`waiting for job ${id}'s video to load`);
+      meta = await page.evaluate(() => {
+        const v = document.getElementById('player');
+        return { fired: window.__rsMeta, w: v.videoWidth, h: v.videoHeight, d: v.duration, src: v.currentSrc,
+          err: v.error ? `code ${v.error.code} ${v.error.message || ''}`.trim() : null };
+      });
+      if (meta.err) fail(`the player cannot load ${meta.src}: ${meta.err}`);
+      if (meta.fired > 0 && meta.w > 0 && meta.d > 0) break;
+      await sleep(100);
+    }
+    if (!/\/jobs\/\d+\/video$/.test(new URL(meta.src).pathname)) fail(`the player loaded ${meta.src}, not /jobs/${id}/video`);
+
+    // 6. screenshot
+    fs.mkdirSync(path.dirname(path.resolve(opt.shot)), { recursive: true });
+    await page.screenshot({ path: opt.shot, fullPage: true });
+    checkPageErrors();
+
+    const secs = ((tDone - tUpload) / 1000).toFixed(1);
+    const dur = Number.isFinite(meta.d) ? meta.d.toFixed(2) : String(meta.d);
+    console.log(`dashboard ok: job ${id} done in ${secs} s (total ${((Date.now() - t0) / 1000).toFixed(1)} s), ` +
+      `video ${meta.w}x${meta.h} ${opt.format}, duration ${dur} s, progress ${samples} samples ${increases} rises, ` +
+      `shot ${opt.shot}`);
+  } finally {
+    await browser.close().catch(() => {});
+  }
+}
+
+main().then(() => process.exit(0), (e) => {
+  console.error(`dashboard FAILED: ${e instanceof Fail ? e.message : (e && e.stack) || e}`);
+  process.exit(1);
+});

@@ -1,0 +1,84 @@
+#!/bin/sh
+# Two daemons on one PostgreSQL queue (a real server started here, on
+# loopback): they split the jobs, and no job is done twice.
+here=$(cd "$(dirname "$0")/.." && pwd)
+: "${RS_BIN:=$(dirname "$here")/build/ringside}"
+. "$here/lib.sh"
+. "$here/service/svc_lib.sh"
+. "$here/pg.sh"
+trap 'exit 143' TERM INT HUP
+
+t_two_daemons_share_one_queue() {
+    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
+    trap 'for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done; pg_stop' EXIT
+    pg_start "$pgdir"
+    rc=$?
+    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
+    [ "$rc" = 0 ] || return 1
+    svc_replays r 20 1 || return 1
+    # two machines in miniature: own data directories, one queue, one
+    # shared output directory
+    mkdir -p shared
+    svc_start a $SVC_FAST --queue "$PG_URI" --output shared --workers 1 || return 1
+    url_a=$SVC_URL pid_a=$SVC_PID
+    svc_start b $SVC_FAST --queue "$PG_URI" --output shared --workers 1 || return 1
+    url_b=$SVC_URL pid_b=$SVC_PID
+    grep -q "queue postgres" a.log || { cat a.log; return 1; }
+    # clients split between the two front doors, all at once
+    k=1
+    while [ $k -le 20 ]; do
+        u=$url_a; [ $((k % 2)) = 0 ] && u=$url_b
+        curl -s -X POST --data-binary @r/r$k.rsr "$u/jobs?name=r$k.rsr" >sub$k.json &
+        cpids="${cpids:-} $!"
+        k=$((k + 1))
+    done
+    # only the clients: a bare `wait` would wait for the daemon too
+    for c in $cpids; do wait "$c"; done
+    ids=""
+    for k in $(seq 1 20); do ids="$ids $(json_get id <sub$k.json)" || { cat sub$k.json; return 1; }; done
+    # either daemon answers for every job
+    SVC_URL=$url_a
+    for id in $ids; do
+        svc_wait_state "$id" done 300 || return 1
+        [ "$(svc_field "$id" attempts)" = 1 ] || { echo "job $id took $(svc_field "$id" attempts) attempts"; return 1; }
+        curl -sf -o "v$id.mp4" "$url_b/jobs/$id/video" || { echo "daemon b cannot serve job $id's video"; return 1; }
+        [ "$(frames_of "v$id.mp4")" = 60 ] || { echo "job $id: $(frames_of "v$id.mp4") frames"; return 1; }
+    done
+    # each job rendered exactly once, and both daemons took a share
+    grep -ho 'job [0-9]*: done' a.log b.log | sort | uniq -d >twice.txt
+    [ ! -s twice.txt ] || { echo "done twice:"; cat twice.txt; return 1; }
+    na=$(grep -c ': done: ' a.log) nb=$(grep -c ': done: ' b.log)
+    echo "daemon a rendered $na jobs, daemon b $nb"
+    [ $((na + nb)) = 20 ] || return 1
+    [ "$na" -ge 3 ] && [ "$nb" -ge 3 ] || { echo "the split is lopsided: $na / $nb"; return 1; }
+    svc_stop "$pid_a"
+    [ "$SVC_RC" = 0 ] || return 1
+    svc_stop "$pid_b"
+    [ "$SVC_RC" = 0 ] || return 1
+}
+
+t_lease_of_a_dead_daemon_expires() {
+    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
+    trap 'for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done; pg_stop' EXIT
+    pg_start "$pgdir"
+    rc=$?
+    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
+    [ "$rc" = 0 ] || return 1
+    "$RS_BIN" record --ai --quiet --seconds 8 --seed 4 -o long.rsr || return 1
+    mkdir -p shared
+    svc_start a $SVC_FAST --queue "$PG_URI" --output shared || return 1
+    pid_a=$SVC_PID
+    id=$(svc_submit long.rsr) || return 1
+    svc_wait_state "$id" running 30 || return 1
+    # machine a dies; b has never seen the job
+    kill -KILL "$pid_a"
+    svc_start b $SVC_FAST --queue "$PG_URI" --output shared || return 1
+    svc_wait_state "$id" done 120 || return 1
+    grep -q "with an expired lease re-queued" b.log || { cat b.log; return 1; }
+    [ "$(svc_field "$id" attempts)" = 2 ] || return 1
+    curl -sf -o v.mp4 "$SVC_URL/jobs/$id/video" && [ "$(frames_of v.mp4)" = 480 ] || return 1
+    svc_stop
+}
+
+t_run two_daemons_share_one_queue lease_of_a_dead_daemon_expires
+t_done
