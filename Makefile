@@ -198,11 +198,12 @@ demo-replays: $(BUILD)/ringside
 # --- install ---
 install: $(BUILD)/ringside
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/ringside/shaders $(DESTDIR)$(PREFIX)/share/ringside/demos \
-	    $(DESTDIR)$(PREFIX)/share/ringside/stages
+	    $(DESTDIR)$(PREFIX)/share/ringside/stages $(DESTDIR)$(PREFIX)/share/ringside/service
 	install -m 755 $(BUILD)/ringside $(DESTDIR)$(PREFIX)/bin/ringside
 	install -m 644 shaders/* $(DESTDIR)$(PREFIX)/share/ringside/shaders/
 	install -m 644 demos/*.rsr $(DESTDIR)$(PREFIX)/share/ringside/demos/
 	install -m 644 stages/*.stage $(DESTDIR)$(PREFIX)/share/ringside/stages/
+	install -m 644 service/dashboard.html $(DESTDIR)$(PREFIX)/share/ringside/service/
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/ringside

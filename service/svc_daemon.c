@@ -97,8 +97,15 @@ static void worker_clear(svc_daemon *d, worker *w)
     close_fd(&w->err_fd);
     if (w->replay_path[0])
         unlink(w->replay_path);
-    unlink(w->out_tmp);
-    unlink(w->hashes_tmp);
+    /* a render killed with SIGKILL could not remove its own ".part" files */
+    char part[1100];
+    const char *tmps[] = {w->out_tmp, w->hashes_tmp};
+    for (int i = 0; i < 2; i++)
+        if (tmps[i][0]) {
+            unlink(tmps[i]);
+            snprintf(part, sizeof part, "%s.part", tmps[i]);
+            unlink(part);
+        }
     svc_job_free(&w->job);
     int slot = w->slot;
     memset(w, 0, sizeof *w);
@@ -200,7 +207,13 @@ static void on_err_line(svc_daemon *d, worker *w, char *line)
     /* "ringside render: x.rsr: desync ..." -> the part after "render: " */
     const char *m = strstr(line, "ringside render: ");
     m = m ? m + strlen("ringside render: ") : line;
-    snprintf(w->last_err, sizeof w->last_err, "%s", m);
+    /* the render knows the replay by its work-file name; people know it
+     * by the name it was uploaded under */
+    size_t rl = strlen(w->replay_path);
+    if (rl && !strncmp(m, w->replay_path, rl))
+        snprintf(w->last_err, sizeof w->last_err, "%s%s", w->job.name, m + rl);
+    else
+        snprintf(w->last_err, sizeof w->last_err, "%s", m);
     svc_log(SVC_LOG_DEBUG, w->job.id, "render says: %s", m);
     (void)d;
 }

@@ -13,6 +13,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -222,16 +223,29 @@ static bool parse_id(const char *s, size_t n, int64_t *id)
     return v > 0;
 }
 
+/* A refused upload: counted for /metrics, logged, answered. */
+static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, unsigned status, const char *fmt, ...)
+    RS_PRINTF(4, 5);
+static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, unsigned status, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    pthread_mutex_lock(&d->mu);
+    d->uploads_rejected++;
+    pthread_mutex_unlock(&d->mu);
+    svc_log(SVC_LOG_INFO, -1, "upload refused (%u): %s", status, msg);
+    return reply_error(c, status, "%s", msg);
+}
+
 static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     if (q->oom)
         return reply_error(c, 500, "out of memory reading the upload");
-    if (q->too_large) {
-        pthread_mutex_lock(&d->mu);
-        d->uploads_rejected++;
-        pthread_mutex_unlock(&d->mu);
-        return reply_error(c, 413, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
-    }
+    if (q->too_large)
+        return reject(d, c, 413, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
     const char *v;
     if (!q->size[0] && (v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "size")))
         snprintf(q->size, sizeof q->size, "%s", v);
@@ -253,25 +267,20 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         long w, h;
         char x, extra;
         if (sscanf(q->size, "%ld%c%ld%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
-            return reply_error(c, 400, "size '%s': expected WxH, such as 640x360", q->size);
+            return reject(d, c, 400, "size '%s': expected WxH, such as 640x360", q->size);
         if (w < 16 || h < 16 || w > d->cfg.max_width || h > d->cfg.max_height || (w | h) & 1)
-            return reply_error(c, 400, "size %ldx%ld: each side must be even, at least 16 and at most %dx%d", w, h,
+            return reject(d, c, 400, "size %ldx%ld: each side must be even, at least 16 and at most %dx%d", w, h,
                                d->cfg.max_width, d->cfg.max_height);
         j.width = (int)w, j.height = (int)h;
     }
     if (q->format[0]) {
         if (strcmp(q->format, "mp4") && strcmp(q->format, "webm") && strcmp(q->format, "mkv"))
-            return reply_error(c, 400, "format '%s': expected mp4, webm or mkv", q->format);
+            return reject(d, c, 400, "format '%s': expected mp4, webm or mkv", q->format);
         snprintf(j.format, sizeof j.format, "%s", q->format);
     }
     rs_err err = {0};
-    if (!svc_check_upload(&d->cfg, q->body, q->len, j.name, &j, &err)) {
-        pthread_mutex_lock(&d->mu);
-        d->uploads_rejected++;
-        pthread_mutex_unlock(&d->mu);
-        svc_log(SVC_LOG_INFO, -1, "upload refused (%d): %s", err.code, err.msg);
-        return reply_error(c, (unsigned)err.code, "%s", err.msg);
-    }
+    if (!svc_check_upload(&d->cfg, q->body, q->len, j.name, &j, &err))
+        return reject(d, c, (unsigned)err.code, "%s", err.msg);
     j.replay = q->body;
     j.replay_len = q->len;
     if (!d->http_store->ops->submit(d->http_store, &j, &err)) {
