@@ -33,6 +33,8 @@ static const c_row rows[] = {
     {"output", C_STR, OFF(output), 0, 0, sizeof((svc_config *)0)->output - 32, "", NULL,
      "directory for finished videos (default: DATA/videos; shared by every machine of a PostgreSQL queue)"},
     {"max_upload", C_BYTES, OFF(max_upload), 0, 1024, 64L << 20, "1M", NULL, "largest replay accepted (K and M suffixes)"},
+    {"max_seconds", C_INT, OFF(max_seconds), 0, 1, 7 * 24 * 3600, "1800", NULL,
+     "longest replay accepted, in seconds of game time (a render takes about as long on a GPU)"},
     {"max_attempts", C_INT, OFF(max_attempts), 0, 1, 100, "3", NULL, "attempts before a job is failed for good"},
     {"lease", C_INT, OFF(lease), 0, 3, 3600, "30", NULL,
      "seconds a claimed job stays claimed without a heartbeat (heartbeats come every lease/6 s)"},
@@ -102,6 +104,10 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
         return true;
     }
     case C_STR:
+        /* the dump must reload as the same value: no comment marks or
+         * line breaks, which a config file could not hold */
+        if (strpbrk(v, "#\r\n"))
+            return rs_fail(err, 1, "%s: '#' and line breaks are not allowed in values", r->name);
         if (strlen(v) > (size_t)r->hi)
             return rs_fail(err, 1, "%s: longer than %ld characters", r->name, r->hi);
         if (r->lo && !*v)
@@ -137,8 +143,12 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
     }
     case C_LISTEN: {
         const char *colon = strrchr(v, ':');
-        if (!colon || colon == v || strlen(v) >= (size_t)r->hi)
+        if (!colon || colon == v || strlen(v) >= (size_t)r->hi || strpbrk(v, "#\r\n "))
             return rs_fail(err, 1, "%s: '%s' is not address:port (such as 127.0.0.1:8080)", r->name, v);
+        /* an IPv6 host goes in brackets, or "::1" would read as ":" port 1 */
+        if (v[0] == '[' ? colon[-1] != ']' : memchr(v, ':', (size_t)(colon - v)) != NULL)
+            return rs_fail(err, 1, "%s: '%s' is not address:port; an IPv6 address goes in brackets, such as [::1]:8080",
+                           r->name, v);
         if (!parse_long(colon + 1, &n, &rest) || *rest || n < 0 || n > 65535)
             return rs_fail(err, 1, "%s: '%s': the port must be 0..65535", r->name, v);
         snprintf(base + r->off, (size_t)r->hi, "%s", v);
@@ -243,10 +253,11 @@ void svc_config_dump(const svc_config *c, FILE *f)
 {
     static const char *const levels[] = {"debug", "info", "warn", "error"};
     fprintf(f,
-            "listen = %s\nworkers = %d\ndata = %s\nqueue = %s\noutput = %s\nmax_upload = %ld\nmax_attempts = %d\n"
+            "listen = %s\nworkers = %d\ndata = %s\nqueue = %s\noutput = %s\nmax_upload = %ld\nmax_seconds = %d\n"
+            "max_attempts = %d\n"
             "lease = %d\nwatchdog = %d\ngrace = %d\nsize = %dx%d\nmax_size = %dx%d\nrender_size = %dx%d\n"
             "format = %s\nbackend = %s\nlog_level = %s\n",
-            c->listen, c->workers, c->data, c->queue, c->output, c->max_upload, c->max_attempts, c->lease, c->watchdog,
+            c->listen, c->workers, c->data, c->queue, c->output, c->max_upload, c->max_seconds, c->max_attempts, c->lease, c->watchdog,
             c->grace, c->width, c->height, c->max_width, c->max_height, c->render_width, c->render_height, c->format,
             c->backend, levels[c->log_level & 3]);
 }

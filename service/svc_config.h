@@ -20,6 +20,7 @@ typedef struct svc_config {
     char queue[1024];     /* sqlite:PATH or postgres://...; "" = sqlite:<data>/queue.db */
     char output[512];     /* where videos go; "" = <data>/videos */
     long max_upload;      /* bytes */
+    int max_seconds;      /* longest replay accepted (game time) */
     int max_attempts;     /* claims before a job is failed for good */
     int lease;            /* seconds a claim lasts without a heartbeat */
     int watchdog;         /* seconds without progress before a render is killed */

@@ -44,6 +44,11 @@ bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, co
     rp_free(&rp);
     if (j->frames_total == 0)
         return rs_fail(err, 400, "%s: the replay has no ticks: nothing to render", name);
+    /* a small file can describe days of play (inputs are run-length coded):
+     * one job must not hold a worker for that long */
+    if (j->frames_total > (int64_t)cfg->max_seconds * 60)
+        return rs_fail(err, 400, "%s: the replay lasts %lld s; this service renders at most %d s (max_seconds)", name,
+                       (long long)((j->frames_total + 59) / 60), cfg->max_seconds);
     return true;
 }
 

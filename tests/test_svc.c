@@ -1,0 +1,798 @@
+/* service: the daemon's pure logic, no socket and no database: the settings
+ * table (svc_config), the JSON writer (svc_json), HTTP Range parsing and the
+ * upload check (svc_http.c's plain functions).  The store has its own file,
+ * tests/test_svc_store.c; the running daemon is tests/service/.
+ *   build/tests/test_svc [config_|json_|range_|upload_|NAME...] */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../runtime/game/g_game.h"
+#include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_img.h"
+#include "../service/svc_config.h"
+#include "../service/svc_json.h"
+#include "../service/svc_local.h"
+#include "t.h"
+
+/* Fixed-seed xorshift64*: a failing random case fails the same way each run. */
+static uint64_t rng = 0x9e3779b97f4a7c15ull;
+static uint32_t rnd(void)
+{
+    rng ^= rng >> 12, rng ^= rng << 25, rng ^= rng >> 27;
+    return (uint32_t)((rng * 0x2545f4914f6cdd1dull) >> 32);
+}
+
+/* --- svc_config --- */
+
+static void t_config_defaults(void)
+{
+    svc_config c;
+    svc_config_defaults(&c);
+    T_ASSERT(!strcmp(c.listen, "127.0.0.1:8080")); /* loopback unless told otherwise */
+    T_ASSERT(!strcmp(c.data, "ringside-data") && !c.queue[0] && !c.output[0]); /* svc_config_finish derives */
+    T_ASSERT(!strcmp(c.format, "mp4") && !strcmp(c.backend, "egl"));
+    T_ASSERT(c.workers == 1 && c.max_upload == 1 << 20 && c.max_attempts == 3);
+    T_ASSERT(c.lease == 30 && c.watchdog == 120 && c.grace == 30);
+    T_ASSERT(c.width == 640 && c.height == 360 && c.max_width == 1920 && c.max_height == 1080);
+    T_ASSERT(c.render_width == 1280 && c.render_height == 720);
+    T_EQ(c.log_level, SVC_LOG_INFO);
+}
+
+/* A value, and what must come of it: the line svc_config_dump then writes
+ * (ok), or words of the refusal. */
+typedef struct set_case {
+    const char *name, *value;
+    bool ok;
+    const char *want;
+} set_case;
+
+static const set_case set_cases[] = {
+    {"workers", "1", 1, "workers = 1"}, {"workers", "64", 1, "workers = 64"},
+    {"grace", "0", 1, "grace = 0"}, {"watchdog", "86400", 1, "watchdog = 86400"},
+    {"workers", "0", 0, "workers: 0 is out of range (expected 1..64)"},
+    {"workers", "65", 0, "workers: 65 is out of range (expected 1..64)"},
+    {"workers", "4294967297", 0, "out of range"}, /* wraps to 1 if narrowed before the check */
+    {"lease", "2", 0, "lease: 2 is out of range (expected 3..3600)"}, {"max_attempts", "-1", 0, "expected 1..100"},
+    {"workers", "abc", 0, "workers: 'abc' is not a whole number"}, {"workers", "3x", 0, "'3x' is not a whole number"},
+    {"workers", "", 0, "'' is not a whole number"}, {"workers", " 3", 0, "is not a whole number"},
+    {"workers", "4.0", 0, "is not a whole number"}, {"workers", "99999999999999999999", 0, "is not a whole number"},
+    {"max_upload", "2048", 1, "max_upload = 2048"}, {"max_upload", "1K", 1, "max_upload = 1024"},
+    {"max_upload", "4k", 1, "max_upload = 4096"}, {"max_upload", "2m", 1, "max_upload = 2097152"},
+    {"max_upload", "64M", 1, "max_upload = 67108864"},
+    {"max_upload", "65M", 0, "max_upload: '65M' is out of range (expected 1K..64M)"},
+    {"max_upload", "1023", 0, "out of range"}, {"max_upload", "0", 0, "out of range"},
+    {"max_upload", "-1K", 0, "out of range"}, {"max_upload", "1G", 0, "out of range"},
+    {"max_upload", "1KB", 0, "out of range"},
+    {"max_upload", "9007199254740993K", 0, "out of range"}, /* n * K would overflow */
+    {"max_upload", "K", 0, "max_upload: 'K' is not a size (expected bytes, or a number with K or M)"},
+    {"max_upload", "99999999999999999999M", 0, "is not a size"}, {"queue", "", 1, "queue = "},
+    {"queue", "postgres://u@db:5432/ring", 1, "queue = postgres://u@db:5432/ring"},
+    {"data", "", 0, "data: must not be empty"}, {"size", "800x600", 1, "size = 800x600"},
+    {"max_size", "8192X16", 1, "max_size = 8192x16"},
+    {"size", "641x360", 0, "size: 641x360: each side must be even and 16..8192"},
+    {"size", "640x361", 0, "must be even"},
+    {"size", "14x360", 0, "size: 14x360: each side must be even and 16..8192"},
+    {"render_size", "8194x720", 0, "render_size: 8194x720: each side"},
+    {"size", "-2x4", 0, "size: -2x4: each side must be even and 16..8192"},
+    {"size", "640", 0, "size: '640' is not a size (expected WxH, such as 640x360)"},
+    {"size", "x360", 0, "'x360' is not a size"}, {"size", "640x360x2", 0, "'640x360x2' is not a size"},
+    {"size", "640x", 0, "is not a size"}, {"size", "640*360", 0, "is not a size"},
+    {"size", " 640x360", 0, "is not a size"}, {"size", "640x 360", 0, "is not a size"},
+    {"size", "", 0, "is not a size"}, {"size", "99999999999999999999x2", 0, "is not a size"},
+    {"format", "webm", 1, "format = webm"}, {"format", "mkv", 1, "format = mkv"},
+    {"backend", "osmesa", 1, "backend = osmesa"}, {"log_level", "debug", 1, "log_level = debug"},
+    {"log_level", "error", 1, "log_level = error"}, {"format", "MP4", 0, "format: 'MP4' is not one of mp4|webm|mkv"},
+    {"format", "mp", 0, "is not one of"},   /* a prefix of a choice */
+    {"format", "mp4x", 0, "is not one of"}, /* a choice as a prefix */
+    {"format", "mp4|webm", 0, "is not one of"}, {"format", "", 0, "is not one of"},
+    {"log_level", "verbose", 0, "log_level: 'verbose' is not one of debug|info|warn|error"},
+    {"listen", "0.0.0.0:0", 1, "listen = 0.0.0.0:0"}, {"listen", "localhost:65535", 1, "listen = localhost:65535"},
+    {"listen", "[::1]:8080", 1, "listen = [::1]:8080"},
+    {"listen", "127.0.0.1", 0, "listen: '127.0.0.1' is not address:port (such as 127.0.0.1:8080)"},
+    {"listen", ":8080", 0, "is not address:port"}, {"listen", "", 0, "is not address:port"},
+    {"listen", "host:70000", 0, "listen: 'host:70000': the port must be 0..65535"},
+    {"listen", "host:", 0, "the port must be 0..65535"}, {"listen", "host:-1", 0, "the port must be 0..65535"},
+    {"listen", "host:80x", 0, "the port must be 0..65535"}, {"listen", "[::1]", 0, "an IPv6 address goes in brackets"},
+    {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
+                        "max_seconds, max_attempts, lease, watchdog, grace, size, max_size, render_size, format, backend, log_level)"},
+    {"", "1", 0, "unknown setting ''"},
+};
+
+static void set_check(const set_case *k)
+{
+    svc_config c, before;
+    svc_config_defaults(&c);
+    before = c;
+    rs_err e = {0};
+    bool ok = svc_config_set(&c, k->name, k->value, &e);
+    T_ASSERTF(ok == k->ok, "%s = '%s': %s", k->name, k->value, ok ? "accepted" : e.msg);
+    if (!ok) {
+        T_ASSERT(e.code != 0);
+        T_CONTAINS(e.msg, k->want);
+        /* a bad flag must not half-apply */
+        T_ASSERTF(!memcmp(&c, &before, sizeof c), "%s = '%s' changed the config", k->name, k->value);
+        return;
+    }
+    char *text = NULL;
+    size_t n = 0;
+    FILE *f = open_memstream(&text, &n);
+    T_ASSERT(f);
+    fputc('\n', f);
+    svc_config_dump(&c, f);
+    T_ASSERT(fclose(f) == 0);
+    char want[1200];
+    snprintf(want, sizeof want, "\n%s\n", k->want);
+    T_CONTAINS(text, want);
+    free(text);
+}
+
+static void t_config_set(void)
+{
+    for (size_t i = 0; i < sizeof set_cases / sizeof *set_cases; i++)
+        set_check(&set_cases[i]);
+}
+
+/* Each string row at its length limit, and one character past it. */
+static void t_config_lengths(void)
+{
+    static const struct {
+        const char *name, *why;
+        size_t max;
+    } rows[] = {{"data", "data: longer than 448 characters", 448}, /* leaves room for "/queue.db" */
+                {"output", "output: longer than 480", 480}, {"queue", "queue: longer than 1023", 1023},
+                {"listen", "is not address:port", 127}};
+    char v[1100], want[1200];
+    for (size_t i = 0; i < sizeof rows / sizeof *rows; i++)
+        for (size_t len = rows[i].max; len <= rows[i].max + 1; len++) {
+            memset(v, 'a', len), v[len] = 0;
+            memcpy(v + len - 5, ":8080", 5); /* listen's port; plain text to the others */
+            snprintf(want, sizeof want, "%s = %s", rows[i].name, v);
+            set_case k = {rows[i].name, v, len == rows[i].max, len == rows[i].max ? want : rows[i].why};
+            set_check(&k);
+        }
+}
+
+/* An IPv6 address must be bracketed: "::1" would otherwise be read as host
+ * ":" and port 1, and only fail at bind time with a resolver message. */
+static void t_config_listen_bare_ipv6(void)
+{
+    set_case k = {"listen", "::1", 0, "listen: '::1'"};
+    set_check(&k);
+}
+
+static const char *tmp_path(const char *name)
+{
+    static char p[512];
+    snprintf(p, sizeof p, "%s/%s", t_tmpdir(), name);
+    return p;
+}
+
+static void t_config_load_good(void)
+{
+    t_write(t_tmpdir(), "good.conf",
+            "# ringside serve\n\n   workers=4   \n"
+            "\tsize = 1280x720  # trailing comment\r\n"
+            "queue = postgres://u@db/ring?sslmode=require\n" /* '=' inside a value */
+            "   # indented comment\nformat\t=\twebm\n"
+            "log_level = warn"); /* no final newline */
+    svc_config c;
+    svc_config_defaults(&c);
+    rs_err e = {0};
+    T_ASSERTF(svc_config_load(&c, tmp_path("good.conf"), &e), "%s", e.msg);
+    T_EQ(c.workers, 4);
+    T_ASSERT(c.width == 1280 && c.height == 720);
+    T_ASSERT(!strcmp(c.queue, "postgres://u@db/ring?sslmode=require") && !strcmp(c.format, "webm"));
+    T_EQ(c.log_level, SVC_LOG_WARN);
+    T_EQ(c.lease, 30); /* what the file does not name keeps its default */
+    t_write(t_tmpdir(), "empty.conf", "");
+    T_ASSERTF(svc_config_load(&c, tmp_path("empty.conf"), &e), "%s", e.msg);
+}
+
+/* The whole message, with the path and the line it names. */
+static void load_bad(const char *text, size_t n, const char *after_path)
+{
+    const char *path = tmp_path("bad.conf");
+    FILE *f = fopen(path, "wb");
+    T_ASSERT(f && fwrite(text, 1, n, f) == n && fclose(f) == 0);
+    svc_config c;
+    svc_config_defaults(&c);
+    rs_err e = {0};
+    T_ASSERTF(!svc_config_load(&c, path, &e), "accepted: %s", text);
+    char want[1024];
+    snprintf(want, sizeof want, "%s%s", path, after_path);
+    T_ASSERTF(!strcmp(e.msg, want), "got \"%s\", want \"%s\"", e.msg, want);
+}
+#define LOAD_BAD(text, want) load_bad(text, sizeof text - 1, want)
+
+static void t_config_load_errors(void)
+{
+    LOAD_BAD("# c\n\nworkers = 0\n", ":3: workers: 0 is out of range (expected 1..64)");
+    LOAD_BAD("workers = 2\ngarbage here\n", ":2: expected 'name = value', got 'garbage here'");
+    LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, "
+                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, size, max_size, render_size, "
+                                   "format, backend, log_level)");
+    LOAD_BAD("size = 640x360\r\nsize = 640\r\n", ":2: size: '640' is not a size (expected WxH, such as 640x360)");
+    LOAD_BAD("workers = # nothing left\n", ":1: workers: '' is not a whole number");
+    LOAD_BAD("workers = 2\0\n", ": contains a NUL byte (not a text file)");
+    svc_config c;
+    svc_config_defaults(&c);
+    rs_err e = {0};
+    const char *missing = tmp_path("missing.conf");
+    T_ASSERT(!svc_config_load(&c, missing, &e));
+    char want[600];
+    snprintf(want, sizeof want, "%s: cannot open", missing);
+    T_CONTAINS(e.msg, want);
+}
+
+#define SET_OK(c, name, value)                                                                     \
+    do {                                                                                           \
+        rs_err e_ = {0};                                                                           \
+        T_ASSERTF(svc_config_set((c), (name), (value), &e_), "%s = '%s': %s", (name), (value), e_.msg); \
+    } while (0)
+
+static void t_config_finish(void)
+{
+    svc_config c;
+    svc_config_defaults(&c);
+    rs_err e = {0};
+    SET_OK(&c, "data", "/srv/ring");
+    T_ASSERTF(svc_config_finish(&c, &e), "%s", e.msg);
+    T_ASSERT(!strcmp(c.queue, "sqlite:/srv/ring/queue.db") && !strcmp(c.output, "/srv/ring/videos"));
+    svc_config_defaults(&c); /* explicit values win over derived ones */
+    SET_OK(&c, "queue", "postgres://db/ring");
+    SET_OK(&c, "output", "/mnt/v");
+    T_ASSERT(svc_config_finish(&c, &e));
+    T_ASSERT(!strcmp(c.queue, "postgres://db/ring") && !strcmp(c.output, "/mnt/v"));
+    SET_OK(&c, "size", "1920x1080"); /* equal to max_size: allowed */
+    T_ASSERT(svc_config_finish(&c, &e));
+    SET_OK(&c, "size", "2000x1000");
+    T_ASSERT(!svc_config_finish(&c, &e));
+    T_ASSERT(!strcmp(e.msg, "size 2000x1000 is larger than max_size 1920x1080"));
+    SET_OK(&c, "size", "640x1082");
+    T_ASSERT(!svc_config_finish(&c, &e));
+}
+
+/* Field by field: char arrays may differ past their terminators. */
+static void config_same(const svc_config *a, const svc_config *b)
+{
+    T_ASSERT(!strcmp(a->listen, b->listen) && !strcmp(a->data, b->data) && !strcmp(a->queue, b->queue));
+    T_ASSERT(!strcmp(a->output, b->output) && !strcmp(a->format, b->format) && !strcmp(a->backend, b->backend));
+    T_ASSERT(a->workers == b->workers && a->max_upload == b->max_upload && a->max_attempts == b->max_attempts);
+    T_ASSERT(a->lease == b->lease && a->watchdog == b->watchdog && a->grace == b->grace);
+    T_ASSERT(a->width == b->width && a->height == b->height && a->max_width == b->max_width);
+    T_ASSERT(a->max_height == b->max_height && a->render_width == b->render_width);
+    T_ASSERT(a->render_height == b->render_height && a->log_level == b->log_level);
+}
+
+static void dump_reload(const svc_config *c, svc_config *back)
+{
+    const char *path = tmp_path("dump.conf");
+    FILE *f = fopen(path, "w");
+    T_ASSERT(f);
+    svc_config_dump(c, f);
+    T_ASSERT(fclose(f) == 0);
+    svc_config_defaults(back);
+    rs_err e = {0};
+    T_ASSERTF(svc_config_load(back, path, &e), "the dump does not load: %s", e.msg);
+}
+
+static void t_config_dump_roundtrip(void)
+{
+    svc_config c, back;
+    svc_config_defaults(&c);
+    dump_reload(&c, &back);
+    config_same(&c, &back);
+    /* every row away from its default, so a row the dump forgets shows */
+    const char *kv[][2] = {{"listen", "[::1]:9000"}, {"workers", "8"}, {"data", "/srv/ring side"},
+                           {"queue", "postgres://u@db:5432/ring?sslmode=require"}, {"output", "/mnt/videos"},
+                           {"max_upload", "3M"}, {"max_attempts", "5"}, {"lease", "60"}, {"watchdog", "300"},
+                           {"grace", "0"}, {"size", "1280x720"}, {"max_size", "3840x2160"},
+                           {"render_size", "2560x1440"}, {"format", "mkv"}, {"backend", "osmesa"},
+                           {"log_level", "debug"}};
+    for (size_t i = 0; i < sizeof kv / sizeof *kv; i++)
+        SET_OK(&c, kv[i][0], kv[i][1]);
+    dump_reload(&c, &back);
+    config_same(&c, &back);
+    rs_err e = {0};
+    T_ASSERT(svc_config_finish(&c, &e) && svc_config_finish(&back, &e));
+    config_same(&c, &back);
+}
+
+/* A value the file syntax cannot carry ('#' starts a comment) must be refused
+ * when set or survive the dump: never reload as something else. */
+static void t_config_dump_hash(void)
+{
+    svc_config c, back;
+    svc_config_defaults(&c);
+    if (!svc_config_set(&c, "data", "/srv/build#2", NULL))
+        return;
+    dump_reload(&c, &back);
+    T_ASSERTF(!strcmp(back.data, c.data), "data '%s' reloads as '%s'", c.data, back.data);
+}
+
+/* --- svc_json --- */
+
+/* The next UTF-8 scalar of s[0..n): its length, or 0 when invalid.  Decodes
+ * the code point and checks it against its shortest form and the surrogate
+ * gap: a different route from svc_json.c's lead-byte table. */
+static int u8_scalar(const unsigned char *s, size_t n)
+{
+    int len = s[0] < 0x80 ? 1 : (s[0] & 0xe0) == 0xc0 ? 2 : (s[0] & 0xf0) == 0xe0 ? 3 : (s[0] & 0xf8) == 0xf0 ? 4 : 0;
+    if (!len || (size_t)len > n)
+        return 0;
+    uint32_t c = len == 1 ? s[0] : s[0] & (0x7fu >> len);
+    for (int i = 1; i < len; i++) {
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+        c = c << 6 | (s[i] & 0x3f);
+    }
+    static const uint32_t shortest[] = {0, 0, 0x80, 0x800, 0x10000};
+    return c < shortest[len] || c > 0x10ffff || (c >= 0xd800 && c <= 0xdfff) ? 0 : len;
+}
+
+static size_t u8_put(unsigned char *o, uint32_t c)
+{
+    size_t n = c < 0x80 ? 1 : c < 0x800 ? 2 : c < 0x10000 ? 3 : 4;
+    static const unsigned char lead[] = {0, 0, 0xc0, 0xe0, 0xf0};
+    for (size_t i = n - 1; i > 0; i--, c >>= 6)
+        o[i] = (unsigned char)(0x80 | (c & 0x3f));
+    o[0] = (unsigned char)(lead[n] | c);
+    return n;
+}
+
+static int hex4(const unsigned char *p)
+{
+    char h[5] = {(char)p[0], (char)p[1], (char)p[2], (char)p[3], 0};
+    return strspn(h, "0123456789abcdefABCDEF") == 4 ? (int)strtol(h, NULL, 16) : -1;
+}
+
+/* A strict reader of exactly one JSON string (RFC 8259) filling s[0..n):
+ * only the listed escapes, paired surrogates, no raw control characters,
+ * valid UTF-8.  Decodes into out (as long as the input); returns its length,
+ * or -1. */
+static long json_string(const char *s, size_t n, unsigned char *out)
+{
+    const unsigned char *p = (const unsigned char *)s, *end = p + n;
+    size_t o = 0;
+    if (n < 2 || *p++ != '"')
+        return -1;
+    while (p < end && *p != '"') {
+        if (*p < 0x20)
+            return -1;
+        if (*p != '\\') {
+            int k = u8_scalar(p, (size_t)(end - p));
+            if (!k)
+                return -1;
+            memcpy(out + o, p, (size_t)k), o += (size_t)k, p += k;
+            continue;
+        }
+        static const char names[] = "\"\\/bfnrt", vals[] = "\"\\/\b\f\n\r\t";
+        const char *esc = end - p >= 2 && p[1] ? strchr(names, p[1]) : NULL;
+        if (esc) {
+            out[o++] = (unsigned char)vals[esc - names], p += 2;
+            continue;
+        }
+        int u, lo;
+        if (end - p < 6 || p[1] != 'u' || (u = hex4(p + 2)) < 0 || (u >= 0xdc00 && u <= 0xdfff))
+            return -1;
+        p += 6;
+        if (u >= 0xd800 && u <= 0xdbff) {
+            if (end - p < 6 || p[0] != '\\' || p[1] != 'u' || (lo = hex4(p + 2)) < 0xdc00 || lo > 0xdfff)
+                return -1;
+            u = 0x10000 + ((u - 0xd800) << 10) + (lo - 0xdc00), p += 6;
+        }
+        o += u8_put(out + o, (uint32_t)u);
+    }
+    return p + 1 == end ? (long)o : -1;
+}
+
+static void t_json_str_fixed(void)
+{
+    static const char *const cases[][2] = {
+        {"", "\"\""}, {"plain text", "\"plain text\""},
+        {"say \"hi\"", "\"say \\\"hi\\\"\""}, {"C:\\dir\\", "\"C:\\\\dir\\\\\""},
+        {"a\nb", "\"a\\nb\""}, {"\x01\t\r\x1f", "\"\\u0001\\u0009\\u000d\\u001f\""},
+        {"del\x7f", "\"del\\u007f\""}, {"</script>", "\"</script>\""},
+        {"caf\xc3\xa9", "\"caf\xc3\xa9\""},           /* 2 bytes */
+        {"\xe2\x82\xac 5", "\"\xe2\x82\xac 5\""},     /* 3 bytes */
+        {"\xf0\x9f\xa5\x8a", "\"\xf0\x9f\xa5\x8a\""}, /* 4 bytes */
+        {"\xf4\x8f\xbf\xbf", "\"\xf4\x8f\xbf\xbf\""}, /* U+10FFFF, the last */
+        {"a\x80z", "\"a\\ufffdz\""},                  /* lone continuation bytes */
+        {"\xbf\xbf", "\"\\ufffd\\ufffd\""},
+        {"\xc0\x80", "\"\\ufffd\\ufffd\""}, /* overlong NUL */
+        {"\xc1\xbf", "\"\\ufffd\\ufffd\""},
+        {"\xe0\x80\xaf", "\"\\ufffd\\ufffd\\ufffd\""}, /* overlong '/' */
+        {"\xf0\x8f\xbf\xbf", "\"\\ufffd\\ufffd\\ufffd\\ufffd\""},
+        {"\xed\xa0\x80", "\"\\ufffd\\ufffd\\ufffd\""}, /* surrogates D800, DFFF */
+        {"\xed\xbf\xbf", "\"\\ufffd\\ufffd\\ufffd\""},
+        {"\xf4\x90\x80\x80", "\"\\ufffd\\ufffd\\ufffd\\ufffd\""}, /* past U+10FFFF */
+        {"ok\xe2\x82", "\"ok\\ufffd\\ufffd\""},                   /* cut short by the end */
+        {"\xf0\x9f\xa5", "\"\\ufffd\\ufffd\\ufffd\""}, {"\xc3", "\"\\ufffd\""},
+        {"\xe2\x82\"", "\"\\ufffd\\ufffd\\\"\""}, /* cut short by a quote */
+        {"\xff\xfe", "\"\\ufffd\\ufffd\""},
+    };
+    svc_buf b = {0};
+    unsigned char out[64];
+    svc_json_str(&b, NULL); /* a missing name still makes valid JSON */
+    T_ASSERT(!strcmp(b.p, "\"\""));
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        b.len = 0;
+        svc_json_str(&b, cases[i][0]);
+        T_ASSERTF(!strcmp(b.p, cases[i][1]), "case %zu: got %s, want %s", i, b.p, cases[i][1]);
+        T_ASSERTF(json_string(b.p, b.len, out) >= 0, "case %zu: %s is not a JSON string", i, b.p);
+    }
+    svc_buf_free(&b);
+}
+
+/* Bytes F5..FF never start UTF-8, even when continuation bytes follow. */
+static void t_json_str_f5_lead(void)
+{
+    svc_buf b = {0};
+    svc_json_str(&b, "\xf5\x80\x80|\xf8\x88\x80\x80|\xff\xbf\xbf");
+    T_ASSERTF(!strcmp(b.p, "\"\\ufffd\\ufffd\\ufffd|\\ufffd\\ufffd\\ufffd\\ufffd|\\ufffd\\ufffd\\ufffd\""),
+              "got %s", b.p);
+    svc_buf_free(&b);
+}
+
+/* Random bytes, biased towards UTF-8's edges: the output must be one valid
+ * JSON string whose text is the input with each invalid byte read as U+FFFD. */
+static void t_json_str_random(void)
+{
+    unsigned char in[40], want[128], got[128];
+    svc_buf b = {0};
+    for (int iter = 0; iter < 20000; iter++) {
+        size_t n = 0, len = rnd() % 32;
+        while (n < len) {
+            uint32_t k = rnd() % 5;
+            if (k < 3) { /* ASCII, any byte, a continuation byte */
+                static const uint32_t base[] = {1, 1, 0x80}, span[] = {127, 255, 64};
+                in[n++] = (unsigned char)(base[k] + rnd() % span[k]);
+                continue;
+            }
+            /* a sequence: sometimes a surrogate or past U+10FFFF, or cut short (k == 4) */
+            static const uint32_t top[] = {0x800, 0x10000, 0x110000, 0x140000};
+            unsigned char seq[4];
+            size_t m = u8_put(seq, 0x80 + rnd() % (top[rnd() % 4] - 0x80));
+            if (k == 4 && m > 1)
+                m -= 1 + rnd() % (m - 1);
+            for (size_t i = 0; i < m && n < len; i++)
+                in[n++] = seq[i];
+        }
+        in[n] = 0;
+        size_t wn = 0;
+        for (size_t i = 0; i < n;) {
+            int m = u8_scalar(in + i, n - i);
+            if (m)
+                memcpy(want + wn, in + i, (size_t)m), wn += (size_t)m, i += (size_t)m;
+            else
+                memcpy(want + wn, "\xef\xbf\xbd", 3), wn += 3, i++;
+        }
+        b.len = 0;
+        svc_json_str(&b, (const char *)in);
+        long gn = json_string(b.p, b.len, got);
+        if (gn != (long)wn || memcmp(got, want, wn)) {
+            char hex[200] = "";
+            for (size_t i = 0; i < n; i++)
+                snprintf(hex + strlen(hex), sizeof hex - strlen(hex), "%02x ", in[i]);
+            t_fail(__FILE__, __LINE__, "iteration %d: bytes %s-> %s (%s)", iter, hex, b.p,
+                   gn < 0 ? "not a valid JSON string" : "valid, but the wrong text");
+        }
+    }
+    svc_buf_free(&b);
+}
+
+static svc_job job(int state)
+{
+    svc_job j;
+    memset(&j, 0, sizeof j);
+    j.id = 42, j.state = state, j.attempts = 1, j.desync_tick = -1;
+    snprintf(j.name, sizeof j.name, "dojo \"final\".rsr");
+    snprintf(j.format, sizeof j.format, "webm");
+    snprintf(j.owner, sizeof j.owner, "box:123"); /* shown only while running */
+    j.width = 1280, j.height = 720, j.frames_total = 200;
+    j.created = 1700000000; /* 2023-11-14T22:13:20Z */
+    return j;
+}
+
+/* The job's JSON is exactly want (exact == starts with want), or contains it. */
+static void job_is(const svc_job *j, const char *want, bool exact)
+{
+    svc_buf b = {0};
+    svc_json_job(&b, j, 3);
+    T_ASSERT(b.p && !b.oom);
+    if (exact)
+        T_ASSERTF(!strcmp(b.p, want), "\ngot  %s\nwant %s", b.p, want);
+    else
+        T_CONTAINS(b.p, want);
+    svc_buf_free(&b);
+}
+
+#define JOB_HEAD "{\"id\":42,\"state\":"
+#define JOB_NAME "\"name\":\"dojo \\\"final\\\".rsr\",\"size\":\"1280x720\",\"format\":\"webm\","
+
+static void t_json_job(void)
+{
+    svc_job j = job(SVC_QUEUED);
+    job_is(&j, JOB_HEAD "\"queued\"," JOB_NAME "\"frames_done\":0,\"frames_total\":200,\"progress\":0.0000,"
+                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":1,\"max_attempts\":3,\"error\":null,"
+                        "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
+                        "\"finished\":null,\"url\":\"/jobs/42\"}", true);
+    j = job(SVC_RUNNING);
+    j.frames_done = 50, j.fps = 25, j.started = 1700000060;
+    job_is(&j, JOB_HEAD "\"running\"," JOB_NAME "\"frames_done\":50,\"frames_total\":200,\"progress\":0.2500,"
+                        "\"fps\":25.00,\"eta_s\":6.0,\"attempts\":1,\"max_attempts\":3,\"error\":null,"
+                        "\"desync_tick\":null,\"worker\":\"box:123\",\"created\":\"2023-11-14T22:13:20Z\","
+                        "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":null,\"url\":\"/jobs/42\"}", true);
+    j.fps = 0; /* no speed yet: no guess */
+    job_is(&j, "\"fps\":0.00,\"eta_s\":null,", false);
+    j.fps = 30, j.frames_done = 250; /* a total behind the count must not give a negative ETA */
+    job_is(&j, "\"eta_s\":null,", false);
+    j = job(SVC_DONE);
+    j.frames_done = 190, j.fps = 40; /* the last heartbeat may lag the end */
+    j.started = 1700000060, j.finished = 1700000100;
+    job_is(&j, JOB_HEAD "\"done\"," JOB_NAME "\"frames_done\":200,\"frames_total\":200,\"progress\":1.0000,"
+                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":1,\"max_attempts\":3,\"error\":null,"
+                        "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\","
+                        "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":\"2023-11-14T22:15:00Z\","
+                        "\"url\":\"/jobs/42\",\"video\":\"/jobs/42/video\",\"hashes\":\"/jobs/42/hashes\"}", true);
+    j = job(SVC_FAILED);
+    j.attempts = 3, j.frames_done = 120, j.finished = 1700000100;
+    j.desync_tick = 0; /* tick 0 is a tick, not "none" */
+    snprintf(j.error, sizeof j.error, "desync at tick 0:\n\"want\" \x01 \xff");
+    job_is(&j, JOB_HEAD "\"failed\"," JOB_NAME "\"frames_done\":120,\"frames_total\":200,\"progress\":0.6000,"
+                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":3,\"max_attempts\":3,"
+                        "\"error\":\"desync at tick 0:\\n\\\"want\\\" \\u0001 \\ufffd\",\"desync_tick\":0,"
+                        "\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
+                        "\"finished\":\"2023-11-14T22:15:00Z\",\"url\":\"/jobs/42\"}", true);
+    j.desync_tick = 3600;
+    job_is(&j, ",\"desync_tick\":3600,", false);
+    j = job(SVC_CANCELLED);
+    j.frames_total = 0; /* no division by zero */
+    job_is(&j, JOB_HEAD "\"cancelled\"," JOB_NAME "\"frames_done\":0,\"frames_total\":0,\"progress\":0.0000,", false);
+}
+
+static void t_json_buf_growth(void)
+{
+    svc_buf b = {0};
+    size_t n = 3u << 20;
+    char *big = malloc(n + 1);
+    T_ASSERT(big);
+    for (size_t i = 0; i < n; i++)
+        big[i] = (char)('a' + i % 26);
+    big[n] = 0;
+    for (size_t i = 0; i < 3; i++)
+        svc_buf_add(&b, big + i * (n / 3), n / 3);
+    T_ASSERT(b.len == n && b.cap > n && !memcmp(b.p, big, n) && b.p[n] == 0);
+    b.len = 0;
+    svc_buf_printf(&b, "<%s>", big);
+    T_ASSERT(b.len == n + 2 && b.p[0] == '<' && b.p[n + 1] == '>' && !memcmp(b.p + 1, big, n));
+    memset(big, '"', n); /* every byte doubles */
+    b.len = 0;
+    svc_json_str(&b, big);
+    T_EQ(b.len, 2 * n + 2);
+    unsigned char *out = malloc(n);
+    T_ASSERT(out && json_string(b.p, b.len, out) == (long)n);
+    free(out);
+    svc_buf_free(&b);
+    T_ASSERT(!b.p && !b.len && !b.cap);
+    svc_json_error(&b, "bad \"size\"");
+    T_ASSERT(!strcmp(b.p, "{\"error\":\"bad \\\"size\\\"\"}\n"));
+    svc_buf_free(&b);
+    free(big);
+}
+
+/* --- svc_parse_range --- */
+
+static void t_range_cases(void)
+{
+    static const struct {
+        const char *h;
+        uint64_t len;
+        int want;
+        uint64_t first, last;
+    } cases[] = {
+        {"bytes=0-99", 1000, 1, 0, 99}, {"bytes=100-", 1000, 1, 100, 999}, {"bytes=-50", 1000, 1, 950, 999},
+        {"bytes=-5000", 1000, 1, 0, 999}, /* more than the file: all of it */
+        {"bytes=500-5000", 1000, 1, 500, 999}, {"bytes=0-18446744073709551615", 1000, 1, 0, 999}, /* the end clamps */
+        {"bytes=999-999", 1000, 1, 999, 999}, {"bytes=0-0", 1, 1, 0, 0},
+        {"bytes=-0", 1000, -1, 0, 0}, {"bytes=1000-", 1000, -1, 0, 0}, {"bytes=1000-2000", 1000, -1, 0, 0},
+        {"bytes=18446744073709551615-", 1000, -1, 0, 0},
+        {"bytes=0-", 0, -1, 0, 0}, {"bytes=0-0", 0, -1, 0, 0}, {"bytes=-10", 0, -1, 0, 0}, /* nothing to send */
+        {NULL, 1000, 0, 0, 0},
+        /* 0: serve the whole file, as RFC 9110 allows for what it cannot use */
+        {"bytes=5-2", 1000, 0, 0, 0}, {"bytes=0-1,5-6", 1000, 0, 0, 0}, {"0-99", 1000, 0, 0, 0},
+        {"items=0-99", 1000, 0, 0, 0}, {"", 1000, 0, 0, 0}, {"bytes=", 1000, 0, 0, 0}, {"bytes=-", 1000, 0, 0, 0},
+        {"bytes=abc", 1000, 0, 0, 0}, {"bytes=1", 1000, 0, 0, 0}, {"bytes=1-x", 1000, 0, 0, 0},
+        {"bytes=0-99 ", 1000, 0, 0, 0}, {"bytes= 0-9", 1000, 0, 0, 0}, {"bytes=+1-5", 1000, 0, 0, 0},
+        {"bytes=1-+5", 1000, 0, 0, 0}, {"bytes=--5", 1000, 0, 0, 0}, {"bytes=-+5", 1000, 0, 0, 0},
+        {"bytes=-5x", 1000, 0, 0, 0}, {"bytes=0x10-", 1000, 0, 0, 0},
+        /* overflow: no range rather than a wrapped one */
+        {"bytes=99999999999999999999-", 1000, 0, 0, 0}, {"bytes=0-99999999999999999999", 1000, 0, 0, 0},
+        {"bytes=-99999999999999999999", 1000, 0, 0, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        uint64_t f = 777, l = 777;
+        int r = svc_parse_range(cases[i].h, cases[i].len, &f, &l);
+        T_ASSERTF(r == cases[i].want && (r != 1 || (f == cases[i].first && l == cases[i].last)),
+                  "'%s' of %llu bytes: got %d (%llu-%llu)", cases[i].h ? cases[i].h : "(null)",
+                  (unsigned long long)cases[i].len, r, (unsigned long long)f, (unsigned long long)l);
+    }
+}
+
+/* Against a model of RFC 9110's single byte range, with random lengths and
+ * bounds near the file's end and far past it. */
+static void t_range_random(void)
+{
+    char h[80];
+    for (int iter = 0; iter < 200000; iter++) {
+        uint64_t len = rnd() % 4 ? rnd() % 1000 : (uint64_t)rnd() << 32 | rnd();
+        uint64_t a = rnd() % 3 ? rnd() % 1100 : (uint64_t)rnd() << 32 | rnd();
+        uint64_t b = rnd() % 3 ? rnd() % 1100 : (uint64_t)rnd() << 32 | rnd();
+        int form = (int)(rnd() % 3), want;
+        uint64_t wf = a, wl = len - 1;
+        if (form == 0) {
+            snprintf(h, sizeof h, "bytes=%llu-%llu", (unsigned long long)a, (unsigned long long)b);
+            want = b < a ? 0 : a >= len ? -1 : 1;
+            wl = b < len ? b : len - 1;
+        } else if (form == 1) {
+            snprintf(h, sizeof h, "bytes=%llu-", (unsigned long long)a);
+            want = a >= len ? -1 : 1;
+        } else {
+            snprintf(h, sizeof h, "bytes=-%llu", (unsigned long long)b);
+            want = b == 0 || len == 0 ? -1 : 1;
+            wf = b >= len ? 0 : len - b;
+        }
+        uint64_t f = 0, l = 0;
+        int r = svc_parse_range(h, len, &f, &l);
+        T_ASSERTF(r == want, "'%s' of %llu bytes: got %d, want %d", h, (unsigned long long)len, r, want);
+        T_ASSERTF(r != 1 || (f <= l && l < len && f == wf && l == wl), "'%s' of %llu bytes: got %llu-%llu", h,
+                  (unsigned long long)len, (unsigned long long)f, (unsigned long long)l);
+    }
+}
+
+/* --- svc_check_upload --- */
+
+/* A match recorded in memory with random inputs held for a while, as a
+ * player holds them. */
+static uint8_t *make_replay(uint64_t ticks, size_t *n)
+{
+    g_state st;
+    g_init(&st, 0, 7);
+    rp_recorder rec;
+    rp_rec_init(&rec, 0, 7, RP_HUMAN, RP_HUMAN);
+    rs_err e = {0};
+    g_input in[2] = {0, 0};
+    for (uint64_t t = 0; t < ticks; t++) {
+        if (rnd() % 8 == 0)
+            in[0] = g_input_clean((g_input)(rnd() & 0x7f)), in[1] = g_input_clean((g_input)(rnd() & 0x7f));
+        g_step(&st, in, NULL);
+        T_ASSERTF(rp_rec_tick(&rec, in, &st, &e), "%s", e.msg);
+    }
+    uint8_t *buf;
+    T_ASSERTF(rp_encode(&rec.rp, &buf, n, &e), "%s", e.msg);
+    rp_free(&rec.rp);
+    return buf;
+}
+
+/* Rewrites the trailing CRC so a change reaches the parser's field checks. */
+static void put_crc(uint8_t *buf, size_t n)
+{
+    uint32_t c = rs_crc32(0, buf, n - 4);
+    for (int k = 0; k < 4; k++)
+        buf[n - 4 + (size_t)k] = (uint8_t)(c >> (8 * k));
+}
+
+/* frames_total (> 0) when accepted; 0 when refused, which must be with code
+ * and a message holding want (want NULL: must be accepted). */
+static int64_t upload(const svc_config *cfg, const uint8_t *data, size_t len, int code, const char *want)
+{
+    svc_job j;
+    memset(&j, 0, sizeof j);
+    rs_err e = {0};
+    if (svc_check_upload(cfg, data, len, "clip.rsr", &j, &e)) {
+        T_ASSERT(j.frames_total > 0);
+        return j.frames_total;
+    }
+    T_ASSERTF(want && e.code == code, "%zu bytes: code %d, want %d: %s", len, e.code, code, e.msg);
+    T_CONTAINS(e.msg, want);
+    return 0;
+}
+
+static void t_upload_refusals(void)
+{
+    svc_config cfg;
+    svc_config_defaults(&cfg);
+    T_EQ(upload(&cfg, (const uint8_t *)"", 0, 400, "empty upload"), 0);
+    T_EQ(upload(&cfg, (const uint8_t *)"hello world", 11, 400, "clip.rsr: not a ringside replay"), 0);
+    SET_OK(&cfg, "max_upload", "1K");
+    uint8_t *junk = calloc(1, 1025);
+    T_ASSERT(junk);
+    T_EQ(upload(&cfg, junk, 1025, 413, "clip.rsr: 1025 bytes is over the upload limit of 1024 bytes"), 0);
+    T_EQ(upload(&cfg, junk, 1024, 400, "clip.rsr: not a ringside replay"), 0); /* at the limit: parsed */
+    free(junk);
+    size_t n;
+    uint8_t *buf = make_replay(120, &n);
+    memset(buf + 20, 0, 8); /* a replay of no ticks: nothing to render */
+    put_crc(buf, n);
+    T_EQ(upload(&cfg, buf, n, 400, "clip.rsr: tick count 0"), 0);
+    free(buf);
+}
+
+static void t_upload_valid(void)
+{
+    svc_config cfg;
+    svc_config_defaults(&cfg);
+    size_t n;
+    uint8_t *buf = make_replay(1000, &n);
+    T_EQ(upload(&cfg, buf, n, 0, NULL), 1000);
+    /* max_seconds: 1000 ticks is 16.7 s of game time */
+    cfg.max_seconds = 17;
+    T_EQ(upload(&cfg, buf, n, 0, NULL), 1000);
+    cfg.max_seconds = 16;
+    upload(&cfg, buf, n, 400, "clip.rsr: the replay lasts 17 s; this service renders at most 16 s (max_seconds)");
+    svc_config_defaults(&cfg);
+    free(buf);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/demos/temple.rsr", RS_SOURCE_DIR);
+    rs_err e = {0};
+    rp_replay rp;
+    buf = (uint8_t *)rs_read_file(path, RP_MAX_FILE, &n, &e);
+    T_ASSERTF(buf && rp_read(path, &rp, &e), "%s", e.msg);
+    T_EQ(upload(&cfg, buf, n, 0, NULL), rp.ticks);
+    rp_free(&rp);
+    free(buf);
+}
+
+/* Every prefix of a good replay is a broken upload: refused with 400, and
+ * never read past its end (each copy is exactly k bytes, for ASan). */
+static void t_upload_truncations(void)
+{
+    svc_config cfg;
+    svc_config_defaults(&cfg);
+    size_t n;
+    uint8_t *buf = make_replay(2000, &n);
+    for (size_t k = 1; k < n; k++) {
+        uint8_t *cut = malloc(k);
+        T_ASSERT(cut);
+        memcpy(cut, buf, k);
+        T_ASSERTF(upload(&cfg, cut, k, 400, "clip.rsr") == 0, "the first %zu of %zu bytes were accepted", k, n);
+        free(cut);
+    }
+    free(buf);
+}
+
+/* One byte changed: accepted (it still parses) or refused with 400, never a
+ * crash.  Half the trials fix the checksum so the field checks are reached. */
+static void t_upload_corruptions(void)
+{
+    svc_config cfg;
+    svc_config_defaults(&cfg);
+    size_t n;
+    uint8_t *buf = make_replay(1500, &n), *bad = malloc(n);
+    T_ASSERT(bad);
+    int refused = 0;
+    for (int iter = 0; iter < 4000; iter++) {
+        memcpy(bad, buf, n);
+        size_t at = rnd() % n;
+        bad[at] ^= (uint8_t)(rnd() % 255 + 1);
+        if (iter & 1 && at < n - 4)
+            put_crc(bad, n);
+        refused += !upload(&cfg, bad, n, 400, "clip.rsr");
+    }
+    T_ASSERT(refused > 2000); /* the unfixed half all fail the checksum */
+    free(bad);
+    free(buf);
+}
+
+T_MAIN({"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
+       {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
+       {"config_load_errors", t_config_load_errors}, {"config_finish", t_config_finish},
+       {"config_dump_roundtrip", t_config_dump_roundtrip}, {"config_dump_hash", t_config_dump_hash},
+       {"json_str_fixed", t_json_str_fixed}, {"json_str_f5_lead", t_json_str_f5_lead},
+       {"json_str_random", t_json_str_random}, {"json_job", t_json_job}, {"json_buf_growth", t_json_buf_growth},
+       {"range_cases", t_range_cases}, {"range_random", t_range_random}, {"upload_refusals", t_upload_refusals},
+       {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
+       {"upload_corruptions", t_upload_corruptions})
