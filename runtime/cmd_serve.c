@@ -169,6 +169,13 @@ int cmd_serve(int argc, char **argv)
         return RS_EXIT_OK;
     }
     svc_log_level(d.cfg.log_level);
+    /* started with stdin/out/err closed, pipes could land on fds 0..2 and
+     * be overwritten when a render's stdio is set up: fill them first */
+    int nullfd = open("/dev/null", O_RDWR);
+    while (nullfd >= 0 && nullfd <= 2)
+        nullfd = open("/dev/null", O_RDWR);
+    if (nullfd > 2)
+        close(nullfd);
 
     int status = RS_EXIT_FAIL, lock_fd = -1;
     struct MHD_Daemon *http = NULL;

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../capture/cap.h"
 #include "../runtime/util/rs_file.h"
 
 typedef enum { C_INT, C_BYTES, C_STR, C_SIZE, C_CHOICE, C_LISTEN } c_type;
@@ -240,6 +241,10 @@ bool svc_config_finish(svc_config *c, rs_err *err)
     if (c->width > c->max_width || c->height > c->max_height)
         return rs_fail(err, 1, "size %dx%d is larger than max_size %dx%d", c->width, c->height, c->max_width,
                        c->max_height);
+    rs_err serr = {0};
+    if (!cap_check_sizes_for(CAP_I420, c->render_width, c->render_height, c->width, c->height, &serr))
+        return rs_fail(err, 1, "size %dx%d with render_size %dx%d: %s", c->width, c->height, c->render_width,
+                       c->render_height, serr.msg);
     return true;
 }
 

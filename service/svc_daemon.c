@@ -44,6 +44,8 @@
 
 typedef struct worker {
     int slot;
+    char owner[SVC_OWNER_MAX]; /* "host:pid-nonce/slot": a lease belongs to one slot, so a job re-claimed
+                                  by another slot of this daemon is no longer the old render's */
     bool busy;
     pid_t pid;
     svc_job job;
@@ -56,6 +58,7 @@ typedef struct worker {
     int64_t fps_d0;
     double fps;
     enum { K_NONE, K_WATCHDOG, K_CANCEL, K_SHUTDOWN } killed;
+    double killed_at;
     char out_tmp[1024], hashes_tmp[1024], replay_path[1024];
 } worker;
 
@@ -108,8 +111,11 @@ static void worker_clear(svc_daemon *d, worker *w)
         }
     svc_job_free(&w->job);
     int slot = w->slot;
+    char owner[SVC_OWNER_MAX];
+    memcpy(owner, w->owner, sizeof owner);
     memset(w, 0, sizeof *w);
     w->slot = slot;
+    memcpy(w->owner, owner, sizeof owner);
     w->prog_fd = w->err_fd = -1;
     publish(d, w);
 }
@@ -125,7 +131,8 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
              j->format);
     snprintf(w->hashes_tmp, sizeof w->hashes_tmp, "%s/.job%" PRId64 "-%d-a%d.hashes", d->cfg.output, j->id, (int)me,
              j->attempts);
-    if (!rs_write_part(w->replay_path, j->replay, j->replay_len, err) || !rs_commit_file(w->replay_path, err))
+    if (!rs_mkdirs_for(w->replay_path, err) || !rs_write_part(w->replay_path, j->replay, j->replay_len, err) ||
+        !rs_commit_file(w->replay_path, err))
         return false;
     char size[32], rsize[32];
     snprintf(size, sizeof size, "%dx%d", j->width, j->height);
@@ -150,6 +157,9 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
         prctl(PR_SET_PDEATHSIG, SIGKILL);
         if (getppid() != parent)
             _exit(127);
+        /* its own process group: Ctrl-C at the daemon's terminal (or a
+         * signal to the daemon's group) reaches the daemon, which decides */
+        setpgid(0, 0);
         int devnull = open("/dev/null", O_RDWR);
         if (devnull < 0 || dup2(devnull, 0) < 0 || dup2(devnull, 1) < 0 || dup2(errp[1], 2) < 0 ||
             dup2(prog[1], 3) < 0)
@@ -262,6 +272,20 @@ static void describe_status(int status, char *out, size_t n)
         snprintf(out, n, "status %d", status);
 }
 
+/* A problem of this machine (full disk, output directory gone): the jobs
+ * are not at fault, so no attempt is counted, and claiming pauses (1 s,
+ * doubling to 60 s) so one bad disk cannot run the whole queue into the
+ * attempt cap. */
+static double local_backoff, claim_after;
+
+static void local_failure(double now)
+{
+    local_backoff = local_backoff ? local_backoff * 2 : 1.0;
+    if (local_backoff > 60)
+        local_backoff = 60;
+    claim_after = now + local_backoff;
+}
+
 /* A render process ended: decide what its job becomes. */
 static void on_exit_status(svc_daemon *d, worker *w, int status)
 {
@@ -273,28 +297,26 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
     describe_status(status, how, sizeof how);
     double secs = now_s() - w->spawned;
 
-    if (w->killed == K_CANCEL) {
+    bool exited_ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    if (w->killed == K_CANCEL && !exited_ok) {
         svc_log(SVC_LOG_INFO, j->id, "cancelled; render process stopped after %.1f s", secs);
         goto out;
     }
-    if (w->killed == K_SHUTDOWN) {
-        if (d->store->ops->release(d->store, j->id, d->owner, "the daemon shut down before the render finished", false,
-                                   d->cfg.max_attempts, &err) < 0)
-            svc_log(SVC_LOG_ERROR, j->id, "could not re-queue: %s", err.msg);
-        else
-            svc_log(SVC_LOG_INFO, j->id, "re-queued: the daemon is shutting down (%" PRId64 " of %" PRId64 " frames done)",
-                    w->done, w->total);
-        goto out;
-    }
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    /* a finished render counts even if a stop signal came just too late */
+    if (exited_ok) {
         char video[1100], hashes[1100];
         final_paths(d, j, video, sizeof video, hashes, sizeof hashes);
         if (rename(w->hashes_tmp, hashes) != 0 || rename(w->out_tmp, video) != 0) {
+            /* this machine's problem (disk, a vanished directory), not the job's */
             snprintf(why, sizeof why, "the render finished but its output could not be moved to %s: %s", video,
                      strerror(errno));
-            goto retry;
+            if (d->store->ops->release(d->store, j->id, w->owner, why, false, d->cfg.max_attempts, &err) < 0)
+                svc_log(SVC_LOG_ERROR, j->id, "could not re-queue: %s", err.msg);
+            local_failure(now_s());
+            svc_log(SVC_LOG_ERROR, j->id, "%s; re-queued, no new jobs for %.0f s", why, local_backoff);
+            goto out;
         }
-        int r = d->store->ops->finish(d->store, j->id, d->owner, SVC_DONE, "", -1, w->total, &err);
+        int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
         if (r == 1) {
             svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames in %.1f s (%.1f fps)", video, w->total, secs,
                     secs > 0 ? (double)w->total / secs : 0.0);
@@ -302,17 +324,36 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
             d->jobs_done++;
             pthread_mutex_unlock(&d->mu);
         } else if (r == 0) {
-            svc_log(SVC_LOG_WARN, j->id, "finished, but the job is no longer ours (cancelled or re-claimed)");
+            /* cancelled meanwhile: its files go; finished by another daemon
+             * (a lease lost and re-claimed): the same bytes, keep them */
+            svc_job cur;
+            if (d->store->ops->get(d->store, j->id, &cur, &err) == 1 && cur.state == SVC_CANCELLED) {
+                unlink(video);
+                unlink(hashes);
+                svc_log(SVC_LOG_INFO, j->id, "finished just after it was cancelled: video removed");
+            } else
+                svc_log(SVC_LOG_WARN, j->id, "finished, but the job is no longer ours (re-claimed elsewhere)");
         } else
             svc_log(SVC_LOG_ERROR, j->id, "finished, but recording it failed: %s (the lease will expire and the "
                                           "job will run again)", err.msg);
+        goto out;
+    }
+    if (w->killed == K_SHUTDOWN || (d->stop && w->killed == K_NONE)) {
+        /* stopped for the daemon's shutdown (by us after the grace period,
+         * or by a signal to the whole service): not the job's fault */
+        if (d->store->ops->release(d->store, j->id, w->owner, "the daemon shut down before the render finished", false,
+                                   d->cfg.max_attempts, &err) < 0)
+            svc_log(SVC_LOG_ERROR, j->id, "could not re-queue: %s", err.msg);
+        else
+            svc_log(SVC_LOG_INFO, j->id, "re-queued: the daemon is shutting down (%" PRId64 " of %" PRId64 " frames done)",
+                    w->done, w->total);
         goto out;
     }
     if (w->desync >= 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 2)) {
         /* the replay's own fault (or a usage error of ours): retrying
          * cannot help */
         snprintf(why, sizeof why, "%s", w->last_err[0] ? w->last_err : how);
-        if (d->store->ops->finish(d->store, j->id, d->owner, SVC_FAILED, why, w->desync, w->done, &err) < 0)
+        if (d->store->ops->finish(d->store, j->id, w->owner, SVC_FAILED, why, w->desync, w->done, &err) < 0)
             svc_log(SVC_LOG_ERROR, j->id, "could not record the failure: %s", err.msg);
         svc_log(SVC_LOG_WARN, j->id, "failed: %s", why);
         pthread_mutex_lock(&d->mu);
@@ -328,12 +369,11 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
         snprintf(why, sizeof why, "the render process was %s at frame %" PRId64 " of %" PRId64, how, w->done, w->total);
     else
         snprintf(why, sizeof why, "%s (%s)", w->last_err[0] ? w->last_err : "the render failed", how);
-retry:
     pthread_mutex_lock(&d->mu);
     d->worker_crashes++;
     pthread_mutex_unlock(&d->mu);
     {
-        int r = d->store->ops->release(d->store, j->id, d->owner, why, true, d->cfg.max_attempts, &err);
+        int r = d->store->ops->release(d->store, j->id, w->owner, why, true, d->cfg.max_attempts, &err);
         if (r < 0)
             svc_log(SVC_LOG_ERROR, j->id, "could not re-queue after \"%s\": %s", why, err.msg);
         else if (r == 0)
@@ -373,19 +413,25 @@ static void tend(svc_daemon *d, worker *w, double now)
         w->fps_d0 = w->done;
     }
     publish(d, w);
-    if (w->killed)
+    if (w->killed) {
+        /* a render stopped with SIGTERM that has not gone in 10 s (hung in
+         * the driver or the encoder) gets SIGKILL */
+        if (now - w->killed_at > 10.0)
+            kill(w->pid, SIGKILL);
         return;
+    }
     double beat = d->cfg.lease / 6.0 < 1.0 ? 1.0 : d->cfg.lease / 6.0;
     if (now - w->last_beat >= beat) {
         rs_err err = {0};
         w->last_beat = now;
-        int r = d->store->ops->heartbeat(d->store, w->job.id, d->owner, d->cfg.lease, w->done, w->total, w->fps, &err);
+        int r = d->store->ops->heartbeat(d->store, w->job.id, w->owner, d->cfg.lease, w->done, w->total, w->fps, &err);
         if (r == 0) {
             /* cancelled by DELETE (or, after a long stall, re-claimed) */
             svc_job cur;
             bool cancelled = d->store->ops->get(d->store, w->job.id, &cur, &err) == 1 && cur.state == SVC_CANCELLED;
             svc_log(SVC_LOG_INFO, w->job.id, "%s: stopping its render", cancelled ? "cancelled" : "no longer ours");
             w->killed = K_CANCEL;
+            w->killed_at = now;
             kill(w->pid, SIGTERM);
             return;
         }
@@ -396,6 +442,7 @@ static void tend(svc_daemon *d, worker *w, double now)
         svc_log(SVC_LOG_WARN, w->job.id, "no progress for %d s (frame %" PRId64 " of %" PRId64 "): killing process %d",
                 d->cfg.watchdog, w->done, w->total, (int)w->pid);
         w->killed = K_WATCHDOG;
+        w->killed_at = now;
         kill(w->pid, SIGKILL);
         pthread_mutex_lock(&d->mu);
         d->watchdog_kills++;
@@ -406,7 +453,9 @@ static void tend(svc_daemon *d, worker *w, double now)
 static void start_job(svc_daemon *d, worker *w)
 {
     rs_err err = {0};
-    int r = d->store->ops->claim(d->store, d->owner, d->cfg.lease, &w->job, &err);
+    if (now_s() < claim_after)
+        return;
+    int r = d->store->ops->claim(d->store, w->owner, d->cfg.lease, &w->job, &err);
     if (r <= 0) {
         if (r < 0)
             svc_log(SVC_LOG_ERROR, -1, "claiming a job failed: %s", err.msg);
@@ -417,10 +466,14 @@ static void start_job(svc_daemon *d, worker *w)
         snprintf(why, sizeof why, "could not start the render: %s", err.msg);
         svc_log(SVC_LOG_ERROR, w->job.id, "%s", why);
         rs_err e2 = {0};
-        if (d->store->ops->release(d->store, w->job.id, d->owner, why, true, d->cfg.max_attempts, &e2) < 0)
+        if (d->store->ops->release(d->store, w->job.id, w->owner, why, false, d->cfg.max_attempts, &e2) < 0)
             svc_log(SVC_LOG_ERROR, w->job.id, "could not re-queue: %s", e2.msg);
+        local_failure(now_s());
+        svc_log(SVC_LOG_WARN, -1, "a local problem: no new jobs for %.0f s", local_backoff);
         worker_clear(d, w);
+        return;
     }
+    local_backoff = 0;
 }
 
 int svc_run(svc_daemon *d)
@@ -434,6 +487,7 @@ int svc_run(svc_daemon *d)
     for (int i = 0; i < n; i++) {
         ws[i].slot = i;
         ws[i].prog_fd = ws[i].err_fd = -1;
+        snprintf(ws[i].owner, sizeof ws[i].owner, "%s/%d", d->owner, i);
     }
     double last_reap = 0, drain_start = 0;
     bool draining = false;
@@ -456,13 +510,13 @@ int svc_run(svc_daemon *d)
             for (int i = 0; i < n; i++)
                 if (ws[i].busy && !ws[i].killed) {
                     ws[i].killed = K_SHUTDOWN;
+                    ws[i].killed_at = now;
                     kill(ws[i].pid, SIGTERM);
                 }
             /* a render that ignores SIGTERM for 10 s gets SIGKILL */
-            if (now - drain_start >= d->cfg.grace + 10.0 || (d->stop > 1 && now - drain_start > 10.0))
-                for (int i = 0; i < n; i++)
-                    if (ws[i].busy)
-                        kill(ws[i].pid, SIGKILL);
+            for (int i = 0; i < n; i++)
+                if (ws[i].busy && now - ws[i].killed_at > 10.0)
+                    kill(ws[i].pid, SIGKILL);
         }
         /* children that ended */
         for (int i = 0; i < n; i++) {

@@ -23,6 +23,7 @@
 #include "svc_json.h"
 #include "svc_local.h"
 #include "svc_log.h"
+#include "../capture/cap.h"
 #include "../runtime/cli.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
@@ -36,6 +37,16 @@ bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, co
         return rs_fail(err, 400, "empty upload: send the replay file (.rsr) as the request body");
     if (len > (size_t)cfg->max_upload)
         return rs_fail(err, 413, "%s: %zu bytes is over the upload limit of %ld bytes", name, len, cfg->max_upload);
+    /* the tick count (byte 20) first: a small file can declare days of
+     * run-length coded play, and decoding it would allocate 2 bytes a tick */
+    if (len >= 28 && !memcmp(data, RP_MAGIC, 4)) {
+        uint64_t ticks = 0;
+        for (int k = 0; k < 8; k++)
+            ticks |= (uint64_t)data[20 + k] << (8 * k);
+        if (ticks > (uint64_t)cfg->max_seconds * 60 && ticks <= RP_MAX_TICKS)
+            return rs_fail(err, 400, "%s: the replay lasts %llu s; this service renders at most %d s (max_seconds)",
+                           name, (unsigned long long)((ticks + 59) / 60), cfg->max_seconds);
+    }
     rp_replay rp = {0};
     rs_err perr = {0};
     if (!rp_decode(data, len, name, &rp, &perr))
@@ -105,6 +116,7 @@ typedef struct req {
     uint8_t *body;
     size_t len, cap;
     bool too_large, oom;
+    const char *bad; /* a malformed body: answered 400 once it is read */
     char name[SVC_NAME_MAX];
     char size[32], format[16];
 } req;
@@ -123,8 +135,10 @@ static enum MHD_Result reply(struct MHD_Connection *c, unsigned status, const ch
 
 static enum MHD_Result reply_json(struct MHD_Connection *c, unsigned status, svc_buf *b)
 {
-    if (b->oom)
+    if (b->oom) {
+        svc_buf_free(b);
         return MHD_NO;
+    }
     enum MHD_Result r = reply(c, status, "application/json", b->p ? b->p : "", b->len);
     svc_buf_free(b);
     return r;
@@ -143,11 +157,11 @@ static enum MHD_Result reply_error(struct MHD_Connection *c, unsigned status, co
     return reply_json(c, status, &b);
 }
 
-static bool append(req *q, const char *data, size_t n, long cap)
+static bool append(req *q, const char *data, size_t n, long limit)
 {
     if (q->too_large || q->oom)
         return true;
-    if (q->len + n > (size_t)cap) {
+    if (q->len + n > (size_t)limit) {
         q->too_large = true;
         free(q->body);
         q->body = NULL;
@@ -190,14 +204,16 @@ static enum MHD_Result post_field(void *cls, enum MHD_ValueKind kind, const char
     (void)kind, (void)content_type, (void)transfer_encoding;
     svc_daemon *d = ((void **)cls)[0];
     req *q = ((void **)cls)[1];
+    if (!key) /* a part without a name: nothing we asked for */
+        return MHD_YES;
     if (!strcmp(key, "replay") || !strcmp(key, "file")) {
         if (off == 0 && filename)
             set_name(q, filename);
         return append(q, data, size, d->cfg.max_upload) ? MHD_YES : MHD_NO;
     }
     char *dst = !strcmp(key, "size") ? q->size : !strcmp(key, "format") ? q->format : NULL;
-    size_t cap = !strcmp(key, "size") ? sizeof q->size : sizeof q->format;
-    if (dst && off + size < cap) {
+    size_t room = !strcmp(key, "size") ? sizeof q->size : sizeof q->format;
+    if (dst && off + size < room) {
         memcpy(dst + off, data, size);
         dst[off + size] = 0;
     }
@@ -249,6 +265,8 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
 {
     if (q->oom)
         return reply_error(c, 500, "out of memory reading the upload");
+    if (q->bad)
+        return reject(d, c, 400, "%s", q->bad);
     if (q->too_large)
         return reject(d, c, 413, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
     const char *v;
@@ -277,6 +295,9 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
             return reject(d, c, 400, "size %ldx%ld: each side must be even, at least 16 and at most %dx%d", w, h,
                                d->cfg.max_width, d->cfg.max_height);
         j.width = (int)w, j.height = (int)h;
+        rs_err serr = {0};
+        if (!cap_check_sizes_for(CAP_I420, d->cfg.render_width, d->cfg.render_height, j.width, j.height, &serr))
+            return reject(d, c, 400, "size %s: %s", q->size, serr.msg);
     }
     if (q->format[0]) {
         if (strcmp(q->format, "mp4") && strcmp(q->format, "webm") && strcmp(q->format, "mkv"))
@@ -417,7 +438,7 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, int64_t 
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     struct stat st;
     if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        int e = errno;
+        int e = fd >= 0 && S_ISREG(st.st_mode) ? errno : fd < 0 ? errno : EISDIR;
         if (fd >= 0)
             close(fd);
         svc_log(SVC_LOG_WARN, id, "%s: %s (a shared output directory not mounted here?)", path, strerror(e));
@@ -623,10 +644,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             cx->pc.pair[0] = d;
             cx->pc.pair[1] = q;
             q->pp = MHD_create_post_processor(c, 32 * 1024, post_field, cx->pc.pair);
-            if (!q->pp) {
-                q->done = true;
-                return reply_error(c, 400, "malformed multipart/form-data request (no boundary?)");
-            }
+            if (!q->pp)
+                q->bad = "malformed multipart/form-data request (no boundary?)";
         }
         return MHD_YES;
     }
@@ -636,11 +655,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             if (!q->post_jobs)
                 ; /* a body nobody asked for: ignored */
             else if (q->pp) {
-                if (MHD_post_process(q->pp, upload, *upload_size) != MHD_YES && !q->oom && !q->too_large) {
-                    *upload_size = 0;
-                    q->done = true;
-                    return reply_error(c, 400, "malformed multipart/form-data body");
-                }
+                /* libmicrohttpd takes no response while a body is still
+                 * arriving: remember, read the rest, answer at the end */
+                if (!q->bad && MHD_post_process(q->pp, upload, *upload_size) != MHD_YES && !q->oom && !q->too_large)
+                    q->bad = "malformed multipart/form-data body";
             } else if (!append(q, upload, *upload_size, d->cfg.max_upload))
                 q->oom = true;
         }
@@ -706,9 +724,9 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
         flags |= MHD_USE_IPv6;
     flags |= MHD_USE_AUTO; /* epoll on Linux: no FD_SETSIZE limit */
     struct MHD_Daemon *mhd = MHD_start_daemon(
-        flags, 0, NULL, NULL, on_request, d, MHD_OPTION_SOCK_ADDR, ai->ai_addr, MHD_OPTION_THREAD_POOL_SIZE, 4u,
-        MHD_OPTION_NOTIFY_COMPLETED, on_completed, d, MHD_OPTION_CONNECTION_TIMEOUT, 60u, MHD_OPTION_EXTERNAL_LOGGER,
-        on_mhd_log, d, MHD_OPTION_CONNECTION_LIMIT, 256u, MHD_OPTION_END);
+        flags, 0, NULL, NULL, on_request, d, MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, d, MHD_OPTION_SOCK_ADDR,
+        ai->ai_addr, MHD_OPTION_THREAD_POOL_SIZE, 4u, MHD_OPTION_NOTIFY_COMPLETED, on_completed, d,
+        MHD_OPTION_CONNECTION_TIMEOUT, 60u, MHD_OPTION_CONNECTION_LIMIT, 256u, MHD_OPTION_END);
     freeaddrinfo(ai);
     if (!mhd) {
         rs_fail(err, 1, "cannot listen on %s (in use, or not an address of this machine?)", d->cfg.listen);

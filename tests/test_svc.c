@@ -246,6 +246,14 @@ static void t_config_finish(void)
     SET_OK(&c, "output", "/mnt/v");
     T_ASSERT(svc_config_finish(&c, &e));
     T_ASSERT(!strcmp(c.queue, "postgres://db/ring") && !strcmp(c.output, "/mnt/v"));
+    SET_OK(&c, "size", "1280x720"); /* equal to the render size: allowed */
+    T_ASSERT(svc_config_finish(&c, &e));
+    SET_OK(&c, "size", "1920x1080"); /* within max_size, but larger than what is drawn */
+    T_ASSERT(!svc_config_finish(&c, &e));
+    T_CONTAINS(e.msg, "size 1920x1080 with render_size 1280x720");
+    SET_OK(&c, "size", "16x16"); /* more than 8 times smaller than what is drawn */
+    T_ASSERT(!svc_config_finish(&c, &e));
+    SET_OK(&c, "render_size", "1920x1080");
     SET_OK(&c, "size", "1920x1080"); /* equal to max_size: allowed */
     T_ASSERT(svc_config_finish(&c, &e));
     SET_OK(&c, "size", "2000x1000");

@@ -9,6 +9,12 @@
 SVC_SRC=$(cd "$(dirname "$0")/../.." && pwd)
 SVC_BIN_DIR=$(dirname "$RS_BIN")
 SVC_PIDS=""
+# what else a case must undo when it ends (pg_stop, say)
+SVC_ON_EXIT=":"
+svc_cleanup() {
+    for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done
+    $SVC_ON_EXIT
+}
 
 # small and fast: the tests check the service, not the picture
 SVC_FAST="--render-size 160x90 --size 160x90 --lease 6 --log-level debug"
@@ -30,7 +36,7 @@ svc_start() {
     SVC_PIDS="$SVC_PIDS $SVC_PID"
     # every daemon a test case started dies with the case, whatever happened
     # (each case is a subshell: this trap is the case's own)
-    trap 'for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done' EXIT
+    trap svc_cleanup EXIT
     i=0
     while [ $i -lt 100 ]; do
         port=$(sed -n 's/.*listening on http:\/\/127\.0\.0\.1:\([0-9]*\)\/.*/\1/p' "$name.log" | tail -1)

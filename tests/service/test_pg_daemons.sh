@@ -10,7 +10,8 @@ trap 'exit 143' TERM INT HUP
 
 t_two_daemons_share_one_queue() {
     pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
-    trap 'for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done; pg_stop' EXIT
+    SVC_ON_EXIT=pg_stop
+    trap svc_cleanup EXIT
     pg_start "$pgdir"
     rc=$?
     [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
@@ -59,7 +60,8 @@ t_two_daemons_share_one_queue() {
 
 t_lease_of_a_dead_daemon_expires() {
     pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
-    trap 'for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done; pg_stop' EXIT
+    SVC_ON_EXIT=pg_stop
+    trap svc_cleanup EXIT
     pg_start "$pgdir"
     rc=$?
     [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"

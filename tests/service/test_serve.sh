@@ -171,6 +171,13 @@ t_bad_uploads_get_4xx() {
     post good.rsr 400 "size '12x': expected WxH" "size=12x" || return 1
     post good.rsr 400 "size 4000x4000" "size=4000x4000" || return 1
     post good.rsr 400 "format 'avi'" "format=avi" || return 1
+    # sizes the renderer cannot make from what it draws (160x90 here)
+    post good.rsr 400 "size 320x180: .*larger than the render size" "size=320x180" || return 1
+    # a multipart part without a name (libmicrohttpd hands it over nameless)
+    printf -- '--XYZ\r\nFoo: bar\r\n\r\nAAAA\r\n--XYZ--\r\n' >noname.txt
+    code=$(curl -s -o resp.json -w '%{http_code}' -H 'Content-Type: multipart/form-data; boundary=XYZ' \
+        --data-binary @noname.txt "$SVC_URL/jobs")
+    [ "$code" = 400 ] || { echo "nameless multipart part: $code $(cat resp.json)"; return 1; }
     # a wrong version byte gets the parser's own message
     python3 -c 'import sys; b=bytearray(open("good.rsr","rb").read()); b[4]=99; open("v99.rsr","wb").write(b)'
     post v99.rsr 400 'version' || return 1
@@ -186,8 +193,46 @@ t_bad_uploads_get_4xx() {
     id=$(svc_submit good.rsr) || return 1
     [ "$id" = 1 ] || { echo "a refused upload took an id: $id"; return 1; }
     svc_wait_state "$id" done 60 || return 1
-    curl -s "$SVC_URL/metrics" | grep -q '^ringside_uploads_rejected_total 10$' || { curl -s "$SVC_URL/metrics" | grep rejected; return 1; }
+    curl -s "$SVC_URL/metrics" | grep -q '^ringside_uploads_rejected_total 12$' || { curl -s "$SVC_URL/metrics" | grep rejected; return 1; }
     svc_stop
+}
+
+t_local_problems_do_not_burn_attempts() {
+    # the work directory vanishes under a running daemon: the next job
+    # recreates it instead of failing every job for good
+    "$RS_BIN" record --ai --quiet --seconds 1 --seed 4 -o a.rsr || return 1
+    svc_start d $SVC_FAST || return 1
+    rm -rf d/work
+    id=$(svc_submit a.rsr) || return 1
+    svc_wait_state "$id" done 60 || return 1
+    [ "$(svc_field "$id" attempts)" = 1 ] || { echo "attempts $(svc_field "$id" attempts)"; return 1; }
+    svc_stop
+}
+
+t_ctrl_c_to_the_whole_group() {
+    # Ctrl-C at a terminal signals the daemon's whole process group: the
+    # renders are in their own groups, so the daemon drains as for SIGTERM
+    "$RS_BIN" record --ai --quiet --seconds 3 --seed 2 -o a.rsr || return 1
+    mkdir -p d
+    setsid "$RS_BIN" serve --listen 127.0.0.1:0 --data d $SVC_FAST >>d.log 2>&1 &
+    SVC_PID=$!
+    SVC_PIDS="$SVC_PIDS $SVC_PID"
+    trap svc_cleanup EXIT
+    i=0
+    until port=$(sed -n 's/.*listening on http:\/\/127\.0\.0\.1:\([0-9]*\)\/.*/\1/p' d.log) && [ -n "$port" ]; do
+        sleep 0.1; i=$((i + 1)); [ $i -lt 100 ] || { cat d.log; return 1; }
+    done
+    SVC_URL=http://127.0.0.1:$port
+    id=$(svc_submit a.rsr) || return 1
+    i=0
+    while [ "$(svc_field "$id" frames_done)" -lt 10 ] 2>/dev/null; do
+        sleep 0.2; i=$((i + 1)); [ $i -lt 300 ] || { echo "no progress"; return 1; }
+    done
+    kill -INT "-$SVC_PID" # dash's kill takes no "--"
+    wait "$SVC_PID"
+    rc=$?
+    [ "$rc" = 0 ] || { echo "exit $rc"; cat d.log; return 1; }
+    grep -q "job $id: done" d.log || { echo "the running job did not finish in the grace period"; cat d.log; return 1; }
 }
 
 t_desynced_replay_fails_with_its_tick() {
@@ -304,7 +349,8 @@ t_range_requests() {
 }
 
 t_run ${T_ONLY:-readme_flow twenty_concurrent_jobs worker_killed_mid_render daemon_killed_and_restarted \
-    sigterm_lets_running_jobs_finish sigterm_after_grace_requeues bad_uploads_get_4xx \
+    sigterm_lets_running_jobs_finish sigterm_after_grace_requeues ctrl_c_to_the_whole_group \
+    local_problems_do_not_burn_attempts bad_uploads_get_4xx \
     desynced_replay_fails_with_its_tick cancel_queued_and_running watchdog_kills_a_stalled_render \
     retry_cap_dead_letters config_file_and_errors range_requests}
 t_done
