@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../service/svc_local.h"
@@ -200,7 +201,11 @@ int cmd_serve(int argc, char **argv)
     }
     char host[64] = "localhost";
     gethostname(host, sizeof host - 1);
-    snprintf(d.owner, sizeof d.owner, "%s:%d", host, (int)getpid());
+    /* the nonce: two containers may share a hostname and both be pid 1 */
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    snprintf(d.owner, sizeof d.owner, "%s:%d-%08x", host, (int)getpid(),
+             (unsigned)(ts.tv_nsec ^ (ts.tv_sec << 20) ^ ((long)getpid() << 8)));
 
     bool sqlite = strncmp(d.cfg.queue, "postgres://", 11) != 0 && strncmp(d.cfg.queue, "postgresql://", 13) != 0;
     if (sqlite) {
