@@ -77,7 +77,7 @@ static void t_skipped_pass_is_not_called(void)
     r_graph g;
     build(&g);
     world w = {.want_b = false};
-    uint32_t ran = r_graph_run(&g, &w);
+    r_graph_mask ran = r_graph_run(&g, &w);
     T_EQ(ran, 0xD); /* passes 0, 2, 3 */
     T_EQ(w.n, 3);
     T_EQ(w.order[0], 0);
@@ -128,14 +128,14 @@ static void t_inconsistent_needed_is_an_error(void)
 /* Timing on a GL context: every pass that ran gets a time, skipped ones
  * none, and the report names them all. */
 static int frames_seen;
-static uint32_t last_ran_seen;
-static void on_frame(void *u, uint64_t frame, uint32_t ran, const double *gpu, const double *cpu)
+static r_graph_mask last_ran_seen;
+static void on_frame(void *u, uint64_t frame, r_graph_mask ran, const double *gpu, const double *cpu)
 {
     (void)u, (void)frame, (void)gpu;
     frames_seen++;
     last_ran_seen = ran;
     for (int i = 0; i < 4; i++)
-        if (ran & (1u << i))
+        if (ran & ((r_graph_mask)1 << i))
             T_ASSERT(cpu[i] >= 0 && cpu[i] < 10000);
 }
 static GLuint fbo_for_test;

@@ -8,6 +8,9 @@ const g_stage_def g_stages[G_STAGES] = {
     {"dojo", FX(4.0), false},
     {"harbor", FX(3.5), true},
     {"temple", FX(4.5), false},
+    {"shallows", FX(4.0), false},  /* ankle-deep water over the ring (water) */
+    {"snowfield", FX(4.0), false}, /* fresh snow on the ring (snow) */
+    {"mistvale", FX(4.5), false},  /* mist that limbs stir (fog map) */
 };
 
 #define WALK_F_SPEED FX(0.030)

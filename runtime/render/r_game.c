@@ -13,112 +13,24 @@
 #include "r_shader.h"
 #include "r_tex.h"
 #include "r_tone.h"
+#include "r_local.h"
 
 const float r_fighter_color[2][3] = {{0.80f, 0.16f, 0.12f}, {0.14f, 0.32f, 0.85f}};
 static const float skin[3] = {0.85f, 0.66f, 0.52f};
 
-#define HUD_MAX_QUADS 4096
-#define SHADOW_SIZE 1024 /* SSFSM light depth map */
-#define SIL_SIZE 512     /* silhouette, level 0 */
-#define SIL_LEVELS 5     /* the sharp level and 4 blurred ones */
-#define SKY_SIZE 128     /* the environment as seen */
-#define LENS_ALPHA 0.15f
-
-/* resources of the pass graph */
-enum {
-    RES_ENV = 1u << 0,  /* IBL maps, sky, LUT, textures: built at load */
-    RES_SHADOW = 1u << 1,
-    RES_SIL = 1u << 2,
-    RES_DEPTH = 1u << 3,
-    RES_MASK = 1u << 4,
-    RES_HDR = 1u << 5,
-    RES_BLOOM = 1u << 6,
-    RES_SUNVIS = 1u << 7,
-    RES_OUT = 1u << 8,
-    RES_FLARE = 1u << 9,
-};
-static const char *const res_names[] = {"env", "shadow map", "silhouette", "depth", "shadow mask",
-                                        "hdr", "bloom", "sun visibility", "output", "flare"};
-
-typedef struct hud_vertex {
-    float x, y, u, v, r, g, b, a;
-} hud_vertex;
-
-typedef struct prog {
-    GLuint id;
-} prog;
-
-enum { P_FIGHTER, P_STAGE, P_LENS, P_DEPTH, P_SIL, P_SKY, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD,
-       P_TONE, /* + 4 variants: bloom x flare */
-       P_COUNT = P_TONE + 4 };
-
-typedef struct frame {
-    const g_state *prev, *cur;
-    float alpha;
-    int w, h;
-    r_mat4 vp, inv_vp, light;
-    r_vec3 eye, light_dir, waist[2];
-    float bones[2][16][16], colors[2][16][4];
-    float flash, saturation, exposure;
-    bool sun_on_screen;
-    float sun_px[2];
-    int fig_box[4]; /* x, y, w, h: the fighters on screen plus the mask filter's reach */
-    GLint out_fbo;
-} frame;
-
-struct r_game {
-    r_game_opts opts;
-    char stage_file[1024];
-    GLuint prog[P_COUNT];
-    GLuint fighter_vao, fighter_vbo, fighter_ibo;
-    GLsizei fighter_count;
-    GLuint lens_vao, lens_vbo, lens_ibo;
-    GLsizei lens_count;
-    GLuint ring_vao, ring_vbo, ring_ibo;
-    GLsizei ring_count;
-    int ring_stage; /* the game stage the ring mesh has the size of; -1 none */
-    GLuint empty_vao;
-    GLuint hud_vao, hud_vbo, font_tex;
-    hud_vertex *hud;
-    int nhud;
-    /* look */
-    bool have_stage;
-    int stage_game; /* the game stage the look was loaded for; -1 = set by r_game_set_stage */
-    float key_dir[3]; /* the IBL's key direction: shadows are cast from it */
-    r_stage stage;
-    r_hdr_format hdr_format;
-    GLuint ibl_tex[R_IBL_MAPS][2], sky_tex, lut_tex, normal_tex, spec_tex, flare_tex;
-    int lut_size;
-    float lut_gamma;
-    /* light-space targets */
-    GLuint shadow_tex, shadow_fbo;
-    GLuint sil_tex, sil_tmp, sil_fbo[SIL_LEVELS], sil_tmp_fbo[SIL_LEVELS];
-    /* screen targets */
-    int tw, th;
-    r_hdr_format tfmt;
-    GLuint hdr_tex, depth_tex, hdr_fbo, depth_fbo;
-    GLuint mask_tex[2], mask_fbo[2];
-    GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2];
-    GLuint fl_tex, fl_fbo; /* the flare image, quarter size */
-    GLuint sunvis_tex, sunvis_fbo;
-    int mask_final; /* index of the filtered mask */
-    /* graph */
-    r_graph graph;
-    int pass_ids[R_GRAPH_MAX];
-    bool per_frame;
-    FILE *passes_out;
-    frame f;
-    char error[768];
-};
+static const char *const res_names[] = {"env",    "shadow map",  "silhouette",  "depth",       "shadow mask",
+                                        "hdr",    "bloom",       "sun visibility", "output",   "flare",
+                                        "fog map", "water",      "water reflection", "under water", "snow",
+                                        "snow light"};
 
 /* ---- helpers ---- */
 
-static GLint loc(GLuint p, const char *name)
+GLint r_loc(GLuint p, const char *name)
 {
     return gl.GetUniformLocation(p, name);
 }
 
-static void upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *ibo)
+void r_upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *ibo)
 {
     gl.GenVertexArrays(1, vao);
     gl.BindVertexArray(*vao);
@@ -143,7 +55,7 @@ static void upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
-static void free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo)
+void r_free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo)
 {
     if (*vao)
         gl.DeleteVertexArrays(1, vao);
@@ -154,7 +66,7 @@ static void free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo)
     *vao = *vbo = *ibo = 0;
 }
 
-static GLuint tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const void *px, GLenum filter, GLenum wrap)
+GLuint r_tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const void *px, GLenum filter, GLenum wrap)
 {
     GLuint t;
     gl.GenTextures(1, &t);
@@ -169,7 +81,7 @@ static GLuint tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const vo
     return t;
 }
 
-static GLuint fbo_for(GLuint color, int level, GLuint depth)
+GLuint r_fbo_for(GLuint color, int level, GLuint depth)
 {
     GLuint f;
     gl.GenFramebuffers(1, &f);
@@ -204,24 +116,24 @@ static GLuint cube_tex(int n, float *const face[6], int levels)
     return t;
 }
 
-static void bind_tex(GLuint p, const char *name, int unit, GLenum target, GLuint t)
+void r_bind_tex(GLuint p, const char *name, int unit, GLenum target, GLuint t)
 {
     gl.ActiveTexture(GL_TEXTURE0 + (GLenum)unit);
     gl.BindTexture(target, t);
-    gl.Uniform1i(loc(p, name), unit);
+    gl.Uniform1i(r_loc(p, name), unit);
 }
 
-static void bind_ibl(r_game *r, GLuint p)
+void r_bind_ibl(r_game *r, GLuint p)
 {
     static const char *names[R_IBL_MAPS][2] = {{"u_diffuse_off", "u_diffuse_on"},
                                                {"u_spec16_off", "u_spec16_on"},
                                                {"u_spec128_off", "u_spec128_on"}};
     for (int m = 0; m < R_IBL_MAPS; m++)
         for (int k = 0; k < 2; k++)
-            bind_tex(p, names[m][k], 8 + m * 2 + k, GL_TEXTURE_CUBE_MAP, r->ibl_tex[m][k]);
+            r_bind_tex(p, names[m][k], 8 + m * 2 + k, GL_TEXTURE_CUBE_MAP, r->ibl_tex[m][k]);
 }
 
-static void fullscreen(r_game *r)
+void r_fullscreen(r_game *r)
 {
     gl.BindVertexArray(r->empty_vao);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
@@ -236,7 +148,7 @@ static void free_look(r_game *r)
     gl.DeleteTextures(1, &r->sky_tex);
     memset(r->ibl_tex, 0, sizeof r->ibl_tex);
     r->sky_tex = 0;
-    free_mesh(&r->ring_vao, &r->ring_vbo, &r->ring_ibo);
+    r_free_mesh(&r->ring_vao, &r->ring_vbo, &r->ring_ibo);
     r->have_stage = false;
 }
 
@@ -250,8 +162,8 @@ static bool build_ring(r_game *r, int game_stage, rs_err *err)
         r_mesh_free(&m);
         return rs_fail(err, 1, "out of memory for the ring mesh");
     }
-    free_mesh(&r->ring_vao, &r->ring_vbo, &r->ring_ibo);
-    upload_mesh(&m, &r->ring_vao, &r->ring_vbo, &r->ring_ibo);
+    r_free_mesh(&r->ring_vao, &r->ring_vbo, &r->ring_ibo);
+    r_upload_mesh(&m, &r->ring_vao, &r->ring_vbo, &r->ring_ibo);
     r->ring_count = (GLsizei)m.ni;
     r->ring_stage = game_stage;
     r_mesh_free(&m);
@@ -296,6 +208,12 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
         return false;
     r->stage_game = game_stage;
     r->have_stage = true;
+    r->have_last = false; /* the simulations restart on a new look */
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->load && !r_fx_modules[i]->load(r, err)) {
+            r->have_stage = false;
+            return false;
+        }
     RGL_CHECK("load_look");
     return true;
 }
@@ -341,7 +259,7 @@ static void free_targets(r_game *r)
     r->tw = r->th = 0;
 }
 
-static int half(int v, int k)
+int r_half(int v, int k)
 {
     v >>= k;
     return v > 0 ? v : 1;
@@ -353,26 +271,26 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
         return true;
     free_targets(r);
     GLenum hdr_fmt = r->hdr_format == R_HDR_R11G11B10F ? GL_R11F_G11F_B10F : GL_RGBA16F;
-    r->hdr_tex = tex2d(hdr_fmt, w, h, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-    r->depth_tex = tex2d(GL_DEPTH24_STENCIL8, w, h, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, NULL, GL_NEAREST,
+    r->hdr_tex = r_tex2d(hdr_fmt, w, h, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    r->depth_tex = r_tex2d(GL_DEPTH24_STENCIL8, w, h, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, NULL, GL_NEAREST,
                          GL_CLAMP_TO_EDGE);
-    r->hdr_fbo = fbo_for(r->hdr_tex, 0, r->depth_tex);
+    r->hdr_fbo = r_fbo_for(r->hdr_tex, 0, r->depth_tex);
     GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
-    r->depth_fbo = fbo_for(0, 0, r->depth_tex);
+    r->depth_fbo = r_fbo_for(0, 0, r->depth_tex);
     for (int i = 0; i < 2; i++) {
-        r->mask_tex[i] = tex2d(GL_R8, w, h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-        r->mask_fbo[i] = fbo_for(r->mask_tex[i], 0, 0);
-        r->b4_tex[i] = tex2d(GL_RGBA16F, half(w, 2), half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-        r->b4_fbo[i] = fbo_for(r->b4_tex[i], 0, 0);
-        r->b8_tex[i] = tex2d(GL_RGBA16F, half(w, 3), half(h, 3), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-        r->b8_fbo[i] = fbo_for(r->b8_tex[i], 0, 0);
+        r->mask_tex[i] = r_tex2d(GL_R8, w, h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->mask_fbo[i] = r_fbo_for(r->mask_tex[i], 0, 0);
+        r->b4_tex[i] = r_tex2d(GL_RGBA16F, r_half(w, 2), r_half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->b4_fbo[i] = r_fbo_for(r->b4_tex[i], 0, 0);
+        r->b8_tex[i] = r_tex2d(GL_RGBA16F, r_half(w, 3), r_half(h, 3), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->b8_fbo[i] = r_fbo_for(r->b8_tex[i], 0, 0);
     }
-    r->b2_tex = tex2d(GL_RGBA16F, half(w, 1), half(h, 1), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-    r->b2_fbo = fbo_for(r->b2_tex, 0, 0);
-    r->sunvis_tex = tex2d(GL_R16F, 1, 1, GL_RED, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
-    r->sunvis_fbo = fbo_for(r->sunvis_tex, 0, 0);
-    r->fl_tex = tex2d(GL_RGBA16F, half(w, 2), half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-    r->fl_fbo = fbo_for(r->fl_tex, 0, 0);
+    r->b2_tex = r_tex2d(GL_RGBA16F, r_half(w, 1), r_half(h, 1), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    r->b2_fbo = r_fbo_for(r->b2_tex, 0, 0);
+    r->sunvis_tex = r_tex2d(GL_R16F, 1, 1, GL_RED, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+    r->sunvis_fbo = r_fbo_for(r->sunvis_tex, 0, 0);
+    r->fl_tex = r_tex2d(GL_RGBA16F, r_half(w, 2), r_half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    r->fl_fbo = r_fbo_for(r->fl_tex, 0, 0);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
@@ -485,6 +403,38 @@ static void light_setup(r_game *r, frame *f)
     f->light = r_mul(r_ortho(-rad, rad, -rad, rad, 20 - rad - 1, 20 + 40), r_look_at(from, c, up));
 }
 
+static void world_capsules(const g_state *st, int i, r_fx_capsule out[G_BONES])
+{
+    g_capsule c[G_BONES];
+    g_fighter_capsules(st, i, c);
+    float facing = (float)st->f[i].facing;
+    for (int k = 0; k < G_BONES; k++) {
+        float z = fx_to_float(c[k].z) * facing;
+        out[k] = (r_fx_capsule){{fx_to_float(c[k].ax), fx_to_float(c[k].ay), z},
+                                {fx_to_float(c[k].bx), fx_to_float(c[k].by), z},
+                                fx_to_float(c[k].r)};
+    }
+}
+
+/* What the stage effects see (r_fx.h): whole ticks, and how many passed. */
+static void fx_setup(r_game *r, frame *f)
+{
+    const g_state *cur = f->cur, *prev = f->prev && f->prev->tick + 1 == cur->tick ? f->prev : cur;
+    for (int i = 0; i < 2; i++) {
+        world_capsules(cur, i, f->caps[i]);
+        world_capsules(prev, i, f->caps_prev[i]);
+        bone_matrices(NULL, prev, i, 1.0f, f->bones_prev[i]);
+    }
+    f->vp_prev = r_game_camera(prev, f->w, f->h, NULL);
+    uint64_t t = cur->tick;
+    if (!r->have_last || t < r->last_tick || t - r->last_tick > R_FX_MAX_GAP)
+        f->reset = true, f->steps = 1;
+    else
+        f->steps = (int)(t - r->last_tick);
+    r->have_last = true;
+    r->last_tick = t;
+}
+
 static void frame_setup(r_game *r, frame *f)
 {
     const g_state *cur = f->cur;
@@ -504,6 +454,7 @@ static void frame_setup(r_game *r, frame *f)
         f->waist[i] = r_v3(fx_to_float(wx), fx_to_float(wy), 0);
     }
     light_setup(r, f);
+    fx_setup(r, f);
     /* lightning and the KO moment drop saturation for a flash */
     float flash = cur->flash > 0 ? (float)cur->flash / 8.0f : 0.0f;
     if (cur->phase == G_PHASE_ROUND_END && cur->round_result == G_RES_KO && cur->phase_ticks < 10)
@@ -526,11 +477,11 @@ static void frame_setup(r_game *r, frame *f)
 
 /* ---- passes ---- */
 
-static bool ran(const frame *f, r_game *r, const char *name)
+bool r_ran(const frame *f, r_game *r, const char *name)
 {
     (void)f;
     int i = r_graph_find(&r->graph, name);
-    return i >= 0 && (r->graph.ran_now & (1u << i));
+    return i >= 0 && (r->graph.ran_now & ((r_graph_mask)1 << i));
 }
 
 static bool need_always(void *u)
@@ -563,12 +514,12 @@ static bool need_hud(void *u)
     return !r->opts.no_hud && !r->opts.mask;
 }
 
-static void draw_fighters(r_game *r, GLuint p)
+void r_draw_fighters(r_game *r, GLuint p)
 {
     gl.BindVertexArray(r->fighter_vao);
     for (int i = 0; i < 2; i++) {
-        gl.UniformMatrix4fv(loc(p, "u_bones"), G_BONES, GL_FALSE, &r->f.bones[i][0][0]);
-        gl.Uniform4fv(loc(p, "u_bone_color"), G_BONES, &r->f.colors[i][0][0]);
+        gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &r->f.bones[i][0][0]);
+        gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &r->f.colors[i][0][0]);
         gl.DrawElements(GL_TRIANGLES, r->fighter_count, GL_UNSIGNED_INT, NULL);
     }
 }
@@ -576,8 +527,8 @@ static void draw_fighters(r_game *r, GLuint p)
 static void light_view_draw(r_game *r, GLuint p)
 {
     gl.UseProgram(p);
-    gl.UniformMatrix4fv(loc(p, "u_view_proj"), 1, GL_FALSE, r->f.light.m);
-    draw_fighters(r, p);
+    gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, r->f.light.m);
+    r_draw_fighters(r, p);
 }
 
 static void run_shadow_map(void *u)
@@ -608,29 +559,29 @@ static void run_silhouette(void *u)
     light_view_draw(r, r->prog[P_SIL]);
 }
 
-static void blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy)
+void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy)
 {
     GLuint p = r->prog[P_BLUR];
     gl.BindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
     gl.Viewport(0, 0, w, h);
     gl.UseProgram(p);
-    bind_tex(p, "u_src", 0, GL_TEXTURE_2D, src_tex);
-    gl.Uniform2f(loc(p, "u_dir"), dx / (float)w, dy / (float)h);
-    gl.Uniform1f(loc(p, "u_lod"), (float)lod);
-    fullscreen(r);
+    r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, src_tex);
+    gl.Uniform2f(r_loc(p, "u_dir"), dx / (float)w, dy / (float)h);
+    gl.Uniform1f(r_loc(p, "u_lod"), (float)lod);
+    r_fullscreen(r);
 }
 
-static void down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale)
+void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale)
 {
     GLuint p = r->prog[P_DOWN];
     gl.BindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
     gl.Viewport(0, 0, w, h);
     gl.UseProgram(p);
-    bind_tex(p, "u_src", 0, GL_TEXTURE_2D, src_tex);
-    gl.Uniform1f(loc(p, "u_lod"), (float)lod);
-    gl.Uniform1f(loc(p, "u_threshold"), threshold);
-    gl.Uniform1f(loc(p, "u_scale"), scale);
-    fullscreen(r);
+    r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, src_tex);
+    gl.Uniform1f(r_loc(p, "u_lod"), (float)lod);
+    gl.Uniform1f(r_loc(p, "u_threshold"), threshold);
+    gl.Uniform1f(r_loc(p, "u_scale"), scale);
+    r_fullscreen(r);
 }
 
 /* Blurred mipmap projection shadow: level k = blur(downsample(level k-1)),
@@ -652,22 +603,22 @@ static void run_silhouette_mips(void *u)
     for (int k = 1; k < SIL_LEVELS; k++) {
         int n = SIL_SIZE >> k;
         restrict_level(r->sil_tex, k - 1);
-        down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
+        r_down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
         restrict_level(r->sil_tex, k);
-        blur_into(r, r->sil_tmp_fbo[k], r->sil_tex, 0, n, n, 1, 0);
+        r_blur_into(r, r->sil_tmp_fbo[k], r->sil_tex, 0, n, n, 1, 0);
         restrict_level(r->sil_tmp, k);
-        blur_into(r, r->sil_fbo[k], r->sil_tmp, 0, n, n, 0, 1);
+        r_blur_into(r, r->sil_fbo[k], r->sil_tmp, 0, n, n, 0, 1);
     }
     gl.BindTexture(GL_TEXTURE_2D, r->sil_tex);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, SIL_LEVELS - 1);
 }
 
-static void camera_uniforms(r_game *r, GLuint p)
+void r_camera_uniforms(r_game *r, GLuint p)
 {
     gl.UseProgram(p);
-    gl.UniformMatrix4fv(loc(p, "u_view_proj"), 1, GL_FALSE, r->f.vp.m);
-    gl.Uniform3f(loc(p, "u_eye"), r->f.eye.x, r->f.eye.y, r->f.eye.z);
+    gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, r->f.vp.m);
+    gl.Uniform3f(r_loc(p, "u_eye"), r->f.eye.x, r->f.eye.y, r->f.eye.z);
 }
 
 /* SSFSM step 1b: the fighters' depth as the camera sees them */
@@ -683,8 +634,8 @@ static void run_z_prepass(void *u)
     gl.Clear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     gl.Enable(GL_CULL_FACE);
     gl.CullFace(GL_BACK);
-    camera_uniforms(r, r->prog[P_DEPTH]);
-    draw_fighters(r, r->prog[P_DEPTH]);
+    r_camera_uniforms(r, r->prog[P_DEPTH]);
+    r_draw_fighters(r, r->prog[P_DEPTH]);
 }
 
 /* The bound mask buffer: all 1 (lit), then draws limited to the fighters' box. */
@@ -707,13 +658,13 @@ static void run_shadow_mask(void *u)
     gl.Disable(GL_CULL_FACE);
     mask_clear_and_scissor(r);
     gl.UseProgram(p);
-    bind_tex(p, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
-    bind_tex(p, "u_shadow_map", 1, GL_TEXTURE_2D, r->shadow_tex);
-    gl.UniformMatrix4fv(loc(p, "u_inv_view_proj"), 1, GL_FALSE, r->f.inv_vp.m);
-    gl.UniformMatrix4fv(loc(p, "u_light_proj"), 1, GL_FALSE, r->f.light.m);
-    gl.Uniform2f(loc(p, "u_size"), (float)r->f.w, (float)r->f.h);
-    gl.Uniform1f(loc(p, "u_bias"), 0.0015f);
-    fullscreen(r);
+    r_bind_tex(p, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
+    r_bind_tex(p, "u_shadow_map", 1, GL_TEXTURE_2D, r->shadow_tex);
+    gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, r->f.inv_vp.m);
+    gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, r->f.light.m);
+    gl.Uniform2f(r_loc(p, "u_size"), (float)r->f.w, (float)r->f.h);
+    gl.Uniform1f(r_loc(p, "u_bias"), 0.0015f);
+    r_fullscreen(r);
     gl.Disable(GL_SCISSOR_TEST);
 }
 
@@ -726,11 +677,11 @@ static void run_mask_filter(void *u)
     gl.Viewport(0, 0, r->f.w, r->f.h);
     mask_clear_and_scissor(r);
     gl.UseProgram(p);
-    bind_tex(p, "u_src", 0, GL_TEXTURE_2D, r->mask_tex[0]);
-    fullscreen(r);
+    r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, r->mask_tex[0]);
+    r_fullscreen(r);
     /* outside the box both buffers hold 1, so the blur reads the truth there */
-    blur_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->f.w, r->f.h, 1, 0);
-    blur_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->f.w, r->f.h, 0, 1);
+    r_blur_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->f.w, r->f.h, 1, 0);
+    r_blur_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->f.w, r->f.h, 0, 1);
     gl.Disable(GL_SCISSOR_TEST);
     r->mask_final = 1;
 }
@@ -739,7 +690,7 @@ static void run_scene(void *u)
 {
     r_game *r = u;
     frame *f = &r->f;
-    bool shadows = ran(f, r, "mask_filter") && ran(f, r, "silhouette_mips");
+    bool shadows = r_ran(f, r, "mask_filter") && r_ran(f, r, "silhouette_mips");
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
     gl.Viewport(0, 0, f->w, f->h);
     gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -749,36 +700,36 @@ static void run_scene(void *u)
     gl.Enable(GL_CULL_FACE);
     gl.CullFace(GL_BACK);
     gl.Disable(GL_BLEND);
-    bool prepass = ran(f, r, "z_prepass");
+    bool prepass = r_ran(f, r, "z_prepass");
     gl.Clear(GL_COLOR_BUFFER_BIT | (prepass ? 0 : GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT));
 
     /* fighters: over their own z-prepass depth when it ran */
     GLuint p = r->prog[P_FIGHTER];
     gl.DepthFunc(prepass ? GL_LEQUAL : GL_LESS);
-    camera_uniforms(r, p);
-    bind_ibl(r, p);
-    bind_tex(p, "u_normal_map", 0, GL_TEXTURE_2D, r->normal_tex);
-    bind_tex(p, "u_spec_map", 1, GL_TEXTURE_2D, r->spec_tex);
-    bind_tex(p, "u_mask", 2, GL_TEXTURE_2D, r->mask_tex[r->mask_final]);
-    gl.Uniform1i(loc(p, "u_shadows"), shadows);
-    gl.Uniform1f(loc(p, "u_flash"), f->flash);
-    draw_fighters(r, p);
+    r_camera_uniforms(r, p);
+    r_bind_ibl(r, p);
+    r_bind_tex(p, "u_normal_map", 0, GL_TEXTURE_2D, r->normal_tex);
+    r_bind_tex(p, "u_spec_map", 1, GL_TEXTURE_2D, r->spec_tex);
+    r_bind_tex(p, "u_mask", 2, GL_TEXTURE_2D, r->mask_tex[r->mask_final]);
+    gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
+    gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
+    r_draw_fighters(r, p);
 
     /* the ring and the ground, with the projected silhouette */
     p = r->prog[P_STAGE];
     gl.DepthFunc(GL_LESS);
-    camera_uniforms(r, p);
-    bind_ibl(r, p);
-    bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
-    gl.Uniform1i(loc(p, "u_shadows"), shadows);
-    gl.Uniform1f(loc(p, "u_flash"), f->flash);
-    gl.Uniform3fv(loc(p, "u_ring_color"), 1, r->stage.ring_color);
-    gl.UniformMatrix4fv(loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
-    gl.Uniform3f(loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
+    r_camera_uniforms(r, p);
+    r_bind_ibl(r, p);
+    r_bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
+    gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
+    gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
+    gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
+    gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
+    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
     float waist[6] = {f->waist[0].x, f->waist[0].y, f->waist[0].z, f->waist[1].x, f->waist[1].y, f->waist[1].z};
-    gl.Uniform3fv(loc(p, "u_waist"), 2, waist);
-    gl.Uniform1f(loc(p, "u_lod_start"), 0.6f);
-    gl.Uniform1f(loc(p, "u_lod_scale"), 1.6f);
+    gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
+    gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
+    gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
     gl.BindVertexArray(r->ring_vao);
     gl.DrawElements(GL_TRIANGLES, r->ring_count, GL_UNSIGNED_INT, NULL);
 }
@@ -795,18 +746,18 @@ static void run_sky(void *u)
     gl.DepthMask(GL_FALSE);
     gl.Disable(GL_CULL_FACE);
     gl.UseProgram(p);
-    gl.UniformMatrix4fv(loc(p, "u_inv_view_proj"), 1, GL_FALSE, f->inv_vp.m);
-    bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r->sky_tex);
+    gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, f->inv_vp.m);
+    r_bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r->sky_tex);
     const r_stage *st = &r->stage;
     float rad = st->sun_size_deg * 0.5f * 3.14159265f / 180.0f;
     double omega = 2 * 3.14159265358979 * (1 - cos(rad)); /* the disc's solid angle */
     float L = st->sun ? (float)fmin(st->sun_intensity / omega, R_HALF_MAX) : 0.0f;
-    gl.Uniform3f(loc(p, "u_sun_dir"), st->sun_dir[0], st->sun_dir[1], st->sun_dir[2]);
-    gl.Uniform3f(loc(p, "u_sun_radiance"), fminf(L * st->sun_color[0], R_HALF_MAX),
+    gl.Uniform3f(r_loc(p, "u_sun_dir"), st->sun_dir[0], st->sun_dir[1], st->sun_dir[2]);
+    gl.Uniform3f(r_loc(p, "u_sun_radiance"), fminf(L * st->sun_color[0], R_HALF_MAX),
                  fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
-    gl.Uniform1f(loc(p, "u_sun_cos"), cosf(rad));
-    gl.Uniform1f(loc(p, "u_flash"), f->flash);
-    fullscreen(r);
+    gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
+    gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
+    r_fullscreen(r);
     gl.DepthMask(GL_TRUE);
 }
 
@@ -824,13 +775,13 @@ static void run_lens(void *u)
     gl.Disable(GL_CULL_FACE);
     gl.Enable(GL_BLEND);
     gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
-    camera_uniforms(r, p);
-    bind_ibl(r, p);
-    gl.Uniform1f(loc(p, "u_lens_alpha"), LENS_ALPHA);
+    r_camera_uniforms(r, p);
+    r_bind_ibl(r, p);
+    gl.Uniform1f(r_loc(p, "u_lens_alpha"), LENS_ALPHA);
     gl.BindVertexArray(r->lens_vao);
     for (int i = 0; i < 2; i++) {
-        gl.UniformMatrix4fv(loc(p, "u_bones"), G_BONES, GL_FALSE, &f->bones[i][0][0]);
-        gl.Uniform1f(loc(p, "u_lens_side"), (float)f->cur->f[i].facing);
+        gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &f->bones[i][0][0]);
+        gl.Uniform1f(r_loc(p, "u_lens_side"), (float)f->cur->f[i].facing);
         gl.DrawElements(GL_TRIANGLES, r->lens_count, GL_UNSIGNED_INT, NULL);
     }
     gl.Disable(GL_BLEND);
@@ -842,20 +793,20 @@ static void run_bloom_bright(void *u)
     r_game *r = u;
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
-    down_into(r, r->b2_fbo, r->hdr_tex, 0, half(r->f.w, 1), half(r->f.h, 1), r->stage.bloom_threshold,
+    r_down_into(r, r->b2_fbo, r->hdr_tex, 0, r_half(r->f.w, 1), r_half(r->f.h, 1), r->stage.bloom_threshold,
               r->f.exposure);
 }
 
 static void run_bloom_blur(void *u)
 {
     r_game *r = u;
-    int w4 = half(r->f.w, 2), h4 = half(r->f.h, 2), w8 = half(r->f.w, 3), h8 = half(r->f.h, 3);
-    down_into(r, r->b4_fbo[0], r->b2_tex, 0, w4, h4, -1, 1);
-    blur_into(r, r->b4_fbo[1], r->b4_tex[0], 0, w4, h4, 1, 0);
-    blur_into(r, r->b4_fbo[0], r->b4_tex[1], 0, w4, h4, 0, 1);
-    down_into(r, r->b8_fbo[0], r->b4_tex[0], 0, w8, h8, -1, 1);
-    blur_into(r, r->b8_fbo[1], r->b8_tex[0], 0, w8, h8, 1, 0);
-    blur_into(r, r->b8_fbo[0], r->b8_tex[1], 0, w8, h8, 0, 1);
+    int w4 = r_half(r->f.w, 2), h4 = r_half(r->f.h, 2), w8 = r_half(r->f.w, 3), h8 = r_half(r->f.h, 3);
+    r_down_into(r, r->b4_fbo[0], r->b2_tex, 0, w4, h4, -1, 1);
+    r_blur_into(r, r->b4_fbo[1], r->b4_tex[0], 0, w4, h4, 1, 0);
+    r_blur_into(r, r->b4_fbo[0], r->b4_tex[1], 0, w4, h4, 0, 1);
+    r_down_into(r, r->b8_fbo[0], r->b4_tex[0], 0, w8, h8, -1, 1);
+    r_blur_into(r, r->b8_fbo[1], r->b8_tex[0], 0, w8, h8, 1, 0);
+    r_blur_into(r, r->b8_fbo[0], r->b8_tex[1], 0, w8, h8, 0, 1);
 }
 
 static void run_sun_visibility(void *u)
@@ -866,38 +817,38 @@ static void run_sun_visibility(void *u)
     gl.Viewport(0, 0, 1, 1);
     gl.Disable(GL_DEPTH_TEST);
     gl.UseProgram(p);
-    bind_tex(p, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
-    gl.Uniform2f(loc(p, "u_sun"), r->f.sun_px[0], r->f.sun_px[1]);
-    gl.Uniform1f(loc(p, "u_radius"), r->f.h * 0.012f);
-    fullscreen(r);
+    r_bind_tex(p, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
+    gl.Uniform2f(r_loc(p, "u_sun"), r->f.sun_px[0], r->f.sun_px[1]);
+    gl.Uniform1f(r_loc(p, "u_radius"), r->f.h * 0.012f);
+    r_fullscreen(r);
 }
 
 static void run_tonemap(void *u)
 {
     r_game *r = u;
     frame *f = &r->f;
-    bool bloom = ran(f, r, "bloom_blur"), flare = ran(f, r, "flare");
+    bool bloom = r_ran(f, r, "bloom_blur"), flare = r_ran(f, r, "flare");
     GLuint p = r->prog[P_TONE + (bloom ? 1 : 0) + (flare ? 2 : 0)];
     gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)f->out_fbo);
     gl.Viewport(0, 0, f->w, f->h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.UseProgram(p);
-    bind_tex(p, "u_hdr", 0, GL_TEXTURE_2D, r->hdr_tex);
-    bind_tex(p, "u_lut", 1, GL_TEXTURE_1D, r->lut_tex);
-    gl.Uniform1i(loc(p, "u_lut_size"), r->lut_size);
-    gl.Uniform1f(loc(p, "u_lut_inv_power"), (float)(1.0 / r_tone_index_power(r->lut_gamma)));
-    gl.Uniform1f(loc(p, "u_exposure"), f->exposure);
-    gl.Uniform1f(loc(p, "u_saturation"), f->saturation);
-    gl.Uniform1i(loc(p, "u_write_mask"), r->opts.mask);
+    r_bind_tex(p, "u_hdr", 0, GL_TEXTURE_2D, r->hdr_tex);
+    r_bind_tex(p, "u_lut", 1, GL_TEXTURE_1D, r->lut_tex);
+    gl.Uniform1i(r_loc(p, "u_lut_size"), r->lut_size);
+    gl.Uniform1f(r_loc(p, "u_lut_inv_power"), (float)(1.0 / r_tone_index_power(r->lut_gamma)));
+    gl.Uniform1f(r_loc(p, "u_exposure"), f->exposure);
+    gl.Uniform1f(r_loc(p, "u_saturation"), f->saturation);
+    gl.Uniform1i(r_loc(p, "u_write_mask"), r->opts.mask);
     if (bloom) {
-        bind_tex(p, "u_bloom0", 2, GL_TEXTURE_2D, r->b4_tex[0]);
-        bind_tex(p, "u_bloom1", 3, GL_TEXTURE_2D, r->b8_tex[0]);
-        gl.Uniform1f(loc(p, "u_bloom"), r->stage.bloom);
+        r_bind_tex(p, "u_bloom0", 2, GL_TEXTURE_2D, r->b4_tex[0]);
+        r_bind_tex(p, "u_bloom1", 3, GL_TEXTURE_2D, r->b8_tex[0]);
+        gl.Uniform1f(r_loc(p, "u_bloom"), r->stage.bloom);
     }
     if (flare)
-        bind_tex(p, "u_flare_img", 4, GL_TEXTURE_2D, r->fl_tex);
-    fullscreen(r);
+        r_bind_tex(p, "u_flare_img", 4, GL_TEXTURE_2D, r->fl_tex);
+    r_fullscreen(r);
 }
 
 /* The flare image (glow and ghosts along the axis through the centre,
@@ -910,19 +861,19 @@ static void run_flare(void *u)
     frame *f = &r->f;
     GLuint p = r->prog[P_FLARE];
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->fl_fbo);
-    gl.Viewport(0, 0, half(f->w, 2), half(f->h, 2));
+    gl.Viewport(0, 0, r_half(f->w, 2), r_half(f->h, 2));
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.UseProgram(p);
-    bind_tex(p, "u_flare", 0, GL_TEXTURE_2D, r->flare_tex);
-    bind_tex(p, "u_sun_vis", 1, GL_TEXTURE_2D, r->sunvis_tex);
-    gl.Uniform2f(loc(p, "u_size"), (float)half(f->w, 2), (float)half(f->h, 2));
-    gl.Uniform2f(loc(p, "u_sun_uv"), f->sun_px[0] / (float)f->w, f->sun_px[1] / (float)f->h);
+    r_bind_tex(p, "u_flare", 0, GL_TEXTURE_2D, r->flare_tex);
+    r_bind_tex(p, "u_sun_vis", 1, GL_TEXTURE_2D, r->sunvis_tex);
+    gl.Uniform2f(r_loc(p, "u_size"), (float)r_half(f->w, 2), (float)r_half(f->h, 2));
+    gl.Uniform2f(r_loc(p, "u_sun_uv"), f->sun_px[0] / (float)f->w, f->sun_px[1] / (float)f->h);
     const float *c = r->stage.sun_color;
     float k = fminf(r->stage.sun_intensity * 0.08f, 50.0f) * f->exposure;
-    gl.Uniform3f(loc(p, "u_flare_color"), c[0] * k, c[1] * k, c[2] * k);
-    gl.Uniform1f(loc(p, "u_aspect"), (float)f->w / (float)f->h);
-    fullscreen(r);
+    gl.Uniform3f(r_loc(p, "u_flare_color"), c[0] * k, c[1] * k, c[2] * k);
+    gl.Uniform1f(r_loc(p, "u_aspect"), (float)f->w / (float)f->h);
+    r_fullscreen(r);
 }
 
 /* ---- HUD ---- */
@@ -1036,8 +987,8 @@ static void run_hud(void *u)
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
     gl.UseProgram(p);
-    gl.Uniform2f(loc(p, "u_screen"), (float)f->w, (float)f->h);
-    bind_tex(p, "u_font", 0, GL_TEXTURE_2D, r->font_tex);
+    gl.Uniform2f(r_loc(p, "u_screen"), (float)f->w, (float)f->h);
+    r_bind_tex(p, "u_font", 0, GL_TEXTURE_2D, r->font_tex);
     gl.BindVertexArray(r->hud_vao);
     gl.BindBuffer(GL_ARRAY_BUFFER, r->hud_vbo);
     gl.BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(r->nhud * sizeof(hud_vertex)), r->hud);
@@ -1060,7 +1011,7 @@ static GLuint build_font(void)
             for (int x = 0; x < R_FONT_W; x++)
                 if (r_font_glyphs[g].rows[y] & (0x10 >> x))
                     px[(size_t)y * w + g * CW + x] = 255;
-    GLuint t = tex2d(GL_R8, w, CH, GL_RED, GL_UNSIGNED_BYTE, px, GL_NEAREST, GL_CLAMP_TO_EDGE);
+    GLuint t = r_tex2d(GL_R8, w, CH, GL_RED, GL_UNSIGNED_BYTE, px, GL_NEAREST, GL_CLAMP_TO_EDGE);
     free(px);
     return t;
 }
@@ -1129,7 +1080,7 @@ static bool build_programs(r_game *r, rs_err *err)
 
 static bool build_graph(r_game *r, rs_err *err)
 {
-    r_graph_init(&r->graph, RES_ENV, res_names, (int)(sizeof res_names / sizeof res_names[0]));
+    r_graph_init(&r->graph, RES_PERSISTENT, res_names, (int)(sizeof res_names / sizeof res_names[0]));
     const r_pass passes[] = {
         {"shadow_map", RES_ENV, RES_SHADOW, need_shadows, run_shadow_map, 0},
         {"silhouette", RES_ENV, RES_SIL, need_shadows, run_silhouette, 0},
@@ -1137,8 +1088,11 @@ static bool build_graph(r_game *r, rs_err *err)
         {"z_prepass", RES_ENV, RES_DEPTH, need_shadows, run_z_prepass, 0},
         {"shadow_mask", RES_DEPTH | RES_SHADOW, RES_MASK, need_shadows, run_shadow_mask, 0},
         {"mask_filter", RES_MASK, RES_MASK, need_shadows, run_mask_filter, 0},
+        {NULL, R_FX_PRE, 0, NULL, NULL, 0},
         {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene, RES_MASK | RES_SIL},
+        {NULL, R_FX_SURFACE, 0, NULL, NULL, 0},
         {"sky", RES_ENV | RES_DEPTH, RES_HDR, need_always, run_sky, 0},
+        {NULL, R_FX_TRANSLUCENT, 0, NULL, NULL, 0},
         {"lens", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, need_always, run_lens, 0},
         {"bloom_bright", RES_HDR, RES_BLOOM, need_bloom, run_bloom_bright, 0},
         {"bloom_blur", RES_BLOOM, RES_BLOOM, need_bloom, run_bloom_blur, 0},
@@ -1147,9 +1101,19 @@ static bool build_graph(r_game *r, rs_err *err)
         {"tonemap", RES_HDR | RES_ENV, RES_OUT, need_always, run_tonemap, RES_BLOOM | RES_FLARE},
         {"hud", RES_OUT, RES_OUT, need_hud, run_hud, 0},
     };
-    for (size_t i = 0; i < sizeof passes / sizeof passes[0]; i++)
-        if (!r_graph_add(&r->graph, &passes[i], err))
-            return false;
+    /* a row without a name: the stage effects' passes of that phase (r_fx.h) */
+    for (size_t i = 0; i < sizeof passes / sizeof passes[0]; i++) {
+        if (passes[i].name) {
+            if (!r_graph_add(&r->graph, &passes[i], err))
+                return false;
+            continue;
+        }
+        int phase = (int)passes[i].reads;
+        for (int m = 0; m < r_fx_nmodules; m++)
+            for (int k = 0; k < r_fx_modules[m]->npass[phase]; k++)
+                if (!r_graph_add(&r->graph, &r_fx_modules[m]->pass[phase][k], err))
+                    return false;
+    }
     return true;
 }
 
@@ -1182,18 +1146,23 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         r_game_destroy(r);
         return NULL;
     }
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->create && !r_fx_modules[i]->create(r, err)) {
+            r_game_destroy(r);
+            return NULL;
+        }
     gl.Enable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     gl.GenVertexArrays(1, &r->empty_vao);
 
     r_mesh_data m = {0};
     bool ok = r_mesh_fighter(&m);
     if (ok) {
-        upload_mesh(&m, &r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
+        r_upload_mesh(&m, &r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
         r->fighter_count = (GLsizei)m.ni;
     }
     r_mesh_free(&m);
     if (ok && (ok = build_lens(&m))) {
-        upload_mesh(&m, &r->lens_vao, &r->lens_vbo, &r->lens_ibo);
+        r_upload_mesh(&m, &r->lens_vao, &r->lens_vbo, &r->lens_ibo);
         r->lens_count = (GLsizei)m.ni;
     }
     r_mesh_free(&m);
@@ -1224,13 +1193,13 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         return NULL;
     }
     r_tex_normal_map(px, R_TEX_SIZE);
-    r->normal_tex = tex2d(GL_RGBA8, R_TEX_SIZE, R_TEX_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px, GL_LINEAR_MIPMAP_LINEAR, GL_REPEAT);
+    r->normal_tex = r_tex2d(GL_RGBA8, R_TEX_SIZE, R_TEX_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px, GL_LINEAR_MIPMAP_LINEAR, GL_REPEAT);
     gl.GenerateMipmap(GL_TEXTURE_2D);
     r_tex_spec_map(px, R_TEX_SIZE);
-    r->spec_tex = tex2d(GL_RGBA8, R_TEX_SIZE, R_TEX_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px, GL_LINEAR_MIPMAP_LINEAR, GL_REPEAT);
+    r->spec_tex = r_tex2d(GL_RGBA8, R_TEX_SIZE, R_TEX_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px, GL_LINEAR_MIPMAP_LINEAR, GL_REPEAT);
     gl.GenerateMipmap(GL_TEXTURE_2D);
     r_tex_flare(px, R_FLARE_SIZE);
-    r->flare_tex = tex2d(GL_RGBA8, R_FLARE_SIZE, R_FLARE_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    r->flare_tex = r_tex2d(GL_RGBA8, R_FLARE_SIZE, R_FLARE_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px, GL_LINEAR, GL_CLAMP_TO_EDGE);
     free(px);
     r_tone_lut(lut, r->lut_size, 2.2); /* rebuilt when the stage's gamma differs */
     r->lut_gamma = 2.2f;
@@ -1275,8 +1244,8 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     }
     r->sil_tex = sil[0], r->sil_tmp = sil[1];
     for (int k = 0; k < SIL_LEVELS; k++) {
-        r->sil_fbo[k] = fbo_for(r->sil_tex, k, 0);
-        r->sil_tmp_fbo[k] = fbo_for(r->sil_tmp, k, 0);
+        r->sil_fbo[k] = r_fbo_for(r->sil_tex, k, 0);
+        r->sil_tmp_fbo[k] = r_fbo_for(r->sil_tmp, k, 0);
     }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
@@ -1288,11 +1257,14 @@ void r_game_destroy(r_game *r)
 {
     if (!r)
         return;
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->destroy)
+            r_fx_modules[i]->destroy(r);
     free_look(r);
     free_targets(r);
     r_graph_release(&r->graph);
-    free_mesh(&r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
-    free_mesh(&r->lens_vao, &r->lens_vbo, &r->lens_ibo);
+    r_free_mesh(&r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
+    r_free_mesh(&r->lens_vao, &r->lens_vbo, &r->lens_ibo);
     gl.DeleteVertexArrays(1, &r->hud_vao);
     gl.DeleteVertexArrays(1, &r->empty_vao);
     gl.DeleteBuffers(1, &r->hud_vbo);
@@ -1379,19 +1351,19 @@ r_graph *r_game_graph(r_game *r)
     return &r->graph;
 }
 
-static void print_frame(void *user, uint64_t frame_no, uint32_t ran_mask, const double *gpu, const double *cpu)
+static void print_frame(void *user, uint64_t frame_no, r_graph_mask ran_mask, const double *gpu, const double *cpu)
 {
     r_game *r = user;
     if (!r->per_frame || !r->passes_out)
         return;
     fprintf(r->passes_out, "frame %llu:", (unsigned long long)frame_no);
     for (int i = 0; i < r->graph.n; i++)
-        if (ran_mask & (1u << i))
+        if (ran_mask & ((r_graph_mask)1 << i))
             fprintf(r->passes_out, " %s %.3f", r->graph.pass[i].name, gpu ? gpu[i] : cpu[i]);
     fprintf(r->passes_out, " ms%s; skipped:", gpu ? "" : " (cpu)");
     int skipped = 0;
     for (int i = 0; i < r->graph.n; i++)
-        if (!(ran_mask & (1u << i)))
+        if (!(ran_mask & ((r_graph_mask)1 << i)))
             fprintf(r->passes_out, " %s", r->graph.pass[i].name), skipped++;
     fprintf(r->passes_out, "%s\n", skipped ? "" : " none");
 }
@@ -1419,7 +1391,7 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
     if (!strcmp(name, "hdr"))
         tex = r->hdr_tex;
     else if (!strcmp(name, "bloom"))
-        tex = r->b4_tex[0], tw = half(r->tw, 2), th = half(r->th, 2);
+        tex = r->b4_tex[0], tw = r_half(r->tw, 2), th = r_half(r->th, 2);
     else if (!strcmp(name, "mask"))
         tex = r->mask_tex[r->mask_final];
     else if (!strncmp(name, "silhouette", 10) && (!name[10] || (name[10] >= '1' && name[10] < '0' + SIL_LEVELS && !name[11]))) {

@@ -78,7 +78,7 @@ static void collect(r_graph *g, int s)
         return;
     double gpu[R_GRAPH_MAX] = {0};
     for (int i = 0; i < g->n; i++) {
-        if (!(g->slot[s].ran & (1u << i)))
+        if (!(g->slot[s].ran & ((r_graph_mask)1 << i)))
             continue;
         r_pass_stats *st = &g->stats[i];
         double c = g->slot[s].cpu_ms[i];
@@ -100,12 +100,13 @@ static void collect(r_graph *g, int s)
     g->slot[s].pending = false;
 }
 
-uint32_t r_graph_run(r_graph *g, void *user)
+r_graph_mask r_graph_run(r_graph *g, void *user)
 {
     int s = (int)(g->frame % R_GRAPH_LAG);
     if (g->timing)
         collect(g, s);
-    uint32_t ran = 0, produced = g->persistent;
+    r_graph_mask ran = 0;
+    uint32_t produced = g->persistent;
     g->ran_now = 0;
     for (int i = 0; i < g->n; i++) {
         const r_pass *p = &g->pass[i];
@@ -132,7 +133,7 @@ uint32_t r_graph_run(r_graph *g, void *user)
         if (g->timing)
             g->slot[s].cpu_ms[i] = now_ms() - t0;
         g->stats[i].runs++;
-        ran |= 1u << i;
+        ran |= (r_graph_mask)1 << i;
         g->ran_now = ran;
         produced |= p->writes;
     }

@@ -31,7 +31,7 @@
 #include "../gl/rgl.h"
 #include "../util/rs_err.h"
 
-#define R_GRAPH_MAX 24
+#define R_GRAPH_MAX 48 /* passes; r_graph_mask has a bit for each */
 #define R_GRAPH_LAG 4
 
 typedef struct r_pass {
@@ -51,7 +51,9 @@ typedef struct r_pass_stats {
 } r_pass_stats;
 
 /* Called once per frame when its timings are known (lagged). */
-typedef void (*r_graph_frame_fn)(void *user, uint64_t frame, uint32_t ran, const double *gpu_ms, const double *cpu_ms);
+typedef uint64_t r_graph_mask; /* one bit per pass, in order */
+
+typedef void (*r_graph_frame_fn)(void *user, uint64_t frame, r_graph_mask ran, const double *gpu_ms, const double *cpu_ms);
 
 typedef struct r_graph {
     r_pass pass[R_GRAPH_MAX];
@@ -60,8 +62,8 @@ typedef struct r_graph {
     uint32_t persistent;          /* resources valid without a writer this frame */
     const char *resource[32];     /* names, for messages */
     uint64_t frame;
-    uint32_t last_ran;
-    uint32_t ran_now;             /* passes run so far in the frame being run */
+    r_graph_mask last_ran;
+    r_graph_mask ran_now;             /* passes run so far in the frame being run */
     char error[256];              /* first run-time inconsistency, "" if none */
     /* timing */
     bool timing, gpu_timer;
@@ -70,7 +72,7 @@ typedef struct r_graph {
     struct {
         bool pending;
         uint64_t frame;
-        uint32_t ran;
+        r_graph_mask ran;
         double cpu_ms[R_GRAPH_MAX];
     } slot[R_GRAPH_LAG];
     r_graph_frame_fn on_frame;
@@ -83,7 +85,7 @@ bool r_graph_add(r_graph *g, const r_pass *p, rs_err *err);
  * ARB_timer_query is there, else CPU time only). */
 void r_graph_timing(r_graph *g, r_graph_frame_fn fn, void *user);
 /* Runs one frame; returns the mask of passes that ran (bit i = pass i). */
-uint32_t r_graph_run(r_graph *g, void *user);
+r_graph_mask r_graph_run(r_graph *g, void *user);
 /* Collects every outstanding timing (blocking). */
 void r_graph_flush(r_graph *g);
 void r_graph_release(r_graph *g);

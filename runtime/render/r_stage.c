@@ -67,9 +67,9 @@ static const row rows[] = {
     {"flare", K_BOOL, F(flare), 0, 0, "yes"},
     {"shadows", K_BOOL, F(shadows), 0, 0, "yes"},
     {"hdr_format", K_FORMAT, F(hdr_format), 0, 0, "rgba16f"},
-    {"water", K_EFFECT, F(water), 0, 0, "no"},
-    {"snow", K_EFFECT, F(snow), 0, 0, "no"},
-    {"fog", K_EFFECT, F(fog), 0, 0, "no"},
+    {"water", K_BOOL, F(water), 0, 0, "no"},
+    {"snow", K_BOOL, F(snow), 0, 0, "no"},
+    {"fog", K_BOOL, F(fog), 0, 0, "no"},
     {"holes", K_EFFECT, F(holes), 0, 0, "no"},
 };
 #define NROWS (sizeof rows / sizeof rows[0])

@@ -1,0 +1,79 @@
+/* Stage effects (issue 8; techniques A6-A8, B, C, D): each effect is a
+ * module of passes that the renderer's pass graph runs only on stages (or
+ * frames) that need them.
+ *
+ * A module (r_fx_<name>.c) keeps its state behind one pointer in r_game
+ * (r_local.h) and gives the renderer:
+ *   create   at r_game_create: programs and fixed-size GL objects
+ *   destroy  at r_game_destroy (also after a failed create)
+ *   load     when the look changes (r->stage is the new stage)
+ *   passes   by phase, added to the graph in this order:
+ *     R_FX_PRE          after the shadow passes, before "scene"
+ *                       (simulations, light-space and texture-space maps)
+ *     R_FX_SURFACE      after "scene", before "sky": opaque surfaces
+ *     R_FX_TRANSLUCENT  after "sky", before "lens"
+ * Passes get the r_game as their user pointer; the frame being drawn is
+ * r->f.  Simulations step r->f.steps times (whole game ticks since the
+ * frame drawn last, 0 when a tick is drawn again) and restart when
+ * r->f.reset is set, so a video of a replay is the same at any frame rate
+ * and from any machine. */
+#ifndef R_FX_H
+#define R_FX_H
+
+#include <stdbool.h>
+
+#include "../game/g_skel.h"
+#include "../gl/rgl.h"
+#include "../util/rs_err.h"
+#include "r_graph.h"
+
+typedef struct r_game r_game;
+
+/* A fighter's bone capsule in world space (metres; the fight plane is
+ * z = 0, a bone's z is its lateral offset for the mesh). */
+typedef struct r_fx_capsule {
+    float a[3], b[3], r;
+} r_fx_capsule;
+
+/* Where a bone capsule dips below a horizontal surface at height level:
+ * the point of the segment lowest below it, how deep the capsule reaches
+ * under the surface, and how fast that point of the bone moved over the
+ * last tick (m/s; the point at the same place along the bone). */
+typedef struct r_fx_contact {
+    float x, z;     /* on the surface */
+    float depth;    /* > 0: metres of the capsule below the level */
+    float radius;   /* the capsule's radius */
+    float speed;    /* m/s */
+    float vel[3];   /* m/s */
+    int fighter, bone;
+} r_fx_contact;
+
+/* More ticks than this between two frames (a seek) restart the simulations. */
+#define R_FX_MAX_GAP 30
+
+enum { R_FX_PRE, R_FX_SURFACE, R_FX_TRANSLUCENT, R_FX_PHASES };
+
+typedef struct r_fx_module {
+    const char *name;
+    bool (*create)(r_game *r, rs_err *err);
+    void (*destroy)(r_game *r);
+    bool (*load)(r_game *r, rs_err *err);
+    const r_pass *pass[R_FX_PHASES];
+    int npass[R_FX_PHASES];
+} r_fx_module;
+
+extern const r_fx_module *const r_fx_modules[];
+extern const int r_fx_nmodules;
+
+/* Contacts of both fighters' capsules with the plane y = level (at most
+ * max, deepest first when there are more).  caps/caps_prev as in
+ * r_local.h's frame.  Returns the number written. */
+int r_fx_contacts(const r_fx_capsule caps[2][G_BONES], const r_fx_capsule prev[2][G_BONES], float level, r_fx_contact *out,
+                  int max);
+
+/* Fog map (r_fx_fog.c): sets program p's fog uniforms (u_fog_on and the
+ * map when the fog_map pass ran this frame).  Every program that draws the
+ * scene calls it; its shaders include fog_common.glsl. */
+void r_fx_fog_bind(r_game *r, GLuint p, int unit);
+
+#endif

@@ -1,0 +1,149 @@
+/* The game renderer's insides, shared by r_game.c and the stage-effect
+ * modules (r_fx_*.c, r_fx.h).  Not an API: include only from
+ * runtime/render. */
+#ifndef R_LOCAL_H
+#define R_LOCAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "../gl/rgl.h"
+#include "r_fx.h"
+#include "r_game.h"
+#include "r_graph.h"
+#include "r_ibl.h"
+#include "r_mesh.h"
+
+#define HUD_MAX_QUADS 4096
+#define SHADOW_SIZE 1024 /* SSFSM light depth map */
+#define SIL_SIZE 512     /* silhouette, level 0 */
+#define SIL_LEVELS 5     /* the sharp level and 4 blurred ones */
+#define SKY_SIZE 128     /* the environment as seen */
+#define LENS_ALPHA 0.15f
+
+/* resources of the pass graph */
+enum {
+    RES_ENV = 1u << 0,  /* IBL maps, sky, LUT, textures: built at load */
+    RES_SHADOW = 1u << 1,
+    RES_SIL = 1u << 2,
+    RES_DEPTH = 1u << 3,
+    RES_MASK = 1u << 4,
+    RES_HDR = 1u << 5,
+    RES_BLOOM = 1u << 6,
+    RES_SUNVIS = 1u << 7,
+    RES_OUT = 1u << 8,
+    RES_FLARE = 1u << 9,
+    /* stage effects */
+    RES_FOGMAP = 1u << 10,
+    RES_WATER = 1u << 11,       /* the wave simulation: persistent, steps each tick */
+    RES_WATER_REFL = 1u << 12,
+    RES_WATER_UNDER = 1u << 13,
+    RES_SNOW = 1u << 14,        /* the displacement map: persistent */
+    RES_SNOW_LIGHT = 1u << 15,
+};
+#define RES_PERSISTENT (RES_ENV | RES_WATER | RES_SNOW)
+
+typedef struct hud_vertex {
+    float x, y, u, v, r, g, b, a;
+} hud_vertex;
+
+typedef struct prog {
+    GLuint id;
+} prog;
+
+enum { P_FIGHTER, P_STAGE, P_LENS, P_DEPTH, P_SIL, P_SKY, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD,
+       P_TONE, /* + 4 variants: bloom x flare */
+       P_COUNT = P_TONE + 4 };
+
+typedef struct frame {
+    const g_state *prev, *cur;
+    float alpha;
+    int w, h;
+    r_mat4 vp, inv_vp, light;
+    r_vec3 eye, light_dir, waist[2];
+    float bones[2][16][16], colors[2][16][4];
+    float flash, saturation, exposure;
+    bool sun_on_screen;
+    float sun_px[2];
+    int fig_box[4]; /* x, y, w, h: the fighters on screen plus the mask filter's reach */
+    GLint out_fbo;
+    /* for the stage effects (r_fx.h): whole ticks, never interpolated, so
+     * what the simulations see is a function of the game states alone */
+    r_fx_capsule caps[2][G_BONES], caps_prev[2][G_BONES]; /* at cur->tick and prev->tick */
+    int steps;   /* game ticks since the frame drawn last: simulation steps to run now */
+    bool reset;  /* the sequence broke (first frame, seek, new stage): restart simulations */
+    r_mat4 vp_prev; /* the camera at prev->tick (afterimages) */
+    float bones_prev[2][16][16];
+} frame;
+
+struct r_game {
+    r_game_opts opts;
+    char stage_file[1024];
+    GLuint prog[P_COUNT];
+    GLuint fighter_vao, fighter_vbo, fighter_ibo;
+    GLsizei fighter_count;
+    GLuint lens_vao, lens_vbo, lens_ibo;
+    GLsizei lens_count;
+    GLuint ring_vao, ring_vbo, ring_ibo;
+    GLsizei ring_count;
+    int ring_stage; /* the game stage the ring mesh has the size of; -1 none */
+    GLuint empty_vao;
+    GLuint hud_vao, hud_vbo, font_tex;
+    hud_vertex *hud;
+    int nhud;
+    /* look */
+    bool have_stage;
+    int stage_game; /* the game stage the look was loaded for; -1 = set by r_game_set_stage */
+    float key_dir[3]; /* the IBL's key direction: shadows are cast from it */
+    r_stage stage;
+    r_hdr_format hdr_format;
+    GLuint ibl_tex[R_IBL_MAPS][2], sky_tex, lut_tex, normal_tex, spec_tex, flare_tex;
+    int lut_size;
+    float lut_gamma;
+    /* light-space targets */
+    GLuint shadow_tex, shadow_fbo;
+    GLuint sil_tex, sil_tmp, sil_fbo[SIL_LEVELS], sil_tmp_fbo[SIL_LEVELS];
+    /* screen targets */
+    int tw, th;
+    r_hdr_format tfmt;
+    GLuint hdr_tex, depth_tex, hdr_fbo, depth_fbo;
+    GLuint mask_tex[2], mask_fbo[2];
+    GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2];
+    GLuint fl_tex, fl_fbo; /* the flare image, quarter size */
+    GLuint sunvis_tex, sunvis_fbo;
+    int mask_final; /* index of the filtered mask */
+    /* graph */
+    r_graph graph;
+    int pass_ids[R_GRAPH_MAX];
+    bool per_frame;
+    FILE *passes_out;
+    /* stage effects: each module keeps its own state (r_fx.h) */
+    struct r_fx_water *water;
+    struct r_fx_snow *snow;
+    struct r_fx_fog *fog;
+    struct r_fx_afterimage *afterimage;
+    uint64_t last_tick; /* of the frame drawn last, for frame.steps */
+    bool have_last;
+    frame f;
+    char error[768];
+};
+
+
+/* helpers of r_game.c */
+GLint r_loc(GLuint p, const char *name);
+void r_upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *ibo);
+void r_free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo);
+GLuint r_tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const void *px, GLenum filter, GLenum wrap);
+GLuint r_fbo_for(GLuint color, int level, GLuint depth); /* depth: a GL_DEPTH24_STENCIL8 texture or 0 */
+void r_bind_tex(GLuint p, const char *name, int unit, GLenum target, GLuint t);
+void r_bind_ibl(r_game *r, GLuint p); /* units 8..13 */
+void r_fullscreen(r_game *r);      /* one triangle: cap_fullscreen.vert */
+int r_half(int v, int k);          /* v >> k, at least 1 */
+bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run this frame (so far) */
+void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
+void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
+void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
+void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
+
+#endif
