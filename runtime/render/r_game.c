@@ -712,6 +712,7 @@ static void run_scene(void *u)
     r_bind_tex(p, "u_spec_map", 1, GL_TEXTURE_2D, r->spec_tex);
     r_bind_tex(p, "u_mask", 2, GL_TEXTURE_2D, r->mask_tex[r->mask_final]);
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
+    r_fx_fog_bind(r, p, 6);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     r_draw_fighters(r, p);
 
@@ -722,6 +723,7 @@ static void run_scene(void *u)
     r_bind_ibl(r, p);
     r_bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
+    r_fx_fog_bind(r, p, 6);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
     gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
