@@ -333,6 +333,10 @@ static void t_value_errors(void)
         {"environment = .hdr", "environment: expected 'procedural' or an .hdr or .exr file"},
         {"environment = Procedural", "environment: expected 'procedural' or an .hdr or .exr file"},
         {"holes = 1", "holes: stage effect not built yet (issue 8)"},
+        {"afterimage = blur", "afterimage: expected view, world or off, got 'blur'"},
+        {"afterimage = View", "afterimage: expected view, world or off, got 'View'"},
+        {"afterimage_stretch = 9", "afterimage_stretch: expected a number in 1..8, got '9'"},
+        {"afterimage_speed = -1", "afterimage_speed: expected a number in 0..1000, got '-1'"},
         {"water = perhaps", "water: expected yes or no"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {

@@ -1,4 +1,159 @@
-/* TEMPORARY skeleton: replaced by the afterimage effect (issue 8). */
-#include "r_local.h"
+/* Afterimage motion blur (techniques B), on every stage: fast limbs leave
+ * a stretched, translucent copy of themselves along their path.
+ *
+ * The technique draws each moving model twice, first the stretched copy
+ * (depth test on, depth write off), then the model.  Here the models are
+ * already drawn by "scene", which marks their pixels in the stencil
+ * (R_STENCIL_FIGHTER); the copy is drawn after the sky with the stencil
+ * test keeping it off those pixels, which is the same picture as drawing
+ * it first.  The pass runs only on frames where some bone moves faster
+ * than the stage's afterimage_speed, and only those bones are drawn. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
-const r_fx_module r_fx_afterimage_module = {"afterimage", NULL, NULL, NULL, {NULL}, {0}};
+#include "r_local.h"
+#include "r_shader.h"
+
+#define OPACITY 0.6f /* the copy's alpha at rest; the speed fade scales it */
+
+typedef struct r_fx_afterimage {
+    GLuint prog;
+    float radius[16]; /* per bone: the mesh's largest vertex distance from the bone origin */
+    float fast[2][16];
+    bool any_fast;    /* this frame */
+} r_fx_afterimage;
+
+static bool create(r_game *r, rs_err *err)
+{
+    r_fx_afterimage *a = calloc(1, sizeof *a);
+    if (!a)
+        return rs_fail(err, 1, "out of memory");
+    r->afterimage = a;
+    a->prog = r_program(&(r_program_desc){.vs = "afterimage.vert", .fs = "afterimage.frag"}, err);
+    if (!a->prog)
+        return false;
+    r_mesh_data m = {0};
+    if (!r_mesh_fighter(&m)) {
+        r_mesh_free(&m);
+        return rs_fail(err, 1, "out of memory for the fighter mesh");
+    }
+    for (size_t i = 0; i < m.nv; i++) {
+        int b = (int)(m.v[i].bone + 0.5f);
+        if (b < 0 || b >= 16)
+            continue;
+        const float *p = m.v[i].pos;
+        float d = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        if (d > a->radius[b])
+            a->radius[b] = d;
+    }
+    r_mesh_free(&m);
+    for (int b = 0; b < 16; b++)
+        if (!(a->radius[b] > 0.01f))
+            a->radius[b] = 0.01f;
+    return true;
+}
+
+static void destroy(r_game *r)
+{
+    r_fx_afterimage *a = r->afterimage;
+    if (!a)
+        return;
+    gl.DeleteProgram(a->prog);
+    free(a);
+    r->afterimage = NULL;
+}
+
+/* A point of a bone (t metres along its x axis) through matrix v. */
+static r_vec3 bone_point(const float m[16], float t, const r_mat4 *v)
+{
+    float p[3] = {m[12] + m[0] * t, m[13] + m[1] * t, m[14] + m[2] * t};
+    if (!v)
+        return r_v3(p[0], p[1], p[2]);
+    const float *a = v->m;
+    return r_v3(a[0] * p[0] + a[4] * p[1] + a[8] * p[2] + a[12], a[1] * p[0] + a[5] * p[1] + a[9] * p[2] + a[13],
+                a[2] * p[0] + a[6] * p[1] + a[10] * p[2] + a[14]);
+}
+
+/* How fast a bone moves, m/s, as the velocity V of the shader sees it (in
+ * view space, camera motion included, or in world space): the faster of
+ * its origin and its far end (a forearm swung round the elbow barely moves
+ * at its origin).  0 for NaN. */
+static float bone_speed(const float cur[16], const float prev[16], float len, const r_mat4 *view,
+                        const r_mat4 *view_prev)
+{
+    float v = 0;
+    for (int e = 0; e < 2; e++) {
+        r_vec3 d = r_sub(bone_point(cur, e * len, view), bone_point(prev, e * len, view_prev));
+        v = fmaxf(v, sqrtf(r_dot(d, d)) * (float)G_HZ);
+    }
+    return isfinite(v) ? v : 0.0f;
+}
+
+static bool needed(void *u)
+{
+    r_game *r = u;
+    r_fx_afterimage *a = r->afterimage;
+    if (!a || r->stage.afterimage == R_AFTERIMAGE_OFF)
+        return false;
+    a->any_fast = false;
+    const frame *f = &r->f;
+    float thr = r->stage.afterimage_speed;
+    bool view = r->stage.afterimage == R_AFTERIMAGE_VIEW;
+    for (int i = 0; i < 2; i++)
+        for (int b = 0; b < G_BONES; b++) {
+            float v = bone_speed(f->bones[i][b], f->bones_prev[i][b], a->radius[b], view ? &f->view : NULL,
+                                 view ? &f->view_prev : NULL);
+            a->fast[i][b] = v > thr ? 1.0f : 0.0f;
+            a->any_fast |= v > thr;
+        }
+    return a->any_fast;
+}
+
+static void run(void *u)
+{
+    r_game *r = u;
+    r_fx_afterimage *a = r->afterimage;
+    frame *f = &r->f;
+    GLuint p = a->prog;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    gl.Viewport(0, 0, f->w, f->h);
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LESS);
+    gl.DepthMask(GL_FALSE);
+    gl.Disable(GL_CULL_FACE); /* the stretched copy turns some faces round */
+    gl.Enable(GL_STENCIL_TEST);
+    gl.StencilMask(0);
+    gl.StencilFunc(GL_NOTEQUAL, R_STENCIL_FIGHTER, R_STENCIL_FIGHTER);
+    gl.Enable(GL_BLEND);
+    gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    gl.UseProgram(p);
+    r_bind_ibl(r, p);
+    gl.UniformMatrix4fv(r_loc(p, "u_view"), 1, GL_FALSE, f->view.m);
+    gl.UniformMatrix4fv(r_loc(p, "u_view_prev"), 1, GL_FALSE, f->view_prev.m);
+    gl.UniformMatrix4fv(r_loc(p, "u_proj"), 1, GL_FALSE, f->proj.m);
+    gl.Uniform1fv(r_loc(p, "u_radius"), 16, a->radius);
+    gl.Uniform1f(r_loc(p, "u_stretch"), r->stage.afterimage_stretch);
+    gl.Uniform1i(r_loc(p, "u_world"), r->stage.afterimage == R_AFTERIMAGE_WORLD);
+    gl.Uniform1f(r_loc(p, "u_opacity"), OPACITY);
+    gl.BindVertexArray(r->fighter_vao);
+    for (int i = 0; i < 2; i++) {
+        gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &f->bones[i][0][0]);
+        gl.UniformMatrix4fv(r_loc(p, "u_bones_prev"), G_BONES, GL_FALSE, &f->bones_prev[i][0][0]);
+        gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &f->colors[i][0][0]);
+        gl.Uniform1fv(r_loc(p, "u_fast"), 16, a->fast[i]);
+        gl.DrawElements(GL_TRIANGLES, r->fighter_count, GL_UNSIGNED_INT, NULL);
+    }
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_STENCIL_TEST);
+    gl.StencilMask(0xFF);
+    gl.DepthMask(GL_TRUE);
+}
+
+static const r_pass passes[] = {
+    {"afterimage", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, needed, run, 0},
+};
+
+const r_fx_module r_fx_afterimage_module = {
+    "afterimage", create, destroy, NULL, {[R_FX_TRANSLUCENT] = passes}, {[R_FX_TRANSLUCENT] = 1},
+};

@@ -332,7 +332,7 @@ static void bone_matrices(const g_state *prev, const g_state *cur, int i, float 
     }
 }
 
-r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye_out)
+void r_game_camera_parts(const g_state *st, int w, int h, r_mat4 *view, r_mat4 *proj, r_vec3 *eye_out)
 {
     float x0 = fx_to_float(st->f[0].x), x1 = fx_to_float(st->f[1].x);
     float mid = (x0 + x1) / 2, gap = x1 > x0 ? x1 - x0 : x0 - x1;
@@ -340,7 +340,15 @@ r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye_out)
     r_vec3 at = r_v3(mid, 1.0f, 0), eye = r_v3(mid, 1.7f, dist);
     if (eye_out)
         *eye_out = eye;
-    return r_mul(r_perspective(0.75f, (float)w / (float)h, 0.1f, 200.0f), r_look_at(eye, at, r_v3(0, 1, 0)));
+    *proj = r_perspective(0.75f, (float)w / (float)h, 0.1f, 200.0f);
+    *view = r_look_at(eye, at, r_v3(0, 1, 0));
+}
+
+r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye_out)
+{
+    r_mat4 view, proj;
+    r_game_camera_parts(st, w, h, &view, &proj, eye_out);
+    return r_mul(proj, view);
 }
 
 /* The screen rectangle the fighters can cover: the world box round their
@@ -425,7 +433,9 @@ static void fx_setup(r_game *r, frame *f)
         world_capsules(prev, i, f->caps_prev[i]);
         bone_matrices(NULL, prev, i, 1.0f, f->bones_prev[i]);
     }
-    f->vp_prev = r_game_camera(prev, f->w, f->h, NULL);
+    r_mat4 proj;
+    r_game_camera_parts(prev, f->w, f->h, &f->view_prev, &proj, NULL);
+    r_game_camera_parts(cur, f->w, f->h, &f->view, &f->proj, NULL);
     uint64_t t = cur->tick;
     if (!r->have_last || t < r->last_tick || t - r->last_tick > R_FX_MAX_GAP)
         f->reset = true, f->steps = 1;
@@ -714,7 +724,15 @@ static void run_scene(void *u)
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
     r_fx_fog_bind(r, p, 6);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
+    /* stencil bit R_STENCIL_FIGHTER marks the fighters' pixels: copies
+     * drawn later (afterimages) stay behind the models, as if drawn first */
+    gl.Enable(GL_STENCIL_TEST);
+    gl.StencilMask(R_STENCIL_FIGHTER);
+    gl.StencilFunc(GL_ALWAYS, R_STENCIL_FIGHTER, R_STENCIL_FIGHTER);
+    gl.StencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
     r_draw_fighters(r, p);
+    gl.Disable(GL_STENCIL_TEST);
+    gl.StencilMask(0xFF);
 
     /* the ring and the ground, with the projected silhouette */
     p = r->prog[P_STAGE];

@@ -67,6 +67,8 @@ int r_game_ring_stage(const r_game *r);
 
 /* The camera r_game_draw used for this state (tests project with it). */
 r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye);
+/* The same camera as view and projection (r_game_camera = proj * view). */
+void r_game_camera_parts(const g_state *st, int w, int h, r_mat4 *view, r_mat4 *proj, r_vec3 *eye);
 
 /* Fighter colours, for tests that look for them. */
 extern const float r_fighter_color[2][3];

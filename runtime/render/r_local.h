@@ -73,7 +73,7 @@ typedef struct frame {
     r_fx_capsule caps[2][G_BONES], caps_prev[2][G_BONES]; /* at cur->tick and prev->tick */
     int steps;   /* game ticks since the frame drawn last: simulation steps to run now */
     bool reset;  /* the sequence broke (first frame, seek, new stage): restart simulations */
-    r_mat4 vp_prev; /* the camera at prev->tick (afterimages) */
+    r_mat4 view, proj, view_prev; /* the camera now and at prev->tick (afterimages); vp = proj * view */
     float bones_prev[2][16][16];
 } frame;
 
@@ -129,6 +129,9 @@ struct r_game {
     char error[768];
 };
 
+
+/* stencil bits: the scene pass marks the fighters' pixels */
+#define R_STENCIL_FIGHTER 0x80
 
 /* helpers of r_game.c */
 GLint r_loc(GLuint p, const char *name);

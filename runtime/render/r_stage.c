@@ -29,6 +29,7 @@ typedef enum kind {
     K_LIGHT,  /* r_paint_light: 8 numbers */
     K_FORMAT, /* r_hdr_format */
     K_EFFECT, /* a bool whose "yes" is refused until issue 8 builds it */
+    K_AFTERIMAGE, /* r_afterimage */
 } kind;
 
 typedef struct row {
@@ -71,7 +72,11 @@ static const row rows[] = {
     {"snow", K_BOOL, F(snow), 0, 0, "no"},
     {"fog", K_BOOL, F(fog), 0, 0, "no"},
     {"holes", K_EFFECT, F(holes), 0, 0, "no"},
+    {"afterimage", K_AFTERIMAGE, F(afterimage), 0, 0, "view"},
+    {"afterimage_stretch", K_NUM, F(afterimage_stretch), 1, 8, "1"},
+    {"afterimage_speed", K_NUM, F(afterimage_speed), 0, 1000, "2"},
 };
+static const char *const afterimage_names[] = {"off", "view", "world"};
 #define NROWS (sizeof rows / sizeof rows[0])
 
 /* Light components: a direction (any finite size, not zero), a colour and
@@ -322,6 +327,14 @@ static bool set(r_stage *st, const row *r, const char *v, const ctx *c)
             }
         }
         return bad(c, R_STAGE_ERR_VALUE, "hdr_format: expected rgba16f or r11g11b10f, got '%s'", Q(v));
+    case K_AFTERIMAGE:
+        for (size_t i = 0; i < sizeof afterimage_names / sizeof afterimage_names[0]; i++) {
+            if (!strcmp(v, afterimage_names[i])) {
+                *(r_afterimage *)field = (r_afterimage)i;
+                return true;
+            }
+        }
+        return bad(c, R_STAGE_ERR_VALUE, "afterimage: expected view, world or off, got '%s'", Q(v));
     }
     return bad(c, R_STAGE_ERR_VALUE, "%s: internal error: unknown kind %d", r->key, (int)r->kind);
 }
@@ -536,6 +549,11 @@ int r_stage_format(const r_stage *st, char *out, size_t n)
             const r_paint_light *l = field;
             put(&s, "%.9g %.9g %.9g  %.9g %.9g %.9g  %.9g %.9g\n", l->dir[0], l->dir[1], l->dir[2], l->color[0],
                 l->color[1], l->color[2], l->intensity, l->size_deg);
+            break;
+        }
+        case K_AFTERIMAGE: {
+            int a = (int)*(const r_afterimage *)field;
+            put(&s, "%s\n", afterimage_names[a >= 0 && a < 3 ? a : 0]);
             break;
         }
         case K_FORMAT: {

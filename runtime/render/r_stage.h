@@ -28,6 +28,10 @@ typedef struct r_paint_light {
     float size_deg;  /* angular radius of the disc, 0.5..90 */
 } r_paint_light;
 
+/* Afterimage velocity: in view space (camera motion blurs too), in world
+ * space (only the fighters' own motion), or none. */
+typedef enum r_afterimage { R_AFTERIMAGE_OFF, R_AFTERIMAGE_VIEW, R_AFTERIMAGE_WORLD } r_afterimage;
+
 typedef struct r_stage {
     char name[32];
     char game[32];  /* a g_stages name */
@@ -58,8 +62,11 @@ typedef struct r_stage {
     bool shadows;         /* SSFSM + blurred mipmap projection shadows */
     r_hdr_format hdr_format;
 
-    /* stage effects of issue 8: recognised; "yes" is refused until built */
+    /* stage effects (docs/effects.md); "holes = yes" is refused until built */
     bool water, snow, fog, holes;
+    r_afterimage afterimage;  /* motion blur of fast limbs (techniques B) */
+    float afterimage_stretch; /* old position = cur - stretch * V, 1..8 */
+    float afterimage_speed;   /* m/s a bone must move at to leave an afterimage */
 } r_stage;
 
 /* The defaults documented in docs/stages.md (a plain outdoor look). */

@@ -1,0 +1,270 @@
+/* The stage effects as a whole (runtime/render/r_fx*.c) and the afterimage
+ * motion blur: every effect's passes run only on stages that ask for the
+ * effect, and the afterimage shows behind fast limbs, never over the
+ * fighters.  Each effect's own tests are in tests/test_fx_<effect>.c. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_fx.h"
+#include "../runtime/render/r_game.h"
+#include "../runtime/render/r_stage.h"
+#include "../runtime/replay/rp.h"
+#include "t.h"
+
+enum { W = 320, H = 180 };
+
+static void state_at(const char *demo, uint64_t tick, g_state *prev, g_state *cur)
+{
+    char path[1024];
+    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
+    rp_replay rp;
+    rs_err e = {0};
+    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
+    T_ASSERT(tick <= rp.ticks);
+    g_init(cur, rp.stage, rp.seed);
+    *prev = *cur;
+    for (uint64_t t = 0; t < tick; t++) {
+        *prev = *cur;
+        g_step(cur, &rp.inputs[2 * t], NULL);
+    }
+    rp_free(&rp);
+}
+
+typedef struct fb {
+    GLuint fbo, rb[2];
+} fb;
+
+static void fb_make(fb *f)
+{
+    gl.GenFramebuffers(1, &f->fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    gl.GenRenderbuffers(2, f->rb);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
+    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+static void fb_free(fb *f)
+{
+    gl.DeleteFramebuffers(1, &f->fbo);
+    gl.DeleteRenderbuffers(2, f->rb);
+}
+
+static r_game *game_new(bool mask)
+{
+    rs_err e = {0};
+    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
+    T_ASSERTF(r, "%s", e.msg);
+    return r;
+}
+
+static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur)
+{
+    rgl_error_reset();
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    T_EQ(rgl_error_count(), 0);
+    T_EQ(gl.GetError(), GL_NO_ERROR);
+    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
+}
+
+static bool pass_ran(r_game *r, const char *name)
+{
+    r_graph *g = r_game_graph(r);
+    int i = r_graph_find(g, name);
+    T_ASSERTF(i >= 0, "no pass '%s'", name);
+    return (g->last_ran >> i) & 1;
+}
+
+static void load_stage(r_stage *st, const char *name)
+{
+    char path[1024];
+    snprintf(path, sizeof path, RS_SOURCE_DIR "/stages/%s.stage", name);
+    rs_err e = {0};
+    T_ASSERTF(r_stage_load(st, path, &e), "%s", e.msg);
+}
+
+/* Does the stage ask for the module's effect? */
+static bool wants(const r_stage *st, const char *module)
+{
+    if (!strcmp(module, "water"))
+        return st->water;
+    if (!strcmp(module, "snow"))
+        return st->snow;
+    if (!strcmp(module, "fog"))
+        return st->fog;
+    if (!strcmp(module, "afterimage"))
+        return st->afterimage != R_AFTERIMAGE_OFF;
+    T_ASSERTF(false, "unknown effect module '%s': add it here", module);
+    return false;
+}
+
+/* "A stage without an effect runs none of its passes": every shipped
+ * stage, a few frames of a fight, with the effects of every other stage
+ * switched on in turn only where the stage asks for them. */
+static void t_effects_run_only_where_asked(void)
+{
+    plat *p = t_context("egl");
+    static const char *const stages[] = {"dojo", "harbor", "temple", "sunless", "shallows", "snowfield", "mistvale"};
+    fb f;
+    fb_make(&f);
+    int ran_somewhere[16] = {0};
+    for (size_t s = 0; s < sizeof stages / sizeof stages[0]; s++) {
+        r_stage st;
+        load_stage(&st, stages[s]);
+        r_game *r = game_new(false);
+        rs_err e = {0};
+        T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+        g_state prev, cur;
+        state_at("dojo", 400, &prev, &cur);
+        for (int k = 0; k < 10; k++) { /* ticks 400..409: fast limbs among them */
+            draw(r, &f, &prev, &cur);
+            for (int m = 0; m < r_fx_nmodules; m++) {
+                const r_fx_module *mod = r_fx_modules[m];
+                for (int ph = 0; ph < R_FX_PHASES; ph++)
+                    for (int i = 0; i < mod->npass[ph]; i++) {
+                        bool ran = pass_ran(r, mod->pass[ph][i].name);
+                        T_ASSERTF(!ran || wants(&st, mod->name), "stage %s ran pass '%s' of effect %s it does not use",
+                                  stages[s], mod->pass[ph][i].name, mod->name);
+                        ran_somewhere[m] |= ran;
+                    }
+            }
+            g_state next = cur;
+            g_input in[2] = {0, 0};
+            g_step(&next, in, NULL);
+            prev = cur, cur = next;
+        }
+        r_game_destroy(r);
+    }
+    /* and each effect does run somewhere (or the check above proves nothing) */
+    for (int m = 0; m < r_fx_nmodules; m++) {
+        int n = 0;
+        for (int ph = 0; ph < R_FX_PHASES; ph++)
+            n += r_fx_modules[m]->npass[ph];
+        T_ASSERTF(n == 0 || ran_somewhere[m], "effect %s never ran on the stage that asks for it", r_fx_modules[m]->name);
+    }
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+/* The HDR buffer (rgba, bottom-up) of a frame of the dojo demo, with the
+ * afterimage mode given. */
+static float *hdr_frame(r_game *r, fb *f, r_afterimage mode, const g_state *prev, const g_state *cur)
+{
+    r_stage st;
+    load_stage(&st, "dojo");
+    st.afterimage = mode;
+    rs_err e = {0};
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    draw(r, f, prev, cur);
+    float *px = malloc((size_t)W * H * 4 * sizeof *px);
+    T_ASSERT(px);
+    int w = 0, h = 0;
+    T_ASSERT(r_game_read_buffer(r, "hdr", px, &w, &h));
+    T_EQ(w, W);
+    T_EQ(h, H);
+    return px;
+}
+
+/* Tick 408 of the dojo demo: a blow lands, limbs move fast. */
+static void t_afterimage_trails_fast_limbs_only(void)
+{
+    plat *p = t_context("egl");
+    fb f;
+    fb_make(&f);
+    g_state prev, cur;
+    state_at("dojo", 408, &prev, &cur);
+    r_game *r = game_new(true); /* mask mode: HDR alpha = the fighters' mask */
+    float *off = hdr_frame(r, &f, R_AFTERIMAGE_OFF, &prev, &cur);
+    T_ASSERT(!pass_ran(r, "afterimage"));
+    float *on = hdr_frame(r, &f, R_AFTERIMAGE_VIEW, &prev, &cur);
+    T_ASSERT(pass_ran(r, "afterimage"));
+    float *world = hdr_frame(r, &f, R_AFTERIMAGE_WORLD, &prev, &cur);
+    T_ASSERT(pass_ran(r, "afterimage"));
+    int changed = 0, over_fighter = 0, alpha_changed = 0, changed_world = 0, bad = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        const float *a = off + 4 * i, *b = on + 4 * i, *c = world + 4 * i;
+        float d = fabsf(a[0] - b[0]) + fabsf(a[1] - b[1]) + fabsf(a[2] - b[2]);
+        if (d > 1e-3f)
+            changed++;
+        if (fabsf(a[0] - c[0]) + fabsf(a[1] - c[1]) + fabsf(a[2] - c[2]) > 1e-3f)
+            changed_world++;
+        if (a[3] > 0.99f && d > 0) /* a fighter's pixel: the copy stays behind the model */
+            over_fighter++;
+        if (a[3] != b[3])
+            alpha_changed++;
+        for (int k = 0; k < 4; k++)
+            bad += !isfinite(b[k]) || !isfinite(c[k]);
+    }
+    fprintf(stderr, "    afterimage: %d pixels changed (view space), %d (world space); %d over the fighters\n", changed,
+            changed_world, over_fighter);
+    T_ASSERTF(changed > 40, "only %d pixels changed: no visible afterimage", changed);
+    T_ASSERTF(changed_world > 40, "only %d pixels changed in world space", changed_world);
+    T_ASSERTF(changed < W * H / 10, "%d pixels changed: the copy is far too big", changed);
+    T_EQ(over_fighter, 0);
+    T_EQ(alpha_changed, 0); /* the blend keeps the mask */
+    T_EQ(bad, 0);
+    free(off), free(on), free(world);
+
+    /* the same tick drawn again: nothing moved since, no pass */
+    float *still = hdr_frame(r, &f, R_AFTERIMAGE_VIEW, &cur, &cur);
+    T_ASSERT(!pass_ran(r, "afterimage"));
+    free(still);
+    /* a threshold above every limb's speed: no pass */
+    r_stage st;
+    load_stage(&st, "dojo");
+    st.afterimage_speed = 1000;
+    rs_err e = {0};
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    draw(r, &f, &prev, &cur);
+    T_ASSERT(!pass_ran(r, "afterimage"));
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+/* A stretch of 8 with the fastest blow of the demo: still finite, still
+ * only where the limbs were. */
+static void t_afterimage_extremes(void)
+{
+    plat *p = t_context("egl");
+    fb f;
+    fb_make(&f);
+    g_state prev, cur;
+    state_at("dojo", 408, &prev, &cur);
+    r_game *r = game_new(false);
+    r_stage st;
+    load_stage(&st, "dojo");
+    st.afterimage_stretch = 8, st.afterimage_speed = 0;
+    rs_err e = {0};
+    T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+    /* a teleport: the previous tick's state has the fighters 3 m away */
+    g_state far = prev;
+    far.f[0].x += FX(3.0), far.f[1].x -= FX(3.0);
+    draw(r, &f, &far, &cur);
+    T_ASSERT(pass_ran(r, "afterimage"));
+    float *px = malloc((size_t)W * H * 4 * sizeof *px);
+    T_ASSERT(px && r_game_read_buffer(r, "hdr", px, NULL, NULL));
+    int bad = 0;
+    for (size_t i = 0; i < (size_t)W * H * 4; i++)
+        bad += !isfinite(px[i]) || px[i] < 0 || px[i] > 65504;
+    T_EQ(bad, 0);
+    free(px);
+    r_game_destroy(r);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+T_MAIN({"effects_run_only_where_asked", t_effects_run_only_where_asked},
+       {"afterimage_trails_fast_limbs_only", t_afterimage_trails_fast_limbs_only},
+       {"afterimage_extremes", t_afterimage_extremes})
