@@ -21,6 +21,7 @@
 #include "platform/plat.h"
 #include "render/r_game.h"
 #include "render/r_ibl.h"
+#include "render/r_lspsm.h"
 #include "render/r_stage.h"
 #include "render/r_tone.h"
 #include "render/r_target.h"
@@ -183,7 +184,7 @@ static void help(void)
     printf("usage: ringside bench accuracy [--only capture|ibl|tone] [--frames N] [--size WxH]\n"
            "                               [--render-size WxH] [--ibl-sizes LIST] [--ibl-reference N]\n"
            "                               [--stage NAME] [--csv FILE]\n\n"
-           "Run time against error, three tables:\n"
+           "Run time against error, four tables:\n"
            "  capture  downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
            "           nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
            "           with OpenImageIO's resize of the same full-size frame (its lanczos3): PSNR in\n"
@@ -192,14 +193,17 @@ static void help(void)
            "  ibl      prefilters the stage's environment from cubes of each --ibl-sizes edge and\n"
            "           compares the six maps' texels with a brute-force integration over a\n"
            "           --ibl-reference cube: RMS and max relative error, ms per set of maps.\n"
-           "  tone     the tone-curve table's size against the analytic curve, in 8-bit steps.\n\n"
-           "  --only T            one table (default: all three)\n"
+           "  tone     the tone-curve table's size against the analytic curve, in 8-bit steps.\n"
+           "  lspsm    shadow-map texel density near (2 m) and far (50 m) for light space perspective\n"
+           "           shadow maps against uniform shadow mapping, 1024x1024 map, by light angle.\n\n"
+           "  --only T            one table (default: all four)\n"
            "  --frames N          capture: frames from tick 600 on, 60 ticks apart (default 8)\n"
            "  --ibl-sizes LIST    source cube edges, comma-separated (default 8,16,32,64)\n"
            "  --ibl-reference N   the reference cube's edge (default 128)\n"
            "  --stage NAME        the stage whose environment the IBL table uses (default dojo)\n"
-           "  --csv FILE          also write the tables (default out/bench-accuracy.csv; the IBL\n"
-           "                      and tone tables go to FILE's name with -ibl and -tone added)\n");
+           "  --csv FILE          also write the tables (default out/bench-accuracy.csv; the IBL,\n"
+           "                      tone and LSPSM tables go to FILE's name with -ibl, -tone and\n"
+           "                      -lspsm added)\n");
 }
 
 /* out/x.csv + "-ibl" -> out/x-ibl.csv */
@@ -251,8 +255,8 @@ int bench_accuracy(int argc, char **argv)
         case 'r': if (!cli_size("--render-size", optarg, 8192, &sw, &sh)) return RS_EXIT_USAGE; break;
         case 'c': csv = optarg; break;
         case 'o':
-            if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone")) {
-                cli_error("bench", "--only '%s': expected capture, ibl or tone", optarg);
+            if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone") && strcmp(optarg, "lspsm")) {
+                cli_error("bench", "--only '%s': expected capture, ibl, tone or lspsm", optarg);
                 return RS_EXIT_USAGE;
             }
             only = optarg;
@@ -311,6 +315,18 @@ int bench_accuracy(int argc, char **argv)
             return RS_EXIT_FAIL;
         }
         tone_table(cf);
+        if (!csv_close(cf, path, &err)) {
+            cli_error("bench", "%s", err.msg);
+            return RS_EXIT_FAIL;
+        }
+    }
+    if (!only || !strcmp(only, "lspsm")) {
+        csv_name(csv, "-lspsm", path, sizeof path);
+        if (*csv && !(cf = rs_mkdirs_for(path, &err) ? fopen(path, "w") : NULL)) {
+            cli_error("bench", "%s: cannot create", path);
+            return RS_EXIT_FAIL;
+        }
+        r_lspsm_density_rows(stdout, cf);
         if (!csv_close(cf, path, &err)) {
             cli_error("bench", "%s", err.msg);
             return RS_EXIT_FAIL;
