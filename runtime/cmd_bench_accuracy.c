@@ -4,7 +4,9 @@
  *     RGB -> YCbCr 4:2:0 conversion;
  *   - the IBL prefilter: integration resolution against a brute-force
  *     integration over a fine cube;
- *   - the tone-curve table: size against the analytic curve. */
+ *   - the tone-curve table: size against the analytic curve;
+ *   - the water automaton: Courant number against stability;
+ *   - LSPSM shadow-map texel density against uniform shadow mapping. */
 #include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
@@ -20,6 +22,7 @@
 #include "gl/rgl.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_fx_water_sim.h"
 #include "render/r_ibl.h"
 #include "render/r_lspsm.h"
 #include "render/r_stage.h"
@@ -181,10 +184,10 @@ static bool parse_sizes(const char *s, int *out, int *n, int max_n)
 
 static void help(void)
 {
-    printf("usage: ringside bench accuracy [--only capture|ibl|tone] [--frames N] [--size WxH]\n"
+    printf("usage: ringside bench accuracy [--only capture|ibl|tone|water|lspsm] [--frames N] [--size WxH]\n"
            "                               [--render-size WxH] [--ibl-sizes LIST] [--ibl-reference N]\n"
            "                               [--stage NAME] [--csv FILE]\n\n"
-           "Run time against error, four tables:\n"
+           "Run time against error, five tables:\n"
            "  capture  downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
            "           nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
            "           with OpenImageIO's resize of the same full-size frame (its lanczos3): PSNR in\n"
@@ -194,9 +197,11 @@ static void help(void)
            "           compares the six maps' texels with a brute-force integration over a\n"
            "           --ibl-reference cube: RMS and max relative error, ms per set of maps.\n"
            "  tone     the tone-curve table's size against the analytic curve, in 8-bit steps.\n"
+           "  water    the wave automaton's Courant number against stability: margin to the cap,\n"
+           "           energy growth over a long forced run, CPU time per step (about 10 s).\n"
            "  lspsm    shadow-map texel density near (2 m) and far (50 m) for light space perspective\n"
            "           shadow maps against uniform shadow mapping, 1024x1024 map, by light angle.\n\n"
-           "  --only T            one table (default: all four)\n"
+           "  --only T            one table (default: all five)\n"
            "  --frames N          capture: frames from tick 600 on, 60 ticks apart (default 8)\n"
            "  --ibl-sizes LIST    source cube edges, comma-separated (default 8,16,32,64)\n"
            "  --ibl-reference N   the reference cube's edge (default 128)\n"
@@ -255,8 +260,9 @@ int bench_accuracy(int argc, char **argv)
         case 'r': if (!cli_size("--render-size", optarg, 8192, &sw, &sh)) return RS_EXIT_USAGE; break;
         case 'c': csv = optarg; break;
         case 'o':
-            if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone") && strcmp(optarg, "lspsm")) {
-                cli_error("bench", "--only '%s': expected capture, ibl, tone or lspsm", optarg);
+            if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone") && strcmp(optarg, "water") &&
+                strcmp(optarg, "lspsm")) {
+                cli_error("bench", "--only '%s': expected capture, ibl, tone, water or lspsm", optarg);
                 return RS_EXIT_USAGE;
             }
             only = optarg;
@@ -320,6 +326,8 @@ int bench_accuracy(int argc, char **argv)
             return RS_EXIT_FAIL;
         }
     }
+    if (!only || !strcmp(only, "water"))
+        r_water_accuracy_rows(stdout);
     if (!only || !strcmp(only, "lspsm")) {
         csv_name(csv, "-lspsm", path, sizeof path);
         if (*csv && !(cf = rs_mkdirs_for(path, &err) ? fopen(path, "w") : NULL)) {
