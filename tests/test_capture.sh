@@ -155,6 +155,13 @@ t_bench_accuracy_small() {
     # tone: the default table (256) meets the goal at gamma 2.2, 16 entries do not
     awk -F, '$1 == 256 && $3 >= 0.1 { exit 1 } $1 == 16 && $3 < 0.1 { exit 1 }' a-tone.csv || { cat a-tone.csv; return 1; }
     grep -q "256 .*<- default" a.txt || { cat a.txt; return 1; }
+    # water: every capped Courant number is stable; bypassing the cap past the limit is not
+    awk '/^ +0\.[0-9]+ +0\.[0-9]+ +[0-9.]+ +[0-9.]+ / && !/bypassed/ { n++; if ($4 >= 1 || $8 != "yes") exit 1 }
+         END { exit n < 5 }' a.txt || { echo "water table: an unstable capped row"; cat a.txt; return 1; }
+    grep -Eq "^ +0\.7500 +0\.7500 .* 1\.9[0-9]+ .*cap bypassed" a.txt || { echo "water table: no unstable row"; cat a.txt; return 1; }
+    # LSPSM: more texels near than uniform with the light across the view, uniform near parallel
+    awk -F, '$1 == 90 && $7 <= 3 { exit 1 } $1 == 0 && ($7 < 0.999 || $7 > 1.001) { exit 1 }' a-lspsm.csv &&
+        [ "$(wc -l <a-lspsm.csv)" = 6 ] || { cat a-lspsm.csv; return 1; }
 }
 
 t_image_sequences() {
