@@ -22,6 +22,7 @@
 #include "gl/rgl.h"
 #include "platform/plat.h"
 #include "render/r_game.h"
+#include "render/r_fx.h"
 #include "render/r_fx_water_sim.h"
 #include "render/r_ibl.h"
 #include "render/r_lspsm.h"
@@ -184,10 +185,10 @@ static bool parse_sizes(const char *s, int *out, int *n, int max_n)
 
 static void help(void)
 {
-    printf("usage: ringside bench accuracy [--only capture|ibl|tone|water|lspsm] [--frames N] [--size WxH]\n"
+    printf("usage: ringside bench accuracy [--only capture|ibl|tone|water|fog|lspsm] [--frames N] [--size WxH]\n"
            "                               [--render-size WxH] [--ibl-sizes LIST] [--ibl-reference N]\n"
            "                               [--stage NAME] [--csv FILE]\n\n"
-           "Run time against error, five tables:\n"
+           "Run time against error, six tables:\n"
            "  capture  downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
            "           nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
            "           with OpenImageIO's resize of the same full-size frame (its lanczos3): PSNR in\n"
@@ -199,9 +200,11 @@ static void help(void)
            "  tone     the tone-curve table's size against the analytic curve, in 8-bit steps.\n"
            "  water    the wave automaton's Courant number against stability: margin to the cap,\n"
            "           energy growth over a long forced run, CPU time per step (about 10 s).\n"
+           "  fog      the fog map's size (32..512) against the time of its pass and the error of\n"
+           "           the density it gives, against a 1024x1024 map of the same mist.\n"
            "  lspsm    shadow-map texel density near (2 m) and far (50 m) for light space perspective\n"
            "           shadow maps against uniform shadow mapping, 1024x1024 map, by light angle.\n\n"
-           "  --only T            one table (default: all five)\n"
+           "  --only T            one table (default: all six)\n"
            "  --frames N          capture: frames from tick 600 on, 60 ticks apart (default 8)\n"
            "  --ibl-sizes LIST    source cube edges, comma-separated (default 8,16,32,64)\n"
            "  --ibl-reference N   the reference cube's edge (default 128)\n"
@@ -261,8 +264,8 @@ int bench_accuracy(int argc, char **argv)
         case 'c': csv = optarg; break;
         case 'o':
             if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone") && strcmp(optarg, "water") &&
-                strcmp(optarg, "lspsm")) {
-                cli_error("bench", "--only '%s': expected capture, ibl, tone, water or lspsm", optarg);
+                strcmp(optarg, "fog") && strcmp(optarg, "lspsm")) {
+                cli_error("bench", "--only '%s': expected capture, ibl, tone, water, fog or lspsm", optarg);
                 return RS_EXIT_USAGE;
             }
             only = optarg;
@@ -328,6 +331,15 @@ int bench_accuracy(int argc, char **argv)
     }
     if (!only || !strcmp(only, "water"))
         r_water_accuracy_rows(stdout);
+    if (!only || !strcmp(only, "fog")) {
+        plat *p = plat_create(&(plat_desc){.hidden = true}, &err);
+        bool ok = p && r_fx_fog_accuracy_rows(stdout, &err);
+        plat_destroy(p);
+        if (!ok) {
+            cli_error("bench", "fog map: %s", err.msg);
+            return RS_EXIT_FAIL;
+        }
+    }
     if (!only || !strcmp(only, "lspsm")) {
         csv_name(csv, "-lspsm", path, sizeof path);
         if (*csv && !(cf = rs_mkdirs_for(path, &err) ? fopen(path, "w") : NULL)) {

@@ -3,14 +3,17 @@
 // blend is premultiplied (ONE, ONE_MINUS_SRC_ALPHA): the tint is scaled by
 // alpha, the reflection is not, so a lens of alpha 0.15 still shows the sun
 // at full HDR strength.  The blend leaves the destination alpha (the mask)
-// alone.
+// alone.  In fog (A8) the lens fades into the fog's light like the head
+// behind it, so the two add up to the fogged head seen through the lens.
 #include "ibl_common.glsl"
+#include "fog_common.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
 in vec4 v_tangent;
 in vec2 v_uv;
 in vec4 v_color;
+in float v_fog;
 uniform vec3 u_eye;
 uniform float u_lens_alpha;
 
@@ -28,6 +31,10 @@ void main()
     vec3 tint = vec3(0.05, 0.07, 0.09) * ibl_diffuse(n, 1.0);
     vec3 refl = ibl_specular(r, 128.0, 1.0) * mix(0.3, 1.0, fresnel);
     vec3 c = tint * u_lens_alpha + refl;
+    if (u_fog_on == 1) {
+        float t = exp(-v_fog);
+        c = c * t + fog_light(-v) * ((1.0 - t) * u_lens_alpha);
+    }
     // blended result = c + (1 - alpha) * dst with dst <= 65504: keeping c
     // under 65504 * alpha keeps the sum finite in half float on any GPU
     c = min(c, vec3(65504.0 * u_lens_alpha));

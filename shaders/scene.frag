@@ -4,8 +4,10 @@
 // no ambient term.  Every surface blends its key-on and key-off IBL
 // results by its shadow factor: the filtered screen-space mask for the
 // fighters (SSFSM), the blurred silhouette mip chain for the stage.
-// Output: linear HDR, alpha = the fighters' mask.
+// Output: linear HDR, alpha = the fighters' mask.  On a stage with a fog
+// map (A8) the result is mixed with the fog's light last.
 #include "ibl_common.glsl"
+#include "fog_common.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -22,6 +24,7 @@ uniform vec3 u_ring_color;
 uniform sampler2D u_normal_map;
 uniform sampler2D u_spec_map;
 uniform sampler2D u_mask;
+in float v_fog;
 #endif
 uniform vec3 u_eye;
 uniform int u_shadows;   // 1 when this frame's shadow passes ran
@@ -71,5 +74,16 @@ void main()
     float fresnel = 0.25 + 0.75 * pow(1.0 - ndv, 5.0);
     vec3 lit = albedo * ibl_diffuse(n, key) + spec_color * fresnel * ibl_specular(r, exponent, key);
     lit += u_flash * 2.0 * albedo;
+    if (u_fog_on == 1) {
+#ifdef STAGE
+        // the ring and the ground are a few huge triangles (the ground is
+        // 80 m across): a fog factor interpolated between their corners
+        // would never see the map, so the stage integrates per pixel
+        float tau = fog_depth(v_world);
+#else
+        float tau = v_fog;
+#endif
+        lit = fog_apply(lit, tau, -v);
+    }
     o_color = vec4(hdr_out(lit), alpha);
 }

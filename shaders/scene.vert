@@ -4,6 +4,10 @@
 // per bone (bone index -1: world space).  Variants by #define:
 //   FIGHTER, STAGE, LENS   the HDR scene pass (scene.frag)
 //   LIGHT_VIEW             shadow map / silhouette from the key light
+// FIGHTER and LENS compute the fog map's optical depth per vertex (fog A8);
+// STAGE leaves it to the fragment shader (scene.frag says why).
+#include "fog_common.glsl"
+
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_tangent;
@@ -29,6 +33,9 @@ out vec3 v_normal;
 out vec4 v_tangent;
 out vec2 v_uv;
 out vec4 v_color;
+#if defined(FIGHTER) || defined(LENS)
+out float v_fog; // optical depth from the eye
+#endif
 
 invariant gl_Position; // the z-prepass and the scene pass must agree exactly
 
@@ -60,6 +67,9 @@ void main()
     bool behind = dot(world.xyz - w, u_light_dir) > 0.0;
     v_proj = vec3(lp.xy * 0.5 + 0.5, facing && !behind ? 1.0 : 0.0);
     v_lod = clamp((d - u_lod_start) * u_lod_scale, 0.0, 4.0);
+#endif
+#if defined(FIGHTER) || defined(LENS)
+    v_fog = u_fog_on == 1 ? fog_depth(world.xyz) : 0.0;
 #endif
     gl_Position = u_view_proj * world;
 }

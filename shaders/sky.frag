@@ -1,6 +1,8 @@
 #version 330 core
 // The stage's environment as seen, plus the sun disc (the sun is a delta
-// light in the prefiltered maps, so it is drawn analytically here).
+// light in the prefiltered maps, so it is drawn analytically here).  In
+// fog (A8) the sky fades into the fog's light towards the horizon.
+#include "fog_common.glsl"
 in vec3 v_dir;
 uniform samplerCube u_env;
 uniform vec3 u_sun_dir;
@@ -15,6 +17,8 @@ void main()
     float cs = dot(d, u_sun_dir);
     c += u_sun_radiance * smoothstep(u_sun_cos - (1.0 - u_sun_cos) * 0.3, u_sun_cos, cs);
     c += u_flash * vec3(1.5, 1.6, 2.0);
+    if (u_fog_on == 1)
+        c = fog_apply(c, fog_depth_sky(d), d);
     c = min(c, vec3(65504.0));
     o_color = vec4(c, 0.0);
 }

@@ -21,6 +21,7 @@
 #define R_FX_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "../game/g_skel.h"
 #include "../gl/rgl.h"
@@ -75,5 +76,13 @@ int r_fx_contacts(const r_fx_capsule caps[2][G_BONES], const r_fx_capsule prev[2
  * map when the fog_map pass ran this frame).  Every program that draws the
  * scene calls it; its shaders include fog_common.glsl. */
 void r_fx_fog_bind(r_game *r, GLuint p, int unit);
+/* Its hooks for tests and bench accuracy: the mist simulation (NULL when
+ * the module was not created), the map of the frame drawn last (size x
+ * size floats, row = z, covering x, z in +-half metres; out NULL asks the
+ * size only), and the "fog-map resolution vs time" table of bench
+ * accuracy (needs a current GL context). */
+struct r_fog_sim *r_fx_fog_sim(r_game *r);
+bool r_fx_fog_read_map(r_game *r, float *out, int *size, float *half);
+bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err);
 
 #endif

@@ -777,6 +777,7 @@ static void run_sky(void *u)
                  fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
     gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
+    r_fx_fog_bind(r, p, 6);
     r_fullscreen(r);
     gl.DepthMask(GL_TRUE);
 }
@@ -797,6 +798,7 @@ static void run_lens(void *u)
     gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     r_camera_uniforms(r, p);
     r_bind_ibl(r, p);
+    r_fx_fog_bind(r, p, 6);
     gl.Uniform1f(r_loc(p, "u_lens_alpha"), LENS_ALPHA);
     gl.BindVertexArray(r->lens_vao);
     for (int i = 0; i < 2; i++) {
@@ -1109,11 +1111,11 @@ static bool build_graph(r_game *r, rs_err *err)
         {"shadow_mask", RES_DEPTH | RES_SHADOW, RES_MASK, need_shadows, run_shadow_mask, 0},
         {"mask_filter", RES_MASK, RES_MASK, need_shadows, run_mask_filter, 0},
         {NULL, R_FX_PRE, 0, NULL, NULL, 0},
-        {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene, RES_MASK | RES_SIL},
+        {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene, RES_MASK | RES_SIL | RES_FOGMAP},
         {NULL, R_FX_SURFACE, 0, NULL, NULL, 0},
-        {"sky", RES_ENV | RES_DEPTH, RES_HDR, need_always, run_sky, 0},
+        {"sky", RES_ENV | RES_DEPTH, RES_HDR, need_always, run_sky, RES_FOGMAP},
         {NULL, R_FX_TRANSLUCENT, 0, NULL, NULL, 0},
-        {"lens", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, need_always, run_lens, 0},
+        {"lens", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, need_always, run_lens, RES_FOGMAP},
         {"bloom_bright", RES_HDR, RES_BLOOM, need_bloom, run_bloom_bright, 0},
         {"bloom_blur", RES_BLOOM, RES_BLOOM, need_bloom, run_bloom_blur, 0},
         {"sun_visibility", RES_DEPTH, RES_SUNVIS, need_sun, run_sun_visibility, 0},
