@@ -102,17 +102,36 @@ static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur, uint
     T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
 }
 
-/* One picture of a demo with its stage file, the way render makes it. */
-static void picture(const char *demo, uint64_t tick, const r_game_opts *o, uint8_t *px)
+/* One picture of a demo with its stage file, the way render makes it:
+ * the frames of the `history` ticks before it are drawn first, so the
+ * stage effects' simulations (docs/effects.md) have that much past. */
+static void picture_after(const char *demo, uint64_t tick, uint64_t history, const r_game_opts *o, uint8_t *px)
 {
     g_state prev, cur;
-    state_at(demo, tick, &prev, &cur);
+    uint64_t first = tick > history ? tick - history : 0;
+    state_at(demo, first, &prev, &cur);
+    char path[1024];
+    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
+    rp_replay rp;
+    rs_err e = {0};
+    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
     r_game *r = game_new(o);
     fb f;
     fb_make(&f);
+    for (uint64_t t = first; t < tick; t++) {
+        draw(r, &f, &prev, &cur, NULL);
+        prev = cur;
+        g_step(&cur, &rp.inputs[2 * t], NULL);
+    }
     draw(r, &f, &prev, &cur, px);
+    rp_free(&rp);
     fb_free(&f);
     r_game_destroy(r);
+}
+
+static void picture(const char *demo, uint64_t tick, const r_game_opts *o, uint8_t *px)
+{
+    picture_after(demo, tick, 0, o, px);
 }
 
 static const uint8_t *at(const uint8_t *px, int x, int y_from_bottom)
@@ -137,12 +156,12 @@ static void write_ppm_rgb(const char *path, const uint8_t *rgba, int scale, cons
         fprintf(stderr, "    %s\n", e.msg);
 }
 
-static void golden(const char *backend, const char *demo, uint64_t tick)
+static void golden_after(const char *backend, const char *demo, uint64_t tick, uint64_t history)
 {
     char path[1024];
     snprintf(path, sizeof path, RS_SOURCE_DIR "/tests/golden/render_%s_%llu.ppm", demo, (unsigned long long)tick);
     static uint8_t px[W * H * 4];
-    picture(demo, tick, NULL, px);
+    picture_after(demo, tick, history, NULL, px);
     rs_err e = {0};
     if (getenv("T_GOLDEN_UPDATE") && !strcmp(backend, "egl"))
         write_ppm_rgb(path, px, 1, NULL);
@@ -179,12 +198,20 @@ static void golden(const char *backend, const char *demo, uint64_t tick)
               demo, (unsigned long long)tick, psnr, bad, W * H, W * H / 100);
 }
 
+static void golden(const char *backend, const char *demo, uint64_t tick)
+{
+    golden_after(backend, demo, tick, 0);
+}
+
 static void t_golden_egl(void)
 {
     plat *p = t_context("egl");
     golden("egl", "dojo", 1200);   /* low sun on screen: flare, bloom, shadows */
     golden("egl", "harbor", 900);  /* night, no sun, no bloom */
     golden("egl", "temple", 900);  /* high sun, shadows under the fighters */
+    /* the stage effects, with 2 s of history for their simulations */
+    golden_after("egl", "shallows", 380, 120);  /* waves round the fighters' feet, reflections */
+    golden_after("egl", "mistvale", 700, 120);  /* mist stirred by the fight, fog at the horizon */
     plat_destroy(p);
 }
 
