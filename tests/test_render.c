@@ -211,6 +211,7 @@ static void t_golden_egl(void)
     golden("egl", "temple", 900);  /* high sun, shadows under the fighters */
     /* the stage effects, with 2 s of history for their simulations */
     golden_after("egl", "shallows", 380, 120);  /* waves round the fighters' feet, reflections */
+    golden_after("egl", "snowfield", 900, 120); /* footprints in the snow, texture-space light */
     golden_after("egl", "mistvale", 700, 120);  /* mist stirred by the fight, fog at the horizon */
     plat_destroy(p);
 }
