@@ -14,7 +14,8 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 4) in float a_bone;
 
 uniform mat4 u_view, u_view_prev, u_proj;
-uniform mat4 u_bones[16], u_bones_prev[16];
+uniform mat4 u_bones[16];      // where the model is drawn (interpolated between ticks)
+uniform mat4 u_bones_tick[16], u_bones_prev[16]; // the current and previous whole ticks: V
 uniform vec4 u_bone_color[16];
 uniform float u_radius[16];
 uniform float u_fast[16];
@@ -34,20 +35,21 @@ void main()
         return;
     }
     vec4 cur = u_bones[b] * vec4(a_pos, 1.0);
+    vec4 tick = u_bones_tick[b] * vec4(a_pos, 1.0);
     vec4 prev = u_bones_prev[b] * vec4(a_pos, 1.0);
     vec3 n = mat3(u_bones[b]) * a_normal;
     vec3 pos_v;  // the vertex in view space
     vec3 vel;    // V in the chosen space
     vec3 nrm;
     if (u_world != 0) {
-        vel = cur.xyz - prev.xyz;
+        vel = tick.xyz - prev.xyz;
         nrm = n;
         vec3 p = dot(nrm, vel) < 0.0 ? cur.xyz - u_stretch * vel : cur.xyz;
         pos_v = (u_view * vec4(p, 1.0)).xyz;
         v_world = p;
     } else {
-        vec3 cv = (u_view * cur).xyz, pv = (u_view_prev * prev).xyz;
-        vel = cv - pv;
+        vec3 cv = (u_view * cur).xyz;
+        vel = (u_view * tick).xyz - (u_view_prev * prev).xyz;
         nrm = mat3(u_view) * n;
         pos_v = dot(nrm, vel) < 0.0 ? cv - u_stretch * vel : cv;
         v_world = (inverse(u_view) * vec4(pos_v, 1.0)).xyz;

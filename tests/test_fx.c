@@ -265,6 +265,59 @@ static void t_afterimage_extremes(void)
     plat_destroy(p);
 }
 
-T_MAIN({"effects_run_only_where_asked", t_effects_run_only_where_asked},
+/* One renderer going from stage to stage draws what a fresh one draws:
+ * no effect leaves state behind (the water's mirrored sky once kept the
+ * fog of the stage before). */
+static void t_stage_switch_leaves_nothing_behind(void)
+{
+    plat *p = t_context("egl");
+    fb f;
+    fb_make(&f);
+    g_state prev, cur;
+    state_at("dojo", 408, &prev, &cur);
+    static const char *const order[] = {"mistvale", "shallows", "snowfield", "mistvale", "dojo"};
+    r_game *shared = game_new(false);
+    for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
+        r_stage st;
+        load_stage(&st, order[i]);
+        rs_err e = {0};
+        T_ASSERTF(r_game_set_stage(shared, &st, &e), "%s", e.msg);
+        draw(shared, &f, &prev, &cur);
+        float *a = malloc((size_t)W * H * 4 * sizeof *a), *b = malloc((size_t)W * H * 4 * sizeof *b);
+        T_ASSERT(a && b && r_game_read_buffer(shared, "hdr", a, NULL, NULL));
+        r_game *fresh = game_new(false);
+        T_ASSERTF(r_game_set_stage(fresh, &st, &e), "%s", e.msg);
+        draw(fresh, &f, &prev, &cur);
+        T_ASSERT(r_game_read_buffer(fresh, "hdr", b, NULL, NULL));
+        int differ = 0;
+        for (size_t k = 0; k < (size_t)W * H * 4; k++)
+            differ += a[k] != b[k];
+        T_ASSERTF(differ == 0, "%s after %s: %d values differ from a fresh renderer's", order[i], i ? order[i - 1] : "-",
+                  differ);
+        r_game_destroy(fresh);
+        free(a), free(b);
+    }
+    r_game_destroy(shared);
+    fb_free(&f);
+    plat_destroy(p);
+}
+
+static void t_empty_frame_is_refused(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    state_at("shallows", 300, &prev, &cur);
+    r_game *r = game_new(false);
+    T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 0, 0));
+    T_CONTAINS(r_game_error(r), "cannot draw a 0x0 frame");
+    T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 64, -1));
+    T_EQ(gl.GetError(), GL_NO_ERROR);
+    r_game_destroy(r);
+    plat_destroy(p);
+}
+
+T_MAIN({"stage_switch_leaves_nothing_behind", t_stage_switch_leaves_nothing_behind},
+       {"empty_frame_is_refused", t_empty_frame_is_refused},
+       {"effects_run_only_where_asked", t_effects_run_only_where_asked},
        {"afterimage_trails_fast_limbs_only", t_afterimage_trails_fast_limbs_only},
        {"afterimage_extremes", t_afterimage_extremes})

@@ -15,8 +15,9 @@
  * Passes get the r_game as their user pointer; the frame being drawn is
  * r->f.  Simulations step r->f.steps times (whole game ticks since the
  * frame drawn last, 0 when a tick is drawn again) and restart when
- * r->f.reset is set, so a video of a replay is the same at any frame rate
- * and from any machine. */
+ * r->f.reset is set, so a video of a replay (every tick drawn) is the same
+ * on any machine.  A frame spanning several ticks knows only the last two
+ * (docs/effects.md says what each effect does then). */
 #ifndef R_FX_H
 #define R_FX_H
 

@@ -102,7 +102,7 @@ static bool needed(void *u)
     bool view = r->stage.afterimage == R_AFTERIMAGE_VIEW;
     for (int i = 0; i < 2; i++)
         for (int b = 0; b < G_BONES; b++) {
-            float v = bone_speed(f->bones[i][b], f->bones_prev[i][b], a->radius[b], view ? &f->view : NULL,
+            float v = bone_speed(f->bones_tick[i][b], f->bones_prev[i][b], a->radius[b], view ? &f->view : NULL,
                                  view ? &f->view_prev : NULL);
             a->fast[i][b] = v > thr ? 1.0f : 0.0f;
             a->any_fast |= v > thr;
@@ -140,6 +140,7 @@ static void run(void *u)
     for (int i = 0; i < 2; i++) {
         gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &f->bones[i][0][0]);
         gl.UniformMatrix4fv(r_loc(p, "u_bones_prev"), G_BONES, GL_FALSE, &f->bones_prev[i][0][0]);
+        gl.UniformMatrix4fv(r_loc(p, "u_bones_tick"), G_BONES, GL_FALSE, &f->bones_tick[i][0][0]);
         gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &f->colors[i][0][0]);
         gl.Uniform1fv(r_loc(p, "u_fast"), 16, a->fast[i]);
         gl.DrawElements(GL_TRIANGLES, r->fighter_count, GL_UNSIGNED_INT, NULL);

@@ -411,7 +411,6 @@ static void run_surface(void *u)
     r_bind_tex(p, "u_colors", 4, GL_TEXTURE_2D, s->color_tex);
     r_bind_tex(p, "u_silhouette", 5, GL_TEXTURE_2D, r->sil_tex);
     r_bind_tex(p, "u_key", 7, GL_TEXTURE_2D, s->key_tex);
-    r_fx_fog_bind(r, p, 6);
     gl.Uniform1f(r_loc(p, "u_half"), s->half);
     gl.Uniform1f(r_loc(p, "u_color_tile"), COLOR_TILE);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);

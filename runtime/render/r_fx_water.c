@@ -440,6 +440,9 @@ static void run_reflect(void *u)
     GLuint p = r->prog[P_SKY];
     gl.Disable(GL_DEPTH_TEST);
     gl.UseProgram(p);
+    /* the sky program keeps the fog uniforms run_sky set last frame (maybe
+     * another stage's): the mirror is not fogged */
+    gl.Uniform1i(r_loc(p, "u_fog_on"), 0);
     r_mat4 inv = r_invert(vp);
     gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, inv.m);
     r_bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r->sky_tex);

@@ -267,7 +267,7 @@ int r_half(int v, int k)
 
 static bool make_targets(r_game *r, int w, int h, rs_err *err)
 {
-    if (r->tw == w && r->th == h && r->tfmt == r->hdr_format)
+    if (r->tw == w && r->th == h && r->tw > 0 && r->tfmt == r->hdr_format)
         return true;
     free_targets(r);
     GLenum hdr_fmt = r->hdr_format == R_HDR_R11G11B10F ? GL_R11F_G11F_B10F : GL_RGBA16F;
@@ -432,6 +432,7 @@ static void fx_setup(r_game *r, frame *f)
         world_capsules(cur, i, f->caps[i]);
         world_capsules(prev, i, f->caps_prev[i]);
         bone_matrices(NULL, prev, i, 1.0f, f->bones_prev[i]);
+        bone_matrices(NULL, cur, i, 1.0f, f->bones_tick[i]);
     }
     r_mat4 proj;
     r_game_camera_parts(prev, f->w, f->h, &f->view_prev, &proj, NULL);
@@ -1323,12 +1324,16 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     GLint out = 0;
     gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &out);
     rs_err err = {0};
-    if (!r_game_prepare(r, cur->stage, &err) || !make_targets(r, w, h, &err)) {
+    if (w <= 0 || h <= 0)
+        rs_fail(&err, 1, "cannot draw a %dx%d frame", w, h);
+    if (err.msg[0] || !r_game_prepare(r, cur->stage, &err) || !make_targets(r, w, h, &err)) {
         snprintf(r->error, sizeof r->error, "%s", err.msg);
         gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)out);
-        gl.Viewport(0, 0, w, h);
-        gl.ClearColor(0, 0, 0, 1);
-        gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        if (w > 0 && h > 0) {
+            gl.Viewport(0, 0, w, h);
+            gl.ClearColor(0, 0, 0, 1);
+            gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        }
         return false;
     }
     if (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) {
@@ -1339,6 +1344,9 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     /* a known state whatever the caller left: every pass sets what it needs on top */
     gl.Disable(GL_SCISSOR_TEST);
     gl.Disable(GL_BLEND);
+    gl.BlendEquation(GL_FUNC_ADD);
+    gl.Disable(GL_STENCIL_TEST);
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
     gl.Disable(GL_CULL_FACE);
     gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     gl.DepthMask(GL_TRUE);

@@ -74,7 +74,7 @@ typedef struct frame {
     int steps;   /* game ticks since the frame drawn last: simulation steps to run now */
     bool reset;  /* the sequence broke (first frame, seek, new stage): restart simulations */
     r_mat4 view, proj, view_prev; /* the camera now and at prev->tick (afterimages); vp = proj * view */
-    float bones_prev[2][16][16];
+    float bones_prev[2][16][16], bones_tick[2][16][16]; /* at prev->tick and cur->tick, not interpolated */
 } frame;
 
 struct r_game {
