@@ -395,6 +395,8 @@ static void on_step(void *user, const g_input in[2])
 
 static void draw(attract *a, float alpha, int w, int h)
 {
+    if (w <= 0 || h <= 0) /* a minimised window: nothing to draw */
+        return;
     if (a->mode == MODE_LOOP && a->mp) {
         mv_player_draw(a->mp, w, h);
     } else if (a->mode == MODE_MATCH || a->demo_loaded || a->cpu_demo) {
