@@ -14,50 +14,9 @@
 #include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"
 #include "t.h"
+#include "t_render.h"
 
 enum { W = 320, H = 180 };
-
-static void state_at(const char *demo, uint64_t tick, g_state *prev, g_state *cur)
-{
-    char path[1024];
-    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
-    rp_replay rp;
-    rs_err e = {0};
-    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
-    T_ASSERT(tick <= rp.ticks);
-    g_init(cur, rp.stage, rp.seed);
-    *prev = *cur;
-    for (uint64_t t = 0; t < tick; t++) {
-        *prev = *cur;
-        g_step(cur, &rp.inputs[2 * t], NULL);
-    }
-    rp_free(&rp);
-}
-
-typedef struct fb {
-    GLuint fbo, rb[2];
-} fb;
-
-static void fb_make(fb *f)
-{
-    gl.GenFramebuffers(1, &f->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    gl.GenRenderbuffers(2, f->rb);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
-    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-static void fb_free(fb *f)
-{
-    gl.DeleteFramebuffers(1, &f->fbo);
-    gl.DeleteRenderbuffers(2, f->rb);
-}
 
 static r_game *game_new(bool mask)
 {
@@ -67,7 +26,7 @@ static r_game *game_new(bool mask)
     return r;
 }
 
-static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur)
+static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur)
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -116,8 +75,8 @@ static void t_effects_run_only_where_asked(void)
 {
     plat *p = t_context("egl");
     static const char *const stages[] = {"dojo", "harbor", "temple", "sunless", "shallows", "snowfield", "mistvale"};
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     int ran_somewhere[16] = {0};
     for (size_t s = 0; s < sizeof stages / sizeof stages[0]; s++) {
         r_stage st;
@@ -126,7 +85,7 @@ static void t_effects_run_only_where_asked(void)
         rs_err e = {0};
         T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
         g_state prev, cur;
-        state_at("dojo", 400, &prev, &cur);
+        t_state_at("dojo", 400, &prev, &cur);
         for (int k = 0; k < 10; k++) { /* ticks 400..409: fast limbs among them */
             draw(r, &f, &prev, &cur);
             for (int m = 0; m < r_fx_nmodules; m++) {
@@ -153,13 +112,13 @@ static void t_effects_run_only_where_asked(void)
             n += r_fx_modules[m]->npass[ph];
         T_ASSERTF(n == 0 || ran_somewhere[m], "effect %s never ran on the stage that asks for it", r_fx_modules[m]->name);
     }
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
 /* The HDR buffer (rgba, bottom-up) of a frame of the dojo demo, with the
  * afterimage mode given. */
-static float *hdr_frame(r_game *r, fb *f, r_afterimage mode, const g_state *prev, const g_state *cur)
+static float *hdr_frame(r_game *r, t_fb *f, r_afterimage mode, const g_state *prev, const g_state *cur)
 {
     r_stage st;
     load_stage(&st, "dojo");
@@ -180,10 +139,10 @@ static float *hdr_frame(r_game *r, fb *f, r_afterimage mode, const g_state *prev
 static void t_afterimage_trails_fast_limbs_only(void)
 {
     plat *p = t_context("egl");
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state prev, cur;
-    state_at("dojo", 408, &prev, &cur);
+    t_state_at("dojo", 408, &prev, &cur);
     r_game *r = game_new(true); /* mask mode: HDR alpha = the fighters' mask */
     float *off = hdr_frame(r, &f, R_AFTERIMAGE_OFF, &prev, &cur);
     T_ASSERT(!pass_ran(r, "afterimage"));
@@ -229,7 +188,7 @@ static void t_afterimage_trails_fast_limbs_only(void)
     draw(r, &f, &prev, &cur);
     T_ASSERT(!pass_ran(r, "afterimage"));
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -238,10 +197,10 @@ static void t_afterimage_trails_fast_limbs_only(void)
 static void t_afterimage_extremes(void)
 {
     plat *p = t_context("egl");
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state prev, cur;
-    state_at("dojo", 408, &prev, &cur);
+    t_state_at("dojo", 408, &prev, &cur);
     r_game *r = game_new(false);
     r_stage st;
     load_stage(&st, "dojo");
@@ -261,7 +220,7 @@ static void t_afterimage_extremes(void)
     T_EQ(bad, 0);
     free(px);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -271,10 +230,10 @@ static void t_afterimage_extremes(void)
 static void t_stage_switch_leaves_nothing_behind(void)
 {
     plat *p = t_context("egl");
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state prev, cur;
-    state_at("dojo", 408, &prev, &cur);
+    t_state_at("dojo", 408, &prev, &cur);
     static const char *const order[] = {"mistvale", "shallows", "snowfield", "mistvale", "dojo"};
     r_game *shared = game_new(false);
     for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
@@ -298,7 +257,7 @@ static void t_stage_switch_leaves_nothing_behind(void)
         free(a), free(b);
     }
     r_game_destroy(shared);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -306,7 +265,7 @@ static void t_empty_frame_is_refused(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("shallows", 300, &prev, &cur);
+    t_state_at("shallows", 300, &prev, &cur);
     r_game *r = game_new(false);
     T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 0, 0));
     T_CONTAINS(r_game_error(r), "cannot draw a 0x0 frame");

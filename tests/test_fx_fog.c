@@ -20,6 +20,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_img.h"
 #include "t.h"
+#include "t_render.h"
 
 /* ---- the simulation (no GL) ---- */
 
@@ -235,48 +236,6 @@ static void t_sim_extremes_stay_finite(void)
 
 enum { W = 320, H = 180 };
 
-static void state_at(const char *demo, uint64_t tick, g_state *prev, g_state *cur)
-{
-    char path[1024];
-    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
-    rp_replay rp;
-    rs_err e = {0};
-    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
-    T_ASSERT(tick <= rp.ticks);
-    g_init(cur, rp.stage, rp.seed);
-    *prev = *cur;
-    for (uint64_t t = 0; t < tick; t++) {
-        *prev = *cur;
-        g_step(cur, &rp.inputs[2 * t], NULL);
-    }
-    rp_free(&rp);
-}
-
-typedef struct fb {
-    GLuint fbo, rb[2];
-} fb;
-
-static void fb_make(fb *f)
-{
-    gl.GenFramebuffers(1, &f->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    gl.GenRenderbuffers(2, f->rb);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
-    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-static void fb_free(fb *f)
-{
-    gl.DeleteFramebuffers(1, &f->fbo);
-    gl.DeleteRenderbuffers(2, f->rb);
-}
-
 static r_game *game_new(const r_stage *st)
 {
     rs_err e = {0};
@@ -305,7 +264,7 @@ static bool pass_ran(r_game *r, const char *name)
 }
 
 /* One frame into f (px: RGBA8 top row first, may be NULL); no GL errors. */
-static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
+static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -367,7 +326,7 @@ static void dump_frame(const char *name, const uint8_t *rgba)
 
 /* Replaces the mist with these particles (full weight, mid-life) and
  * draws the same tick again: no step, so the map holds exactly them. */
-static void place(r_game *r, fb *f, const g_state *prev, const g_state *cur, const float (*xz)[2], int n)
+static void place(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, const float (*xz)[2], int n)
 {
     r_fog_sim *s = r_fx_fog_sim(r);
     T_ASSERT(s && n <= s->d.count);
@@ -383,11 +342,11 @@ static void t_map_is_where_particles_are(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 900, &prev, &cur);
+    t_state_at("dojo", 900, &prev, &cur);
     r_stage st = mistvale();
     r_game *r = game_new(&st);
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     draw(r, &f, &prev, &cur, NULL);
     T_ASSERT(pass_ran(r, "fog_map"));
     int n;
@@ -444,7 +403,7 @@ static void t_map_is_where_particles_are(void)
         T_ASSERTF(m[k] == 0, "texel %d = %g with no particles", k, m[k]);
     free(m);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -455,8 +414,8 @@ static void t_map_follows_the_game(void)
 {
     plat *p = t_context("egl");
     r_stage st = mistvale();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     rp_replay rp;
     rs_err e = {0};
     T_ASSERTF(rp_read(RS_SOURCE_DIR "/demos/dojo.rsr", &rp, &e), "%s", e.msg);
@@ -490,7 +449,7 @@ static void t_map_follows_the_game(void)
     T_ASSERTF(!memcmp(maps[0], maps[1], (size_t)n * n * sizeof(float)), "two renders of the same ticks differ");
     free(maps[0]), free(maps[1]);
     rp_free(&rp);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -509,13 +468,13 @@ static void t_fog_varies_at_equal_height(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 900, &prev, &cur);
+    t_state_at("dojo", 900, &prev, &cur);
     r_stage st = mistvale();
     st.bloom = 0, st.flare = false; /* nothing that spreads light between the two points */
     static float with[W * H * 4], without[W * H * 4];
     int w, h;
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(&st);
     draw(r, &f, &prev, &cur, NULL);
     r_vec3 eye;
@@ -559,7 +518,7 @@ static void t_fog_varies_at_equal_height(void)
     T_ASSERTF(fabsf(luma(dw) - luma(dn)) > 0.1f * luma(dn), "the misty side hardly changed: %.4f vs %.4f", luma(dw),
               luma(dn));
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -568,13 +527,13 @@ static void t_fog_is_visible(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 900, &prev, &cur);
+    t_state_at("dojo", 900, &prev, &cur);
     r_stage st = mistvale();
     static uint8_t a[W * H * 4], b[W * H * 4];
     static float ha[W * H * 4], hb[W * H * 4];
     int w, h;
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(&st);
     draw(r, &f, &prev, &cur, a);
     T_ASSERT(pass_ran(r, "fog_map"));
@@ -613,7 +572,7 @@ static void t_fog_is_visible(void)
      * sun scattered forward: brighter than the grass, warm */
     T_ASSERTF(luma(ga) > 2 * luma(gb) && ga[0] > ga[2], "far ground %.3f %.3f %.3f", ga[0], ga[1], ga[2]);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -623,10 +582,10 @@ static void t_fog_off_keeps_the_golden_image(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 1200, &prev, &cur);
+    t_state_at("dojo", 1200, &prev, &cur);
     static uint8_t px[W * H * 4];
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(NULL);
     draw(r, &f, &prev, &cur, px);
     T_ASSERT(!pass_ran(r, "fog_map"));
@@ -651,7 +610,7 @@ static void t_fog_off_keeps_the_golden_image(void)
     T_ASSERTF(psnr >= 30 && bad <= W * H / 100, "PSNR %.1f dB, %d pixels more than 24 off", psnr, bad);
     rs_image_free(&g);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -677,10 +636,10 @@ static void t_fp16_extremes(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 900, &prev, &cur);
+    t_state_at("dojo", 900, &prev, &cur);
     const r_stage base = mistvale();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(&base);
     struct {
         const char *what;
@@ -730,7 +689,7 @@ static void t_fp16_extremes(void)
     draw(r, &f, &cur, &back, NULL);
     check_finite(r, "corrupted particles");
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 

@@ -17,6 +17,7 @@
 #include "../runtime/render/r_graph.h"
 #include "../runtime/render/r_stage.h"
 #include "t.h"
+#include "t_render.h"
 
 enum { N = R_SNOW_MAP, W = 160, H = 90 };
 
@@ -92,31 +93,6 @@ static void t_color_textures(void)
 
 /* ---- GL ---- */
 
-typedef struct fb {
-    GLuint fbo, rb[2];
-} fb;
-
-static void fb_make(fb *f)
-{
-    gl.GenFramebuffers(1, &f->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    gl.GenRenderbuffers(2, f->rb);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
-    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-static void fb_free(fb *f)
-{
-    gl.DeleteFramebuffers(1, &f->fbo);
-    gl.DeleteRenderbuffers(2, f->rb);
-}
-
 static r_game *game_new(void)
 {
     rs_err e = {0};
@@ -127,7 +103,7 @@ static r_game *game_new(void)
     return r;
 }
 
-static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur)
+static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur)
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -192,8 +168,8 @@ static void t_contacts_lower_the_map(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state st;
     g_init(&st, snowfield(), 1); /* both fighters standing, feet on the ring */
     draw(r, &f, &st, &st);
@@ -242,7 +218,7 @@ static void t_contacts_lower_the_map(void)
     read_maps(r, &m);
     T_ASSERT(m.map[texel(0, -1.5f)] == m.un[texel(0, -1.5f)]);
     check_bounds(&m, "after the prints");
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -251,8 +227,8 @@ static void t_never_below_trampled_and_reset(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state st;
     g_init(&st, snowfield(), 1);
     draw(r, &f, &st, &st);
@@ -296,7 +272,7 @@ static void t_never_below_trampled_and_reset(void)
     read_maps(r, &after);
     T_ASSERTF(after.map[t] == after.un[t], "after the reset: %g, untouched %g", after.map[t], after.un[t]);
     T_ASSERT(!memcmp(after.map, before.map, sizeof after.map)); /* the fighters stand where they stood */
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -313,8 +289,8 @@ static void t_footprints_where_fighters_walked(void)
     lean.shadows = false, lean.bloom = 0;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(every, &lean, &e) && r_game_set_stage(other, &lean, &e), "%s", e.msg);
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state prev, cur;
     g_init(&cur, snowfield(), 7);
     g_ai ai[2];
@@ -369,7 +345,7 @@ static void t_footprints_where_fighters_walked(void)
                 lowered += m.map[j * N + i] < m.un[j * N + i];
         }
     T_ASSERTF(lowered > 200, "only %d texels pressed down", lowered);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(every);
     r_game_destroy(other);
     plat_destroy(p);
@@ -387,8 +363,8 @@ static void t_snow_is_visible(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state st;
     g_init(&st, snowfield(), 1);
     static float with[W * H * 4], without[W * H * 4];
@@ -421,7 +397,7 @@ static void t_snow_is_visible(void)
             same += fabsf(a[0] - b[0]) < 1e-3f && fabsf(a[1] - b[1]) < 1e-3f && fabsf(a[2] - b[2]) < 1e-3f;
         }
     T_ASSERTF(same == n, "%d of %d sky pixels changed", n - same, n);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -431,8 +407,8 @@ static void t_fp16_extremes(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     g_state st;
     g_init(&st, snowfield(), 1);
     const r_stage base = *r_game_stage(r);
@@ -477,7 +453,7 @@ static void t_fp16_extremes(void)
                       light[i]);
     }
     free(light);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }

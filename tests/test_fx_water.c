@@ -22,6 +22,7 @@
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "t.h"
+#include "t_render.h"
 
 enum { W = 320, H = 180, NN = R_WATER_N * R_WATER_N * 2 };
 
@@ -120,32 +121,7 @@ static r_game *game_new(void)
     return r;
 }
 
-typedef struct fb {
-    GLuint fbo, rb[2];
-} fb;
-
-static void fb_make(fb *f)
-{
-    gl.GenFramebuffers(1, &f->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    gl.GenRenderbuffers(2, f->rb);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
-    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-static void fb_free(fb *f)
-{
-    gl.DeleteFramebuffers(1, &f->fbo);
-    gl.DeleteRenderbuffers(2, f->rb);
-}
-
-static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
+static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -249,8 +225,8 @@ static void t_shallows_waves_and_picture(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     static float g[NN];
     static uint8_t wet[W * H * 4], dry[W * H * 4];
     match m;
@@ -300,7 +276,7 @@ static void t_shallows_waves_and_picture(void)
         }
     fprintf(stderr, "    %d of %d pixels over the ring differ with water on\n", differ, n);
     T_ASSERTF(differ > n / 2, "water on and off look alike over the ring (%d of %d pixels differ)", differ, n);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -326,8 +302,8 @@ static void t_no_nan_or_inf(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     match m;
     match_start(&m);
     while (m.cur.tick < 330)
@@ -378,7 +354,7 @@ static void t_no_nan_or_inf(void)
             check_finite(r, cases[k].what, true);
         }
     }
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }

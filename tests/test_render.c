@@ -25,51 +25,9 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_img.h"
 #include "t.h"
+#include "t_render.h"
 
 enum { W = 320, H = 180 };
-
-static void state_at(const char *demo, uint64_t tick, g_state *prev, g_state *cur)
-{
-    char path[1024];
-    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
-    rp_replay rp;
-    rs_err e = {0};
-    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
-    T_ASSERT(tick <= rp.ticks);
-    g_init(cur, rp.stage, rp.seed);
-    *prev = *cur;
-    for (uint64_t t = 0; t < tick; t++) {
-        *prev = *cur;
-        g_step(cur, &rp.inputs[2 * t], NULL);
-    }
-    rp_free(&rp);
-}
-
-/* An RGBA8 + depth framebuffer of W x H. */
-typedef struct fb {
-    GLuint fbo, rb[2];
-} fb;
-
-static void fb_make(fb *f)
-{
-    gl.GenFramebuffers(1, &f->fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    gl.GenRenderbuffers(2, f->rb);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[0]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->rb[0]);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, f->rb[1]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, f->rb[1]);
-    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-static void fb_free(fb *f)
-{
-    gl.DeleteFramebuffers(1, &f->fbo);
-    gl.DeleteRenderbuffers(2, f->rb);
-}
 
 static r_game *game_new(const r_game_opts *o)
 {
@@ -86,7 +44,7 @@ static r_game *game_new(const r_game_opts *o)
 }
 
 /* Draws one frame into f and reads it back top-down (px may be NULL). */
-static void draw(r_game *r, fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
+static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -109,15 +67,15 @@ static void picture_after(const char *demo, uint64_t tick, uint64_t history, con
 {
     g_state prev, cur;
     uint64_t first = tick > history ? tick - history : 0;
-    state_at(demo, first, &prev, &cur);
+    t_state_at(demo, first, &prev, &cur);
     char path[1024];
     snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
     rp_replay rp;
     rs_err e = {0};
     T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
     r_game *r = game_new(o);
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     for (uint64_t t = first; t < tick; t++) {
         draw(r, &f, &prev, &cur, NULL);
         prev = cur;
@@ -125,7 +83,7 @@ static void picture_after(const char *demo, uint64_t tick, uint64_t history, con
     }
     draw(r, &f, &prev, &cur, px);
     rp_free(&rp);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
 }
 
@@ -229,11 +187,11 @@ static void t_fighters_where_the_camera_says(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("temple", 900, &prev, &cur); /* midday: both fighters in full light */
+    t_state_at("temple", 900, &prev, &cur); /* midday: both fighters in full light */
     static uint8_t px[W * H * 4];
     r_game *r = game_new(NULL);
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     draw(r, &f, &prev, &cur, px);
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
@@ -247,7 +205,7 @@ static void t_fighters_where_the_camera_says(void)
         int main = i == 0 ? q[0] : q[2], other = i == 0 ? q[2] : q[0];
         T_ASSERTF(main > other + 40, "fighter %d's chest at (%.0f,%.0f) is %u,%u,%u", i + 1, sx, sy, q[0], q[1], q[2]);
     }
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -289,15 +247,15 @@ static void t_stage_file_keeps_the_matchs_ring(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 900, &prev, &cur);
+    t_state_at("dojo", 900, &prev, &cur);
     r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/temple.stage"});
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     draw(r, &f, &prev, &cur, NULL);
     T_ASSERT(!strcmp(r_game_stage(r)->name, "temple"));
     T_EQ(r_game_ring_stage(r), cur.stage);
     T_ASSERT(cur.stage != r_game_stage(r)->game_index);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -306,11 +264,11 @@ static void t_drawing_leaves_state_alone(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 900, &prev, &cur);
+    t_state_at("dojo", 900, &prev, &cur);
     uint64_t h0 = g_hash(&prev), h1 = g_hash(&cur);
     r_game *r = game_new(NULL);
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     static uint8_t clean[W * H * 4], messy[W * H * 4];
     draw(r, &f, &prev, &cur, clean);
     T_EQ(g_hash(&prev), h0);
@@ -339,7 +297,7 @@ static void t_drawing_leaves_state_alone(void)
     rs_flip_rows(messy, W, H, 4);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     T_ASSERTF(!memcmp(clean, messy, sizeof clean), "the caller's GL state changed the picture");
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -375,7 +333,7 @@ static void APIENTRY count_bind_fb(GLenum t, GLuint f)
     real_bind_fb(t, f);
 }
 
-static void counted_frame(r_game *r, fb *f, const g_state *prev, const g_state *cur, int *draws, int *binds)
+static void counted_frame(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, int *draws, int *binds)
 {
     real_draw_arrays = gl.DrawArrays, real_draw_elements = gl.DrawElements, real_bind_fb = gl.BindFramebuffer;
     gl.DrawArrays = count_draw_arrays, gl.DrawElements = count_draw_elements, gl.BindFramebuffer = count_bind_fb;
@@ -392,9 +350,9 @@ static void t_sunless_stage_skips_its_passes(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 1200, &prev, &cur);
-    fb f;
-    fb_make(&f);
+    t_state_at("dojo", 1200, &prev, &cur);
+    t_fb f;
+    t_fb_make(&f, W, H);
     /* dojo: the sun is on screen, everything runs */
     r_game *r = game_new(NULL);
     int d_all, b_all, d_less, b_less;
@@ -424,7 +382,7 @@ static void t_sunless_stage_skips_its_passes(void)
     T_ASSERTF(d_less + 25 <= d_all, "draws %d -> %d", d_all, d_less);
     T_ASSERTF(b_less + 20 <= b_all, "binds %d -> %d", b_all, b_less);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -448,11 +406,11 @@ static void t_mask_output_alpha(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("temple", 900, &prev, &cur);
+    t_state_at("temple", 900, &prev, &cur);
     static uint8_t px[W * H * 4];
     r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .mask = true});
-    fb f;
-    fb_make(&f);
+    t_fb f;
+    t_fb_make(&f, W, H);
     draw(r, &f, &prev, &cur, px);
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
@@ -474,7 +432,7 @@ static void t_mask_output_alpha(void)
     for (int k = 0; k < W * H; k++)
         covered += px[4 * k + 3] > 127;
     T_ASSERTF(covered > W * H / 100 && covered < W * H / 4, "%d pixels in the mask", covered);
-    fb_free(&f);
+    t_fb_free(&f);
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -510,9 +468,9 @@ static void t_low_alpha_lens_shows_the_sun(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("temple", 900, &prev, &cur);
-    fb f;
-    fb_make(&f);
+    t_state_at("temple", 900, &prev, &cur);
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(NULL);
     r_stage st;
     lens_stage(&st, true);
@@ -559,7 +517,7 @@ static void t_low_alpha_lens_shows_the_sun(void)
         mx = fmaxf(mx, luma(with + 4 * (size_t)k));
     T_ASSERTF(mx < 0.01f, "a black world without a sun has HDR %.3f somewhere", mx);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
@@ -570,9 +528,9 @@ static void t_low_alpha_lens_shows_the_sun(void)
 static void floor_shadow_check(const r_stage *st_in, const float L[3], float max_ratio, float *mask)
 {
     g_state prev, cur;
-    state_at("temple", 900, &prev, &cur);
-    fb f;
-    fb_make(&f);
+    t_state_at("temple", 900, &prev, &cur);
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(NULL);
     rs_err e = {0};
     r_stage st = *st_in;
@@ -607,7 +565,7 @@ static void floor_shadow_check(const r_stage *st_in, const float L[3], float max
     float c0 = hdr_mean(with, 6, 6, 3), c1 = hdr_mean(without, 6, 6, 3);
     T_ASSERTF(fabsf(c0 - c1) <= 0.01f * c1 + 1e-4f, "a far corner changed: %.4f vs %.4f", c0, c1);
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
 }
 
 static const r_stage *temple_look(void)
@@ -676,9 +634,9 @@ static void t_stress_no_nan_or_inf(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    state_at("dojo", 1200, &prev, &cur); /* the sun on screen */
-    fb f;
-    fb_make(&f);
+    t_state_at("dojo", 1200, &prev, &cur); /* the sun on screen */
+    t_fb f;
+    t_fb_make(&f, W, H);
     r_game *r = game_new(NULL);
     rs_err e = {0};
     T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
@@ -726,7 +684,7 @@ static void t_stress_no_nan_or_inf(void)
         }
     }
     r_game_destroy(r);
-    fb_free(&f);
+    t_fb_free(&f);
     plat_destroy(p);
 }
 
