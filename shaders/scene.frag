@@ -5,9 +5,14 @@
 // results by its shadow factor: the filtered screen-space mask for the
 // fighters (SSFSM), the blurred silhouette mip chain for the stage.
 // Output: linear HDR, alpha = the fighters' mask.  On a stage with a fog
-// map (A8) the result is mixed with the fog's light last.
+// map (A8) the result is mixed with the fog's light last.  On a stage with
+// LSPSM (C) the key light is blocked further by the large-world shadow map:
+// the stage where its scenery casts, the fighters where the ray to the
+// light leaves their own box (no self-shadow) and never below
+// u_lspsm_keep, so they keep their directional shading in shadow.
 #include "ibl_common.glsl"
 #include "fog_common.glsl"
+#include "lspsm_common.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -19,6 +24,7 @@ in vec3 v_proj;
 in float v_lod;
 uniform sampler2D u_silhouette;
 uniform vec3 u_ring_color;
+uniform int u_material; // 0 planks; 1 planks, paving on the ground; 2 a building
 #endif
 #ifdef FIGHTER
 uniform sampler2D u_normal_map;
@@ -53,6 +59,8 @@ void main()
     vec3 spec_color = sm.rgb * v_color.a;
     float exponent = 16.0 + 112.0 * sm.a;
     float key = u_shadows == 1 ? texelFetch(u_mask, ivec2(gl_FragCoord.xy), 0).r : 1.0;
+    if (u_lspsm_on == 1)
+        key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world));
     vec3 albedo = v_color.rgb;
     float alpha = 1.0;
 #endif
@@ -64,9 +72,30 @@ void main()
     vec3 albedo = u_ring_color * grain * seam;
     vec3 spec_color = vec3(0.04);
     float exponent = 16.0;
+    if (u_material == 1 && v_world.y < -2.95) {
+        // paving: 1 m slabs, each a little different, dark joints
+        vec2 slab = floor(v_world.xz);
+        float tone = 0.85 + 0.15 * fract(sin(dot(slab, vec2(12.9898, 78.233))) * 43758.5453);
+        vec2 f = fract(v_world.xz);
+        float joint = min(smoothstep(0.0, 0.03, min(f.x, f.y)), smoothstep(0.0, 0.03, min(1.0 - f.x, 1.0 - f.y)));
+        albedo = vec3(0.46, 0.44, 0.41) * tone * (0.6 + 0.4 * joint);
+    } else if (u_material == 2) {
+        // concrete with a grid of glass windows (3.5 m floors, 2.5 m bays)
+        float along = abs(n.x) > 0.5 ? v_world.z : v_world.x;
+        vec2 cell = fract(vec2(along / 2.5, (v_world.y + 3.0) / 3.5));
+        bool wall = abs(n.y) < 0.5 && v_world.y > -1.0;
+        bool glass = wall && cell.x > 0.18 && cell.x < 0.82 && cell.y > 0.28 && cell.y < 0.86;
+        vec3 block = floor(v_world / 12.0);
+        float tone = 0.8 + 0.2 * fract(sin(dot(block, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
+        albedo = glass ? vec3(0.03, 0.035, 0.04) : vec3(0.56, 0.53, 0.49) * tone;
+        spec_color = glass ? vec3(0.6) : vec3(0.03);
+        exponent = glass ? 128.0 : 16.0;
+    }
     float key = 1.0;
     if (u_shadows == 1 && v_proj.z > 0.5)
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
+    if (u_lspsm_on == 1) // the fighters' shadows come from the silhouette
+        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), true);
     float alpha = 0.0;
 #endif
     vec3 r = reflect(-v, n);

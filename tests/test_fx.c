@@ -64,6 +64,8 @@ static bool wants(const r_stage *st, const char *module)
         return st->fog;
     if (!strcmp(module, "afterimage"))
         return st->afterimage != R_AFTERIMAGE_OFF;
+    if (!strcmp(module, "lspsm")) /* the map and its focus; the buildings pass draws buildings */
+        return st->lspsm || st->buildings > 0;
     T_ASSERTF(false, "unknown effect module '%s': add it here", module);
     return false;
 }
@@ -74,7 +76,7 @@ static bool wants(const r_stage *st, const char *module)
 static void t_effects_run_only_where_asked(void)
 {
     plat *p = t_context("egl");
-    static const char *const stages[] = {"dojo", "harbor", "temple", "sunless", "shallows", "snowfield", "mistvale"};
+    static const char *const stages[] = {"dojo", "harbor", "temple", "sunless", "shallows", "snowfield", "mistvale", "plaza"};
     t_fb f;
     t_fb_make(&f, W, H);
     int ran_somewhere[16] = {0};

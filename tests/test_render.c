@@ -171,6 +171,7 @@ static void t_golden_egl(void)
     golden_after("egl", "shallows", 380, 120);  /* waves round the fighters' feet, reflections */
     golden_after("egl", "snowfield", 900, 120); /* footprints in the snow, texture-space light */
     golden_after("egl", "mistvale", 700, 120);  /* mist stirred by the fight, fog at the horizon */
+    golden_after("egl", "plaza", 1500, 30);     /* LSPSM: the landmark's shadow across the ring */
     plat_destroy(p);
 }
 

@@ -11,6 +11,7 @@ const g_stage_def g_stages[G_STAGES] = {
     {"shallows", FX(4.0), false},  /* ankle-deep water over the ring (water) */
     {"snowfield", FX(4.0), false}, /* fresh snow on the ring (snow) */
     {"mistvale", FX(4.5), false},  /* mist that limbs stir (fog map) */
+    {"plaza", FX(4.0), false},     /* a city square: buildings cast LSPSM shadows */
 };
 
 #define WALK_F_SPEED FX(0.030)

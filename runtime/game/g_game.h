@@ -135,7 +135,7 @@ typedef struct g_stage_def {
     bool storm;    /* random lightning flashes */
 } g_stage_def;
 
-#define G_STAGES 6
+#define G_STAGES 7
 extern const g_stage_def g_stages[G_STAGES];
 
 void g_init(g_state *st, int stage, uint64_t seed);

@@ -86,4 +86,26 @@ struct r_fog_sim *r_fx_fog_sim(r_game *r);
 bool r_fx_fog_read_map(r_game *r, float *out, int *size, float *half);
 bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err);
 
+/* LSPSM (r_fx_lspsm.c): sets program p's u_lspsm_* uniforms and its two
+ * maps on units `unit` and `unit + 1` (u_lspsm_on = 0 whenever the map was
+ * not drawn this frame).  Every program that draws the scene with
+ * lspsm_common.glsl calls it. */
+void r_fx_lspsm_bind(r_game *r, GLuint p, int unit);
+/* What the last frame's lspsm_map did, for tests, bench and docs. */
+typedef struct r_fx_lspsm_stats {
+    int casters, casters_drawn;   /* buildings, and those that passed culling */
+    int city_triangles, proxy_triangles;
+    float range;                  /* the shadow range used (the focus), m */
+    float warp, gamma;            /* r_lspsm's warp strength and view-light angle */
+    float focus_farthest;         /* the farthest sample the focus found, m */
+    int focus_used;               /* samples that counted */
+} r_fx_lspsm_stats;
+bool r_fx_lspsm_stats_get(r_game *r, r_fx_lspsm_stats *out);
+/* Tests and bench: force the light direction (NULL: the stage's key),
+ * switch caster culling off, or the warp (plain uniform shadow mapping). */
+void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform);
+/* Tests: "map" (1024x1024 depth floats), "flag" (1024x1024), "focus"
+ * (20x16 depth samples of the frame drawn last), "shadow" (16 floats). */
+bool r_fx_lspsm_read(r_game *r, const char *what, float *out);
+
 #endif

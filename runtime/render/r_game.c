@@ -21,7 +21,7 @@ static const float skin[3] = {0.85f, 0.66f, 0.52f};
 static const char *const res_names[] = {"env",    "shadow map",  "silhouette",  "depth",       "shadow mask",
                                         "hdr",    "bloom",       "sun visibility", "output",   "flare",
                                         "fog map", "water",      "water reflection", "under water", "snow",
-                                        "snow light"};
+                                        "snow light", "lspsm map"};
 
 /* ---- helpers ---- */
 
@@ -156,8 +156,12 @@ static bool build_ring(r_game *r, int game_stage, rs_err *err)
 {
     float e = fx_to_float(g_stages[game_stage].ring_half);
     r_mesh_data m = {0};
-    const float lo[3] = {-e, -0.6f, -e}, hi[3] = {e, 0.0f, e};
-    const float glo[3] = {-40, -3.3f, -40}, ghi[3] = {40, -3.0f, 40}; /* the ground far below */
+    /* among buildings the ring stands on a plinth in a paved square that
+     * reaches past the shadow range (r_city.h) */
+    bool city = r->stage.buildings > 0;
+    float g = city ? 160.0f : 40.0f;
+    const float lo[3] = {-e, city ? -3.0f : -0.6f, -e}, hi[3] = {e, 0.0f, e};
+    const float glo[3] = {-g, -3.3f, -g}, ghi[3] = {g, -3.0f, g}; /* the ground far below */
     if (!r_mesh_box(&m, lo, hi) || !r_mesh_box(&m, glo, ghi)) {
         r_mesh_free(&m);
         return rs_fail(err, 1, "out of memory for the ring mesh");
@@ -531,6 +535,7 @@ void r_draw_fighters(r_game *r, GLuint p)
     for (int i = 0; i < 2; i++) {
         gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &r->f.bones[i][0][0]);
         gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &r->f.colors[i][0][0]);
+        gl.Uniform1i(r_loc(p, "u_fighter"), i);
         gl.DrawElements(GL_TRIANGLES, r->fighter_count, GL_UNSIGNED_INT, NULL);
     }
 }
@@ -724,6 +729,7 @@ static void run_scene(void *u)
     r_bind_tex(p, "u_mask", 2, GL_TEXTURE_2D, r->mask_tex[r->mask_final]);
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
     r_fx_fog_bind(r, p, 6);
+    r_fx_lspsm_bind(r, p, 4);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     /* stencil bit R_STENCIL_FIGHTER marks the fighters' pixels: copies
      * drawn later (afterimages) stay behind the models, as if drawn first */
@@ -743,6 +749,8 @@ static void run_scene(void *u)
     r_bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
     r_fx_fog_bind(r, p, 6);
+    r_fx_lspsm_bind(r, p, 4);
+    gl.Uniform1i(r_loc(p, "u_material"), r->stage.buildings > 0 ? 1 : 0);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
     gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
@@ -1428,6 +1436,9 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
         level = name[10] ? name[10] - '0' : 0; /* "silhouette2": blurred level 2 */
         tex = r->sil_tex, tw = SIL_SIZE >> level, th = SIL_SIZE >> level;
     }
+    GLenum fmt = GL_RGBA;
+    if (!strcmp(name, "depth")) /* one float per pixel, window depth */
+        tex = r->depth_tex, fmt = GL_DEPTH_COMPONENT;
     if (!tex)
         return false;
     if (w)
@@ -1437,7 +1448,7 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
     if (out) {
         gl.BindTexture(GL_TEXTURE_2D, tex);
         gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-        gl.GetTexImage(GL_TEXTURE_2D, level, GL_RGBA, GL_FLOAT, out);
+        gl.GetTexImage(GL_TEXTURE_2D, level, fmt, GL_FLOAT, out);
         gl.BindTexture(GL_TEXTURE_2D, 0);
     }
     return true;

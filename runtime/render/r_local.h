@@ -41,6 +41,7 @@ enum {
     RES_WATER_UNDER = 1u << 13,
     RES_SNOW = 1u << 14,        /* the displacement map: persistent */
     RES_SNOW_LIGHT = 1u << 15,
+    RES_LSPSM = 1u << 16,       /* the large-world shadow map */
 };
 #define RES_PERSISTENT (RES_ENV | RES_WATER | RES_SNOW)
 
@@ -123,6 +124,7 @@ struct r_game {
     struct r_fx_snow *snow;
     struct r_fx_fog *fog;
     struct r_fx_afterimage *afterimage;
+    struct r_fx_lspsm *lspsm;
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
     bool have_last;
     frame f;

@@ -23,6 +23,7 @@ typedef enum kind {
     K_GAME,   /* a g_stages name; also sets game_index */
     K_ENV,    /* "procedural" or an .hdr/.exr path */
     K_NUM,    /* float in lo..hi */
+    K_INT,    /* a whole number in lo..hi, stored as int */
     K_COLOR,  /* 3 floats, each in lo..hi */
     K_DIR,    /* 3 floats, not all zero, normalised */
     K_BOOL,
@@ -72,6 +73,9 @@ static const row rows[] = {
     {"snow", K_BOOL, F(snow), 0, 0, "no"},
     {"fog", K_BOOL, F(fog), 0, 0, "no"},
     {"holes", K_EFFECT, F(holes), 0, 0, "no"},
+    {"lspsm", K_BOOL, F(lspsm), 0, 0, "no"},
+    {"buildings", K_INT, F(buildings), 0, R_STAGE_MAX_BUILDINGS, "0"},
+    {"buildings_seed", K_INT, F(buildings_seed), 0, 16777216, "1"},
     {"afterimage", K_AFTERIMAGE, F(afterimage), 0, 0, "view"},
     {"afterimage_stretch", K_NUM, F(afterimage_stretch), 1, 8, "1"},
     {"afterimage_speed", K_NUM, F(afterimage_speed), 0, 1000, "2"},
@@ -284,6 +288,15 @@ static bool set(r_stage *st, const row *r, const char *v, const ctx *c)
     case K_NUM: {
         size_t n = strlen(v);
         return number(c, r->key, NULL, v, n, r->lo, r->hi, field);
+    }
+    case K_INT: {
+        char *end;
+        long x = strtol(v, &end, 10);
+        if (!*v || *end || x < (long)r->lo || x > (long)r->hi)
+            return bad(c, R_STAGE_ERR_VALUE, "%s: expected a whole number in %g..%g, got '%s'", r->key, r->lo, r->hi,
+                       Q(v));
+        *(int *)field = (int)x;
+        return true;
     }
     case K_COLOR:
     case K_DIR: {
@@ -536,6 +549,9 @@ int r_stage_format(const r_stage *st, char *out, size_t n)
             break;
         case K_NUM:
             put(&s, "%.9g\n", f[0]);
+            break;
+        case K_INT:
+            put(&s, "%d\n", *(const int *)field);
             break;
         case K_COLOR:
         case K_DIR:

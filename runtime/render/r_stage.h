@@ -14,6 +14,7 @@
 #include "../util/rs_err.h"
 
 #define R_STAGE_MAX_BYTES (64u * 1024u)
+#define R_STAGE_MAX_BUILDINGS 48
 #define R_HALF_MAX 65504.0f /* largest finite fp16: the bound of every HDR value */
 
 enum { R_STAGE_ERR_FILE = 1, R_STAGE_ERR_SYNTAX, R_STAGE_ERR_VALUE };
@@ -64,6 +65,11 @@ typedef struct r_stage {
 
     /* stage effects (docs/effects.md); "holes = yes" is refused until built */
     bool water, snow, fog, holes;
+    /* light space perspective shadow maps over the whole stage (techniques
+     * C): the key light's shadows of the buildings (and the fighters) */
+    bool lspsm;
+    int buildings;        /* how many buildings stand round the ring, 0..R_STAGE_MAX_BUILDINGS */
+    int buildings_seed;   /* their layout (r_city.h), 0..2^24 */
     r_afterimage afterimage;  /* motion blur of fast limbs (techniques B) */
     float afterimage_stretch; /* old position = cur - stretch * V, 1..8 */
     float afterimage_speed;   /* m/s a bone must move at to leave an afterimage */

@@ -1,0 +1,429 @@
+/* Shadows in a large world (techniques C, issue 8): light space
+ * perspective shadow maps over a stage with buildings.
+ *
+ * The mathematics is r_lspsm.c (tested without GL); this module gives it
+ * its passes, on stages with `lspsm = yes` only:
+ *
+ *   lspsm_map    (R_FX_PRE)  the auto-focus takes the depth samples the
+ *                previous frame read back (its PBO, one frame late), then
+ *                r_lspsm_build makes this frame's matrices, and one
+ *                1024x1024 depth map is drawn from the buildings' low-poly
+ *                proxies (one merged mesh; each building's range is drawn
+ *                only when r_lspsm_caster_visible says it can cast into
+ *                the view) and the fighters (movable: their own mesh).
+ *                An R8 target beside the depth marks the texels whose
+ *                nearest caster is a fighter.
+ *   buildings    (R_FX_SURFACE) the detailed building meshes, lit like the
+ *                stage (IBL, fog, the LSPSM map).  Runs on any stage with
+ *                `buildings` > 0, shadow map or not.
+ *   lspsm_focus  (R_FX_TRANSLUCENT) the depth buffer is complete: the
+ *                20x16 tilted pattern is gathered into a 20x16 R32F target
+ *                on the GPU and read into a pixel-pack buffer; the next
+ *                frame maps it.
+ *
+ * The receivers (shaders/lspsm_common.glsl, r_fx_lspsm_bind): the ring,
+ * the ground and the buildings look the map up at their own position
+ * (pushed along the normal), ignoring the fighter-flagged texels since the
+ * blurred silhouette (A5) already casts the fighters onto the stage; the
+ * fighters look it up where the ray towards the light leaves their own box
+ * (no self-shadow, others' shadows received) and keep u_lspsm_keep of the
+ * key light in full shadow, so they keep their directional shading.
+ *
+ * The focus readback waits, in the next frame, for the previous frame's
+ * 1280-byte transfer; every frame is then a function of the frames drawn
+ * before it, so a replay's video is the same on every run.  A reset
+ * (first frame, seek, new stage) forgets the pending samples and starts
+ * from the 100 m limit. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../game/g_game.h"
+#include "r_city.h"
+#include "r_local.h"
+#include "r_lspsm.h"
+#include "r_shader.h"
+
+#define KEEP 0.4f         /* a fighter in full shadow keeps 40 % of the key light */
+#define DEPTH_BIAS 0.0005f /* receivers, window depth units */
+
+struct r_fx_lspsm {
+    GLuint prog_map, prog_focus;
+    GLuint map_tex, flag_tex, map_fbo; /* 1024x1024 depth (compare mode) + R8 fighter flag */
+    GLuint focus_tex, focus_fbo;       /* 20x16 R32F */
+    GLuint pbo;                        /* the samples of the frame drawn last */
+    bool pending;                      /* pbo holds samples not used yet */
+    int pending_w, pending_h;
+    r_mat4 pending_inv_vp;
+    r_lspsm_focus focus;
+    r_lspsm s;            /* this frame's matrices */
+    bool drawn;           /* the map was drawn this frame */
+    /* the city */
+    int nb;
+    r_building b[R_CITY_MAX];
+    float lo[R_CITY_MAX][3], hi[R_CITY_MAX][3];
+    GLuint city_vao, city_vbo, city_ibo, proxy_vao, proxy_vbo, proxy_ibo;
+    GLsizei city_count;
+    GLint proxy_first[R_CITY_MAX];
+    GLsizei proxy_count[R_CITY_MAX];
+    /* tests and --passes */
+    bool no_cull, uniform;
+    bool light_override;
+    r_vec3 light;
+    r_fx_lspsm_stats stats;
+};
+
+static bool need_map(void *u)
+{
+    r_game *r = u;
+    return r->stage.lspsm && r->lspsm;
+}
+
+static bool need_buildings(void *u)
+{
+    r_game *r = u;
+    return r->lspsm && r->lspsm->nb > 0;
+}
+
+/* The key light: the direction the other shadows use (frame.light_dir),
+ * or a test's. */
+static r_vec3 to_light(const r_game *r)
+{
+    return r->lspsm->light_override ? r->lspsm->light : r->f.light_dir;
+}
+
+static void take_focus(struct r_fx_lspsm *ls, bool reset)
+{
+    if (reset) {
+        ls->pending = false;
+        ls->focus.range = 0; /* the limit until samples come */
+        return;
+    }
+    if (!ls->pending)
+        return;
+    ls->pending = false;
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, ls->pbo);
+    /* the previous frame's transfer: long finished on a GPU that is less
+     * than a frame behind; else this waits for it (deterministic videos) */
+    const float *d = gl.MapBufferRange(GL_PIXEL_PACK_BUFFER, 0, R_LSPSM_FOCUS_N * sizeof(float), GL_MAP_READ_BIT);
+    if (d) {
+        float depth[R_LSPSM_FOCUS_N];
+        memcpy(depth, d, sizeof depth);
+        gl.UnmapBuffer(GL_PIXEL_PACK_BUFFER);
+        r_lspsm_focus_update(&ls->focus, depth, ls->pending_w, ls->pending_h, ls->pending_inv_vp);
+    }
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+}
+
+static void run_map(void *u)
+{
+    r_game *r = u;
+    struct r_fx_lspsm *ls = r->lspsm;
+    frame *f = &r->f;
+    take_focus(ls, f->reset);
+    r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
+                      .far = ls->focus.range > 0 ? ls->focus.range : R_LSPSM_LIMIT, .uniform = ls->uniform};
+    r_lspsm_build(&d, &ls->s);
+
+    gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);
+    gl.Viewport(0, 0, R_LSPSM_MAP, R_LSPSM_MAP);
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LESS);
+    gl.DepthMask(GL_TRUE);
+    gl.ClearColor(0, 0, 0, 0);
+    gl.ClearDepth(1.0);
+    gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl.Disable(GL_CULL_FACE); /* closed boxes and capsules: both sides cast */
+    gl.Enable(GL_POLYGON_OFFSET_FILL);
+    gl.PolygonOffset(1.5f, 4.0f);
+    GLuint p = ls->prog_map;
+    gl.UseProgram(p);
+    gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->s.light_vp.m);
+    /* static scenery: each building's proxy, when it can cast into the view */
+    gl.Uniform1f(r_loc(p, "u_flag"), 0.0f);
+    gl.BindVertexArray(ls->proxy_vao);
+    int drawn = 0;
+    for (int i = 0; i < ls->nb; i++) {
+        r_vec3 lo = r_v3(ls->lo[i][0], ls->lo[i][1], ls->lo[i][2]), hi = r_v3(ls->hi[i][0], ls->hi[i][1], ls->hi[i][2]);
+        if (!ls->no_cull && !r_lspsm_caster_visible(&ls->s, lo, hi))
+            continue;
+        gl.DrawElements(GL_TRIANGLES, ls->proxy_count[i], GL_UNSIGNED_INT,
+                        (const void *)((size_t)ls->proxy_first[i] * sizeof(unsigned)));
+        drawn++;
+    }
+    /* movable casters: the fighters */
+    gl.Uniform1f(r_loc(p, "u_flag"), 1.0f);
+    r_draw_fighters(r, p);
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+    ls->drawn = true;
+    ls->stats.casters_drawn = drawn;
+    ls->stats.casters = ls->nb;
+    ls->stats.range = d.far;
+    ls->stats.warp = ls->s.warp;
+    ls->stats.gamma = ls->s.gamma;
+}
+
+static void run_buildings(void *u)
+{
+    r_game *r = u;
+    struct r_fx_lspsm *ls = r->lspsm;
+    frame *f = &r->f;
+    GLuint p = r->prog[P_STAGE];
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    gl.Viewport(0, 0, f->w, f->h);
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LESS);
+    gl.DepthMask(GL_TRUE);
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
+    gl.Disable(GL_BLEND);
+    r_camera_uniforms(r, p);
+    r_bind_ibl(r, p);
+    /* no silhouette: the fighters' blurred shadow does not reach the buildings */
+    gl.Uniform1i(r_loc(p, "u_shadows"), 0);
+    r_fx_fog_bind(r, p, 6);
+    r_fx_lspsm_bind(r, p, 4);
+    gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
+    gl.Uniform1i(r_loc(p, "u_material"), 2);
+    gl.BindVertexArray(ls->city_vao);
+    gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
+    gl.Uniform1i(r_loc(p, "u_material"), 0);
+    gl.Disable(GL_CULL_FACE);
+}
+
+static void run_focus(void *u)
+{
+    r_game *r = u;
+    struct r_fx_lspsm *ls = r->lspsm;
+    frame *f = &r->f;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, ls->focus_fbo);
+    gl.Viewport(0, 0, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_CULL_FACE);
+    gl.UseProgram(ls->prog_focus);
+    r_bind_tex(ls->prog_focus, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
+    r_fullscreen(r);
+    /* into the pixel-pack buffer: glReadPixels returns at once */
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, ls->pbo);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.ReadPixels(0, 0, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H, GL_RED, GL_FLOAT, NULL);
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    ls->pending = true;
+    ls->pending_w = f->w, ls->pending_h = f->h;
+    ls->pending_inv_vp = f->inv_vp;
+}
+
+static const r_pass map_passes[] = {
+    {"lspsm_map", RES_ENV, RES_LSPSM, need_map, run_map, 0},
+};
+static const r_pass surface_passes[] = {
+    {"buildings", RES_ENV, RES_HDR | RES_DEPTH, need_buildings, run_buildings, RES_LSPSM | RES_FOGMAP},
+};
+static const r_pass focus_passes[] = {
+    {"lspsm_focus", RES_DEPTH, 0, need_map, run_focus, 0},
+};
+
+/* ---- the receivers' side ---- */
+
+void r_fx_lspsm_bind(r_game *r, GLuint p, int unit)
+{
+    struct r_fx_lspsm *ls = r->lspsm;
+    bool on = ls && r->stage.lspsm && ls->drawn && r_ran(&r->f, r, "lspsm_map");
+    gl.UseProgram(p);
+    gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
+    /* the two samplers get their own units whether on or not: samplers of
+     * different types must never share a unit */
+    r_bind_tex(p, "u_lspsm_map", unit, GL_TEXTURE_2D, on ? ls->map_tex : 0);
+    r_bind_tex(p, "u_lspsm_flag", unit + 1, GL_TEXTURE_2D, on ? ls->flag_tex : 0);
+    if (!on)
+        return;
+    const frame *f = &r->f;
+    gl.UniformMatrix4fv(r_loc(p, "u_lspsm_shadow"), 1, GL_FALSE, ls->s.shadow.m);
+    gl.Uniform3f(r_loc(p, "u_lspsm_eye"), ls->s.eye.x, ls->s.eye.y, ls->s.eye.z);
+    gl.Uniform2f(r_loc(p, "u_lspsm_fade"), ls->s.fade[0], ls->s.fade[1]);
+    r_vec3 L = to_light(r);
+    gl.Uniform3f(r_loc(p, "u_lspsm_dir"), L.x, L.y, L.z);
+    gl.Uniform1f(r_loc(p, "u_lspsm_bias"), DEPTH_BIAS);
+    gl.Uniform1f(r_loc(p, "u_lspsm_keep"), KEEP);
+    /* the fighters' boxes: each bone's origin +-0.4 m holds its far end too */
+    float box[4][3];
+    for (int i = 0; i < 2; i++) {
+        for (int a = 0; a < 3; a++)
+            box[2 * i][a] = 1e9f, box[2 * i + 1][a] = -1e9f;
+        for (int k = 0; k < G_BONES; k++)
+            for (int a = 0; a < 3; a++) {
+                float c = f->bones[i][k][12 + a];
+                box[2 * i][a] = fminf(box[2 * i][a], c - 0.4f);
+                box[2 * i + 1][a] = fmaxf(box[2 * i + 1][a], c + 0.4f);
+            }
+    }
+    gl.Uniform3fv(r_loc(p, "u_lspsm_box"), 4, &box[0][0]);
+}
+
+/* ---- the module ---- */
+
+static void free_city(struct r_fx_lspsm *ls)
+{
+    r_free_mesh(&ls->city_vao, &ls->city_vbo, &ls->city_ibo);
+    r_free_mesh(&ls->proxy_vao, &ls->proxy_vbo, &ls->proxy_ibo);
+    ls->nb = 0;
+    ls->city_count = 0;
+}
+
+static void lspsm_destroy(r_game *r)
+{
+    struct r_fx_lspsm *ls = r->lspsm;
+    if (!ls)
+        return;
+    free_city(ls);
+    GLuint tex[3] = {ls->map_tex, ls->flag_tex, ls->focus_tex}, fbo[2] = {ls->map_fbo, ls->focus_fbo};
+    gl.DeleteTextures(3, tex);
+    gl.DeleteFramebuffers(2, fbo);
+    if (ls->pbo)
+        gl.DeleteBuffers(1, &ls->pbo);
+    gl.DeleteProgram(ls->prog_map);
+    gl.DeleteProgram(ls->prog_focus);
+    free(ls);
+    r->lspsm = NULL;
+}
+
+static bool lspsm_create(r_game *r, rs_err *err)
+{
+    struct r_fx_lspsm *ls = calloc(1, sizeof *ls);
+    if (!ls)
+        return rs_fail(err, 1, "lspsm: out of memory");
+    r->lspsm = ls;
+    if (!(ls->prog_map = r_program(&(r_program_desc){.vs = "scene.vert", .fs = "light_depth.frag",
+                                                     .defines = "#define LIGHT_VIEW 1\n#define LSPSM 1\n"},
+                                   err)) ||
+        !(ls->prog_focus = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "lspsm_focus.frag"}, err))) {
+        lspsm_destroy(r);
+        return false;
+    }
+    /* the map: depth with hardware comparison, bilinear = 2x2 PCF; outside
+     * it (the border) nothing casts */
+    const float one[4] = {1, 1, 1, 1}, zero[4] = {0, 0, 0, 0};
+    ls->map_tex = r_tex2d(GL_DEPTH_COMPONENT24, R_LSPSM_MAP, R_LSPSM_MAP, GL_DEPTH_COMPONENT, GL_FLOAT, NULL, GL_LINEAR,
+                          GL_CLAMP_TO_BORDER);
+    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, one);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    ls->flag_tex = r_tex2d(GL_R8, R_LSPSM_MAP, R_LSPSM_MAP, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_BORDER);
+    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, zero);
+    gl.GenFramebuffers(1, &ls->map_fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ls->flag_tex, 0);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, ls->map_tex, 0);
+    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    ls->focus_tex = r_tex2d(GL_R32F, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H, GL_RED, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+    ls->focus_fbo = r_fbo_for(ls->focus_tex, 0, 0);
+    GLenum st2 = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.GenBuffers(1, &ls->pbo);
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, ls->pbo);
+    gl.BufferData(GL_PIXEL_PACK_BUFFER, R_LSPSM_FOCUS_N * sizeof(float), NULL, GL_STREAM_READ);
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    if (st != GL_FRAMEBUFFER_COMPLETE || st2 != GL_FRAMEBUFFER_COMPLETE) {
+        lspsm_destroy(r);
+        return rs_fail(err, 1, "lspsm: shadow map target incomplete (%s)",
+                       rgl_enum_name(st != GL_FRAMEBUFFER_COMPLETE ? st : st2));
+    }
+    RGL_CHECK("lspsm create");
+    return true;
+}
+
+/* A new look: the buildings of its layout (their meshes), the focus afresh. */
+static bool lspsm_load(r_game *r, rs_err *err)
+{
+    struct r_fx_lspsm *ls = r->lspsm;
+    free_city(ls);
+    ls->pending = false;
+    ls->focus.range = 0;
+    ls->drawn = false;
+    const r_stage *st = &r->stage;
+    if (st->buildings <= 0)
+        return true;
+    int gs = r->stage_game >= 0 ? r->stage_game : st->game_index;
+    float ring_half = gs >= 0 && gs < G_STAGES ? fx_to_float(g_stages[gs].ring_half) : 4.0f;
+    ls->nb = r_city_layout(st->buildings, (unsigned)st->buildings_seed, r->key_dir, ring_half, ls->b);
+    r_mesh_data city = {0}, proxy = {0};
+    bool ok = true;
+    for (int i = 0; i < ls->nb && ok; i++) {
+        r_city_bounds(&ls->b[i], ls->lo[i], ls->hi[i]);
+        ls->proxy_first[i] = (GLint)proxy.ni;
+        ok = r_city_mesh(&city, &ls->b[i]) && r_city_proxy(&proxy, &ls->b[i]);
+        ls->proxy_count[i] = (GLsizei)(proxy.ni - (size_t)ls->proxy_first[i]);
+    }
+    if (ok) {
+        r_upload_mesh(&city, &ls->city_vao, &ls->city_vbo, &ls->city_ibo);
+        r_upload_mesh(&proxy, &ls->proxy_vao, &ls->proxy_vbo, &ls->proxy_ibo);
+        ls->city_count = (GLsizei)city.ni;
+        ls->stats.city_triangles = (int)(city.ni / 3);
+        ls->stats.proxy_triangles = (int)(proxy.ni / 3);
+    }
+    r_mesh_free(&city);
+    r_mesh_free(&proxy);
+    if (!ok) {
+        free_city(ls);
+        return rs_fail(err, 1, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
+    }
+    return true;
+}
+
+const r_fx_module r_fx_lspsm_module = {
+    "lspsm", lspsm_create, lspsm_destroy, lspsm_load,
+    {map_passes, surface_passes, focus_passes},
+    {(int)(sizeof map_passes / sizeof map_passes[0]), (int)(sizeof surface_passes / sizeof surface_passes[0]),
+     (int)(sizeof focus_passes / sizeof focus_passes[0])},
+};
+
+/* ---- tests, bench and --passes ---- */
+
+bool r_fx_lspsm_stats_get(r_game *r, r_fx_lspsm_stats *out)
+{
+    if (!r->lspsm)
+        return false;
+    *out = r->lspsm->stats;
+    out->focus_farthest = r->lspsm->focus.farthest;
+    out->focus_used = r->lspsm->focus.used;
+    return true;
+}
+
+void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform)
+{
+    if (!r->lspsm)
+        return;
+    r->lspsm->light_override = light != NULL;
+    if (light)
+        r->lspsm->light = r_v3(light[0], light[1], light[2]);
+    r->lspsm->no_cull = no_cull;
+    r->lspsm->uniform = uniform;
+}
+
+bool r_fx_lspsm_read(r_game *r, const char *what, float *out)
+{
+    struct r_fx_lspsm *ls = r->lspsm;
+    if (!ls)
+        return false;
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    if (!strcmp(what, "map") || !strcmp(what, "flag")) {
+        bool map = what[0] == 'm';
+        gl.BindTexture(GL_TEXTURE_2D, map ? ls->map_tex : ls->flag_tex);
+        gl.GetTexImage(GL_TEXTURE_2D, 0, map ? GL_DEPTH_COMPONENT : GL_RED, GL_FLOAT, out);
+        gl.BindTexture(GL_TEXTURE_2D, 0);
+        return true;
+    }
+    if (!strcmp(what, "focus")) {
+        gl.BindTexture(GL_TEXTURE_2D, ls->focus_tex);
+        gl.GetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_FLOAT, out);
+        gl.BindTexture(GL_TEXTURE_2D, 0);
+        return true;
+    }
+    if (!strcmp(what, "shadow")) { /* the frame's world -> map matrix */
+        memcpy(out, ls->s.shadow.m, sizeof ls->s.shadow.m);
+        return true;
+    }
+    return false;
+}

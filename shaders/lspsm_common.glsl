@@ -1,0 +1,68 @@
+#ifndef LSPSM_COMMON_GLSL
+#define LSPSM_COMMON_GLSL
+// Light space perspective shadow maps (techniques C): one 1024x1024 depth
+// map of the key light, warped so texels crowd near the camera, drawn each
+// frame by the lspsm_map pass (r_fx_lspsm.c) from the buildings' low-poly
+// proxies and the fighters.  A second R8 map beside it marks the texels
+// whose nearest caster is a fighter, so the stage, which gets the
+// fighters' shadows from the blurred silhouette (A5) already, can leave
+// them out.  Only when u_lspsm_on == 1: r_fx_lspsm_bind sets it with
+// everything below, and it is 0 whenever the map was not drawn this frame.
+uniform int u_lspsm_on;
+uniform sampler2DShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware
+uniform sampler2D u_lspsm_flag;      // 1 where the nearest caster is a fighter
+uniform mat4 u_lspsm_shadow;         // world -> (u, v, depth, w)
+uniform vec3 u_lspsm_eye;
+uniform vec2 u_lspsm_fade;           // strength 1 up to .x metres from the eye, 0 from .y on
+uniform vec3 u_lspsm_dir;            // towards the light
+uniform float u_lspsm_bias;          // depth bias, window units
+uniform vec3 u_lspsm_box[4];         // the fighters' boxes: lo 0, hi 0, lo 1, hi 1
+uniform int u_fighter;               // which fighter is being drawn (r_draw_fighters)
+uniform float u_lspsm_keep;          // a fighter in full shadow keeps this much of the key light
+
+// Where the ray from p towards d leaves the box lo..hi (r_lspsm_box_exit's
+// twin, the same arithmetic).
+vec3 lspsm_box_exit(vec3 p, vec3 d, vec3 lo, vec3 hi)
+{
+    vec3 t = (mix(lo, hi, step(0.0, d)) - p) / d;
+    t = mix(t, vec3(1e30), equal(d, vec3(0.0)));
+    float te = max(min(min(t.x, t.y), t.z), 0.0);
+    return te < 1e30 ? p + d * te : p;
+}
+
+// Visibility of the key light at p (1 lit, 0 in shadow), already faded out
+// towards the end of the shadow range; p is pushed along the normal n by
+// `offset` metres against acne.  no_fighters: texels whose nearest caster
+// is a fighter count as lit.
+float lspsm_visibility(vec3 p, vec3 n, float offset, bool no_fighters)
+{
+    if (u_lspsm_on != 1)
+        return 1.0;
+    float strength = 1.0 - smoothstep(u_lspsm_fade.x, u_lspsm_fade.y, distance(p, u_lspsm_eye));
+    if (!(strength > 0.0))
+        return 1.0;
+    vec4 s = u_lspsm_shadow * vec4(p + n * offset, 1.0);
+    if (!(s.w > 0.0))
+        return 1.0;
+    vec3 c = s.xyz / s.w;
+    if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0))))
+        return 1.0; // outside the map: nothing casts there
+    float lit = texture(u_lspsm_map, vec3(c.xy, c.z - u_lspsm_bias));
+    // a flagged texel's caster is a fighter, so whatever it shadows counts
+    // as lit: the filtered sum of the flagged texels' weights goes back in
+    // (exact where those texels shadow the receiver, as they do but for a
+    // receiver nearer the light than the fighter; the clamp covers that)
+    if (no_fighters)
+        lit = min(lit + texture(u_lspsm_flag, c.xy).r, 1.0);
+    return mix(1.0, lit, strength);
+}
+
+// A fighter at p: no self-shadow, others' shadows received.  The map is
+// looked up where the ray towards the light leaves the fighter's own box.
+float lspsm_fighter_visibility(vec3 p)
+{
+    int i = clamp(u_fighter, 0, 1);
+    vec3 q = lspsm_box_exit(p, u_lspsm_dir, u_lspsm_box[2 * i], u_lspsm_box[2 * i + 1]);
+    return lspsm_visibility(q, vec3(0.0), 0.0, false);
+}
+#endif

@@ -1,0 +1,489 @@
+/* LSPSM shadows in a large world (runtime/render/r_fx_lspsm.c, techniques
+ * C) on GL: the buildings' shadows show; culling drops casters without
+ * changing the map; the auto-focus reads exactly the 20x16 pattern of the
+ * depth buffer and uses it the next frame; the fighters do not shadow
+ * themselves but receive each other's; light exactly parallel and
+ * anti-parallel to the view stays finite and does not pop; fp16 extremes;
+ * determinism.  The mathematics alone is tests/test_lspsm.c, the layout
+ * tests/test_city.c.  T_DUMP=DIR writes the frames as PPM. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_fx.h"
+#include "../runtime/render/r_game.h"
+#include "../runtime/render/r_lspsm.h"
+#include "../runtime/render/r_stage.h"
+#include "t.h"
+#include "t_render.h"
+
+enum { W = 320, H = 180 };
+#ifndef PLAZA_TICK
+#define PLAZA_TICK 600
+#endif
+#define FIGHTERS_APART 60 /* a tick of the dojo demo: both stand, 2.4 m apart */
+
+static r_game *game_new(bool mask)
+{
+    rs_err e = {0};
+    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
+    T_ASSERTF(r, "%s", e.msg);
+    return r;
+}
+
+static r_stage plaza(void)
+{
+    r_stage st;
+    rs_err e = {0};
+    T_ASSERTF(r_stage_load(&st, RS_SOURCE_DIR "/stages/plaza.stage", &e), "%s", e.msg);
+    T_ASSERT(st.lspsm && st.buildings > 0);
+    return st;
+}
+
+static void set_stage(r_game *r, const r_stage *st)
+{
+    rs_err e = {0};
+    T_ASSERTF(r_game_set_stage(r, st, &e), "%s", e.msg);
+}
+
+static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur)
+{
+    rgl_error_reset();
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    T_EQ(rgl_error_count(), 0);
+    T_EQ(gl.GetError(), GL_NO_ERROR);
+    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
+}
+
+static bool pass_ran(r_game *r, const char *name)
+{
+    r_graph *g = r_game_graph(r);
+    int i = r_graph_find(g, name);
+    T_ASSERTF(i >= 0, "no pass '%s'", name);
+    return (g->last_ran >> i) & 1;
+}
+
+static float *hdr(r_game *r)
+{
+    float *px = malloc((size_t)W * H * 4 * sizeof *px);
+    T_ASSERT(px);
+    int w = 0, h = 0;
+    T_ASSERT(r_game_read_buffer(r, "hdr", px, &w, &h));
+    T_EQ(w, W);
+    T_EQ(h, H);
+    return px;
+}
+
+static void dump(const char *name, const float *px)
+{
+    const char *dir = getenv("T_DUMP");
+    if (!dir)
+        return;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/lspsm_%s.ppm", dir, name);
+    FILE *fp = fopen(path, "wb");
+    if (!fp)
+        return;
+    fprintf(fp, "P6\n%d %d\n255\n", W, H);
+    for (int y = H - 1; y >= 0; y--)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++) {
+                float v = px[4 * ((size_t)y * W + x) + c];
+                v = v / (1 + v); /* enough to look at */
+                fputc((int)(255 * powf(v > 0 ? v : 0, 1 / 2.2f) + 0.5f), fp);
+            }
+    fclose(fp);
+}
+
+static float luma(const float *p)
+{
+    return 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
+}
+
+/* Draws `n` consecutive ticks ending at `tick` (the focus and the
+ * simulations get their history). */
+static void draw_run(r_game *r, t_fb *f, const char *demo, uint64_t tick, int n)
+{
+    for (int k = n - 1; k >= 0; k--) {
+        g_state prev, cur;
+        t_state_at(demo, tick - (uint64_t)k, &prev, &cur);
+        draw(r, f, &prev, &cur);
+    }
+}
+
+/* The buildings' shadows are visible: the plaza frame with lspsm = no
+ * (same buildings, no map) is brighter, and the map holds scenery. */
+static void t_buildings_cast_shadows(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = game_new(false);
+    r_stage st = plaza();
+    set_stage(r, &st);
+    draw_run(r, &f, "plaza", PLAZA_TICK, 2);
+    T_ASSERT(pass_ran(r, "lspsm_map") && pass_ran(r, "buildings") && pass_ran(r, "lspsm_focus"));
+    float *on = hdr(r);
+    float *map = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *map), *flag = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *flag);
+    T_ASSERT(map && flag && r_fx_lspsm_read(r, "map", map) && r_fx_lspsm_read(r, "flag", flag));
+    size_t scenery = 0, fighters = 0;
+    for (size_t i = 0; i < (size_t)R_LSPSM_MAP * R_LSPSM_MAP; i++) {
+        scenery += map[i] < 1 && flag[i] < 0.5f;
+        fighters += flag[i] > 0.5f;
+    }
+    st.lspsm = false;
+    set_stage(r, &st);
+    draw_run(r, &f, "plaza", PLAZA_TICK, 2);
+    T_ASSERT(!pass_ran(r, "lspsm_map") && pass_ran(r, "buildings") && !pass_ran(r, "lspsm_focus"));
+    float *off = hdr(r);
+    dump("plaza_on", on), dump("plaza_off", off);
+    double sum_on = 0, sum_off = 0;
+    int darker = 0, brighter = 0, bad = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        float a = luma(on + 4 * i), b = luma(off + 4 * i);
+        sum_on += a, sum_off += b;
+        darker += a < 0.7f * b;
+        brighter += a > b * 1.001f + 1e-4f;
+        bad += !isfinite(a);
+    }
+    fprintf(stderr, "    plaza@600: mean luminance %.3f with the map, %.3f without; %d of %d pixels darker by 30%%+; "
+                    "map: %zu scenery texels, %zu fighter texels\n",
+            sum_on / (W * H), sum_off / (W * H), darker, W * H, scenery, fighters);
+    T_EQ(bad, 0);
+    T_ASSERTF(darker > W * H / 20, "only %d pixels in a building's shadow", darker);
+    T_ASSERTF(brighter < W * H / 200, "%d pixels got brighter with shadows", brighter);
+    T_ASSERT(scenery > 10000); /* the fighters' texels: t_fighters_no_self_shadow_but_each_others */
+    free(on), free(off), free(map), free(flag);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* Culling draws fewer casters and the same map. */
+static void t_culling_keeps_the_map(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = game_new(false);
+    r_stage st = plaza();
+    set_stage(r, &st);
+    size_t n = (size_t)R_LSPSM_MAP * R_LSPSM_MAP;
+    float *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    T_ASSERT(a && b);
+    const uint64_t ticks[] = {600, 1500, 2400};
+    for (size_t t = 0; t < 3; t++) {
+        r_fx_lspsm_stats s1, s2;
+        r_fx_lspsm_test_set(r, NULL, false, false);
+        draw_run(r, &f, "plaza", ticks[t], 1);
+        T_ASSERT(r_fx_lspsm_stats_get(r, &s1) && r_fx_lspsm_read(r, "map", a));
+        r_fx_lspsm_test_set(r, NULL, true, false);
+        draw_run(r, &f, "plaza", ticks[t], 1);
+        T_ASSERT(r_fx_lspsm_stats_get(r, &s2) && r_fx_lspsm_read(r, "map", b));
+        fprintf(stderr, "    tick %llu: %d of %d buildings cast into the view\n", (unsigned long long)ticks[t],
+                s1.casters_drawn, s1.casters);
+        T_EQ(s2.casters_drawn, s2.casters);
+        T_ASSERTF(s1.casters_drawn < s1.casters && s1.casters_drawn > 0, "culling kept %d of %d", s1.casters_drawn,
+                  s1.casters);
+        size_t diff = 0;
+        for (size_t i = 0; i < n; i++)
+            diff += a[i] != b[i];
+        T_ASSERTF(diff == 0, "tick %llu: culling changed %zu texels of the map", (unsigned long long)ticks[t], diff);
+    }
+    free(a), free(b);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* The focus pass gathers exactly r_lspsm_focus_point's pixels of the depth
+ * buffer, and the next frame's range is r_lspsm_focus_update of them; a
+ * new stage starts again from the limit. */
+static void t_focus_reads_the_pattern_one_frame_late(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = game_new(false);
+    r_stage st = plaza();
+    set_stage(r, &st);
+    float *depth = malloc((size_t)W * H * sizeof *depth), samples[R_LSPSM_FOCUS_N], want[R_LSPSM_FOCUS_N];
+    T_ASSERT(depth);
+    r_fx_lspsm_stats s;
+    g_state prev, cur;
+    t_state_at("plaza", 900, &prev, &cur);
+    draw(r, &f, &prev, &cur);
+    T_ASSERT(r_fx_lspsm_stats_get(r, &s));
+    T_ASSERTF(s.range == R_LSPSM_LIMIT, "first frame: range %g, want the limit", s.range);
+    T_ASSERT(r_fx_lspsm_read(r, "focus", samples));
+    int w = 0, h = 0;
+    T_ASSERT(r_game_read_buffer(r, "depth", depth, &w, &h));
+    T_EQ(w, W);
+    r_lspsm_focus_gather(depth, W, H, want);
+    int sky = 0, near = 0;
+    for (int k = 0; k < R_LSPSM_FOCUS_N; k++) {
+        T_ASSERTF(fabsf(samples[k] - want[k]) <= 2e-7f, "sample %d: %.9g on the GPU, %.9g in the buffer", k, samples[k], want[k]);
+        sky += want[k] >= 1, near += want[k] < 1;
+    }
+    T_ASSERT(sky > 0 && near > 0);
+    /* a camera looking down at the ring from above: every sample is near,
+     * so the range follows the depth; the focus is a frame late */
+    r_mat4 vp = r_game_camera(&cur, W, H, NULL);
+    r_lspsm_focus ref = {0};
+    float expect = r_lspsm_focus_update(&ref, want, W, H, r_invert(vp));
+    g_state next = cur;
+    g_input in[2] = {0, 0};
+    g_step(&next, in, NULL);
+    draw(r, &f, &cur, &next);
+    T_ASSERT(r_fx_lspsm_stats_get(r, &s));
+    fprintf(stderr, "    focus: %d samples, farthest %.1f m, range %.1f m (sky in view: %d samples)\n", s.focus_used,
+            s.focus_farthest, s.range, sky);
+    T_EQ(s.focus_used, R_LSPSM_FOCUS_N);
+    T_ASSERTF(fabsf(s.range - expect) < 1e-4f, "range %g, want %g", s.range, expect);
+    /* a new look: back to the limit, the pending samples forgotten */
+    set_stage(r, &st);
+    draw(r, &f, &cur, &next);
+    T_ASSERT(r_fx_lspsm_stats_get(r, &s));
+    T_ASSERT(s.range == R_LSPSM_LIMIT);
+    free(depth);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* Fighters' pixels: split at the midpoint between them on screen. */
+static void fighter_light(const float *px, const g_state *cur, double mean[2], int count[2])
+{
+    r_mat4 vp = r_game_camera(cur, W, H, NULL);
+    float sx[2];
+    for (int i = 0; i < 2; i++) {
+        float y;
+        T_ASSERT(r_project(vp, r_v3(fx_to_float(cur->f[i].x), 1, 0), W, H, &sx[i], &y));
+    }
+    float mid = (sx[0] + sx[1]) / 2;
+    mean[0] = mean[1] = 0, count[0] = count[1] = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const float *q = px + 4 * ((size_t)y * W + x);
+            if (q[3] < 0.99f)
+                continue;
+            int i = ((float)x < mid) == (sx[0] < mid) ? 0 : 1;
+            mean[i] += luma(q), count[i]++;
+        }
+    for (int i = 0; i < 2; i++)
+        mean[i] = count[i] ? mean[i] / count[i] : 0;
+}
+
+/* No self-shadow: with no buildings and the light straight above (the
+ * fighters apart, so neither is over the other), the fighters look exactly
+ * as without the map.  Others' shadows: with the light low along the fight
+ * line, the fighter further from it is darker, the nearer one not; and in
+ * full shadow a fighter keeps its directional shading (never the flat
+ * key-off look: the keep share). */
+static void t_fighters_no_self_shadow_but_each_others(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = game_new(true);
+    r_stage st = plaza();
+    st.buildings = 0;
+    g_state prev, cur;
+    t_state_at("dojo", FIGHTERS_APART, &prev, &cur);
+    float gap = fabsf(fx_to_float(cur.f[0].x) - fx_to_float(cur.f[1].x));
+    T_ASSERTF(gap > 1.2f, "the fighters stand %.2f m apart: pick another tick", gap);
+    /* above */
+    const float up[3] = {0, 1, 0};
+    set_stage(r, &st);
+    r_fx_lspsm_test_set(r, up, false, false);
+    draw(r, &f, &prev, &cur);
+    float *on = hdr(r);
+    st.lspsm = false;
+    set_stage(r, &st);
+    draw(r, &f, &prev, &cur);
+    float *off = hdr(r);
+    dump("above_on", on), dump("above_off", off);
+    int diff = 0, fighter_px = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        fighter_px += off[4 * i + 3] > 0.99f;
+        for (int c = 0; c < 4; c++) {
+            bool d = fabsf(on[4 * i + c] - off[4 * i + c]) > 1e-4f * (1 + fabsf(off[4 * i + c]));
+            if (d && diff < 12 && getenv("T_VERBOSE"))
+                fprintf(stderr, "      px %zu,%zu c%d: %g vs %g (alpha %g)\n", i % W, i / W, c, on[4 * i + c], off[4 * i + c], off[4 * i + 3]);
+            diff += d;
+        }
+    }
+    fprintf(stderr, "    light above: %d of %d fighter pixels, %d values differ with the map\n", fighter_px, W * H, diff);
+    T_ASSERT(fighter_px > 500);
+    T_EQ(diff, 0);
+    free(on);
+
+    /* low along the fight line, from the side of fighter `near` */
+    int near = fx_to_float(cur.f[0].x) > fx_to_float(cur.f[1].x) ? 0 : 1;
+    const float side[3] = {1, 0.12f, 0};
+    st.lspsm = true;
+    set_stage(r, &st);
+    r_fx_lspsm_test_set(r, side, false, false);
+    draw(r, &f, &prev, &cur);
+    float *lit = hdr(r);
+    double m_on[2], m_off[2];
+    int n_on[2], n_off[2];
+    fighter_light(lit, &cur, m_on, n_on);
+    fighter_light(off, &cur, m_off, n_off);
+    dump("fighters_side", lit), dump("fighters_off", off);
+    fprintf(stderr, "    light low from +x: nearer fighter %.3f -> %.3f, further %.3f -> %.3f (mean luminance)\n",
+            m_off[near], m_on[near], m_off[1 - near], m_on[1 - near]);
+    T_ASSERTF(m_on[1 - near] < 0.9 * m_off[1 - near], "the further fighter is not in the nearer one's shadow");
+    T_ASSERTF(fabs(m_on[near] - m_off[near]) < 0.02 * m_off[near], "the nearer fighter changed: self-shadow?");
+    free(lit), free(off);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* Light exactly parallel and anti-parallel to the view, and a sweep through
+ * the fallback band: finite pictures, a uniform map at 0 deg, and no step
+ * in the picture larger than the steps round it (no pop). */
+static void t_parallel_and_antiparallel_light(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = game_new(false);
+    r_stage st = plaza();
+    set_stage(r, &st);
+    g_state prev, cur;
+    t_state_at("plaza", 600, &prev, &cur);
+    r_vec3 eye;
+    r_mat4 view, proj;
+    r_game_camera_parts(&cur, W, H, &view, &proj, &eye);
+    r_lspsm_camera cam = r_lspsm_camera_from(view, proj);
+    r_vec3 v = r_norm(cam.dir), side = r_norm(r_cross(v, r_v3(0, 1, 0)));
+    /* exactly parallel (light behind the camera) and anti-parallel */
+    for (int s = 0; s < 2; s++) {
+        float L[3] = {s ? v.x : -v.x, s ? v.y : -v.y, s ? v.z : -v.z};
+        r_fx_lspsm_test_set(r, L, false, false);
+        draw(r, &f, &prev, &cur);
+        r_fx_lspsm_stats k;
+        T_ASSERT(r_fx_lspsm_stats_get(r, &k));
+        float *px = hdr(r);
+        int bad = 0;
+        for (size_t i = 0; i < (size_t)W * H * 4; i++)
+            bad += !isfinite(px[i]);
+        float shadow[16];
+        T_ASSERT(r_fx_lspsm_read(r, "shadow", shadow));
+        for (int i = 0; i < 16; i++)
+            bad += !isfinite(shadow[i]);
+        fprintf(stderr, "    %s: angle %.4f rad, warp %g\n", s ? "anti-parallel" : "parallel", k.gamma, k.warp);
+        T_EQ(bad, 0);
+        T_ASSERT(k.warp == 0); /* uniform shadow mapping at the end of the band */
+        free(px);
+    }
+    /* the sweep: 0 to 60 deg off the view direction (behind the camera),
+     * half-degree steps.  The warp fades in continuously (a switch from
+     * uniform to warped would be a pop): it is 0 inside the band's end and
+     * never jumps by more than a tenth of its full strength in a step; the
+     * pictures stay finite all the way */
+    enum { STEPS = 121 };
+    float warp[STEPS];
+    int bad = 0;
+    for (int k = 0; k < STEPS; k++) {
+        double a = k * 0.5 * 3.14159265358979 / 180;
+        float L[3] = {(float)(-v.x * cos(a) + side.x * sin(a)), (float)(-v.y * cos(a) + side.y * sin(a)),
+                      (float)(-v.z * cos(a) + side.z * sin(a))};
+        r_fx_lspsm_test_set(r, L, false, false);
+        draw(r, &f, &prev, &cur);
+        r_fx_lspsm_stats st2;
+        T_ASSERT(r_fx_lspsm_stats_get(r, &st2));
+        warp[k] = st2.warp;
+        if (k % 10 == 0) {
+            float *px = hdr(r);
+            for (size_t i = 0; i < (size_t)W * H * 4; i++)
+                bad += !isfinite(px[i]);
+            free(px);
+        }
+    }
+    float most = 0, jump = 0;
+    int at = 0, first = -1;
+    for (int k = 0; k < STEPS; k++) {
+        T_ASSERTF(isfinite(warp[k]) && warp[k] >= 0, "%.1f deg: warp %g", k * 0.5, warp[k]);
+        most = fmaxf(most, warp[k]);
+        if (first < 0 && warp[k] > 0)
+            first = k;
+        if (k && fabsf(warp[k] - warp[k - 1]) > jump)
+            jump = fabsf(warp[k] - warp[k - 1]), at = k;
+    }
+    fprintf(stderr, "    sweep: warp 0 up to %.1f deg, %.3f /m at 60 deg; largest change in half a degree %.4f (at %.1f deg)\n",
+            (first - 1) * 0.5, warp[STEPS - 1], jump, at * 0.5);
+    T_EQ(bad, 0);
+    for (int k = 0; k * 0.5 * 3.14159265358979 / 180 <= R_LSPSM_BAND_END + 1e-6; k++)
+        T_ASSERTF(warp[k] == 0, "%.1f deg: warped inside the band's end", k * 0.5);
+    T_ASSERTF(most > 0, "the warp never came in");
+    T_ASSERTF(jump <= 0.1f * most, "a pop: the warp jumps by %.4f at %.1f deg (full strength %.4f)", jump, at * 0.5, most);
+    r_fx_lspsm_test_set(r, NULL, false, false);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* fp16 extremes through the map and the receivers. */
+static void t_fp16_extremes(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = game_new(false);
+    r_stage st = plaza();
+    st.sun_intensity = R_HALF_MAX;
+    st.key.intensity = R_HALF_MAX;
+    st.counter.intensity = R_HALF_MAX;
+    for (int c = 0; c < 3; c++)
+        st.sky_zenith[c] = st.sky_horizon[c] = st.ground[c] = R_HALF_MAX;
+    st.exposure = 1000;
+    st.buildings = R_STAGE_MAX_BUILDINGS;
+    set_stage(r, &st);
+    draw_run(r, &f, "plaza", 1500, 2);
+    T_ASSERT(pass_ran(r, "lspsm_map") && pass_ran(r, "buildings"));
+    float *px = hdr(r);
+    int bad = 0;
+    for (size_t i = 0; i < (size_t)W * H * 4; i++)
+        bad += !isfinite(px[i]) || px[i] < 0;
+    T_EQ(bad, 0);
+    free(px);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* The same ticks drawn twice by two renderers: the same picture (the focus
+ * readback makes each frame depend on the one before). */
+static void t_deterministic(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    float *px[2];
+    for (int k = 0; k < 2; k++) {
+        r_game *r = game_new(false);
+        r_stage st = plaza();
+        set_stage(r, &st);
+        draw_run(r, &f, "plaza", 1200, 5);
+        px[k] = hdr(r);
+        r_game_destroy(r);
+    }
+    T_ASSERT(!memcmp(px[0], px[1], (size_t)W * H * 4 * sizeof(float)));
+    free(px[0]), free(px[1]);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+T_MAIN({"buildings_cast_shadows", t_buildings_cast_shadows}, {"culling_keeps_the_map", t_culling_keeps_the_map},
+       {"focus_reads_the_pattern_one_frame_late", t_focus_reads_the_pattern_one_frame_late},
+       {"fighters_no_self_shadow_but_each_others", t_fighters_no_self_shadow_but_each_others},
+       {"parallel_and_antiparallel_light", t_parallel_and_antiparallel_light}, {"fp16_extremes", t_fp16_extremes},
+       {"deterministic", t_deterministic})
