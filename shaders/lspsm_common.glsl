@@ -59,10 +59,12 @@ float lspsm_visibility(vec3 p, vec3 n, float offset, bool no_fighters)
 
 // A fighter at p: no self-shadow, others' shadows received.  The map is
 // looked up where the ray towards the light leaves the fighter's own box.
-float lspsm_fighter_visibility(vec3 p)
+// no_fighters: the screen-space mask (A5) already holds the other
+// fighter's shadow, so only the scenery's counts here.
+float lspsm_fighter_visibility(vec3 p, bool no_fighters)
 {
     int i = clamp(u_fighter, 0, 1);
     vec3 q = lspsm_box_exit(p, u_lspsm_dir, u_lspsm_box[2 * i], u_lspsm_box[2 * i + 1]);
-    return lspsm_visibility(q, vec3(0.0), 0.0, false);
+    return lspsm_visibility(q, vec3(0.0), 0.0, no_fighters);
 }
 #endif

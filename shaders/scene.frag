@@ -60,7 +60,7 @@ void main()
     float exponent = 16.0 + 112.0 * sm.a;
     float key = u_shadows == 1 ? texelFetch(u_mask, ivec2(gl_FragCoord.xy), 0).r : 1.0;
     if (u_lspsm_on == 1)
-        key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world));
+        key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world, u_shadows == 1));
     vec3 albedo = v_color.rgb;
     float alpha = 1.0;
 #endif
@@ -94,8 +94,8 @@ void main()
     float key = 1.0;
     if (u_shadows == 1 && v_proj.z > 0.5)
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
-    if (u_lspsm_on == 1) // the fighters' shadows come from the silhouette
-        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), true);
+    if (u_lspsm_on == 1) // with the A5 shadows on, the fighters' come from the silhouette
+        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), u_shadows == 1);
     float alpha = 0.0;
 #endif
     vec3 r = reflect(-v, n);

@@ -336,6 +336,11 @@ static void t_value_errors(void)
         {"afterimage = blur", "afterimage: expected view, world or off, got 'blur'"},
         {"afterimage = View", "afterimage: expected view, world or off, got 'View'"},
         {"afterimage_stretch = 9", "afterimage_stretch: expected a number in 1..8, got '9'"},
+        {"buildings = 49", "buildings: expected a whole number in 0..48, got '49'"},
+        {"buildings = 2.5", "buildings: expected a whole number in 0..48, got '2.5'"},
+        {"buildings = +7", "buildings: expected a whole number in 0..48, got '+7'"},
+        {"buildings = -1", "buildings: expected a whole number in 0..48, got '-1'"},
+        {"buildings_seed = 99999999999999999999", "buildings_seed: expected a whole number in 0..16777216, got '99999999999999999999'"},
         {"afterimage_speed = -1", "afterimage_speed: expected a number in 0..1000, got '-1'"},
         {"water = perhaps", "water: expected yes or no"},
     };

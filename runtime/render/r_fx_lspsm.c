@@ -23,11 +23,13 @@
  *
  * The receivers (shaders/lspsm_common.glsl, r_fx_lspsm_bind): the ring,
  * the ground and the buildings look the map up at their own position
- * (pushed along the normal), ignoring the fighter-flagged texels since the
- * blurred silhouette (A5) already casts the fighters onto the stage; the
- * fighters look it up where the ray towards the light leaves their own box
- * (no self-shadow, others' shadows received) and keep u_lspsm_keep of the
- * key light in full shadow, so they keep their directional shading.
+ * (pushed along the normal); the fighters look it up where the ray towards
+ * the light leaves their own box (no self-shadow, others' shadows received)
+ * and keep u_lspsm_keep of the key light in full shadow, so they keep their
+ * directional shading.  When the stage's A5 shadows run (the blurred
+ * silhouette on the stage, the screen-space mask on the fighters), those
+ * already cast the fighters, and every receiver ignores the
+ * fighter-flagged texels; without them this map casts the fighters too.
  *
  * The focus readback waits, in the next frame, for the previous frame's
  * 1280-byte transfer; every frame is then a function of the frames drawn
@@ -136,6 +138,9 @@ static void run_map(void *u)
     gl.Disable(GL_CULL_FACE); /* closed boxes and capsules: both sides cast */
     gl.Enable(GL_POLYGON_OFFSET_FILL);
     gl.PolygonOffset(1.5f, 4.0f);
+    /* a tall building beyond the frustum's near plane (100 m towards the
+     * light) still casts: its depth clamps to the plane instead of clipping */
+    gl.Enable(GL_DEPTH_CLAMP);
     GLuint p = ls->prog_map;
     gl.UseProgram(p);
     gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->s.light_vp.m);
@@ -155,6 +160,7 @@ static void run_map(void *u)
     gl.Uniform1f(r_loc(p, "u_flag"), 1.0f);
     r_draw_fighters(r, p);
     gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_DEPTH_CLAMP);
     ls->drawn = true;
     ls->stats.casters_drawn = drawn;
     ls->stats.casters = ls->nb;
@@ -342,6 +348,7 @@ static bool lspsm_load(r_game *r, rs_err *err)
     ls->pending = false;
     ls->focus.range = 0;
     ls->drawn = false;
+    memset(&ls->stats, 0, sizeof ls->stats);
     const r_stage *st = &r->stage;
     if (st->buildings <= 0)
         return true;

@@ -1120,7 +1120,7 @@ static bool build_graph(r_game *r, rs_err *err)
         {"shadow_mask", RES_DEPTH | RES_SHADOW, RES_MASK, need_shadows, run_shadow_mask, 0},
         {"mask_filter", RES_MASK, RES_MASK, need_shadows, run_mask_filter, 0},
         {NULL, R_FX_PRE, 0, NULL, NULL, 0},
-        {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene, RES_MASK | RES_SIL | RES_FOGMAP},
+        {"scene", RES_ENV, RES_HDR | RES_DEPTH, need_always, run_scene, RES_MASK | RES_SIL | RES_FOGMAP | RES_LSPSM},
         {NULL, R_FX_SURFACE, 0, NULL, NULL, 0},
         {"sky", RES_ENV | RES_DEPTH, RES_HDR, need_always, run_sky, RES_FOGMAP},
         {NULL, R_FX_TRANSLUCENT, 0, NULL, NULL, 0},

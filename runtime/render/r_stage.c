@@ -290,11 +290,12 @@ static bool set(r_stage *st, const row *r, const char *v, const ctx *c)
         return number(c, r->key, NULL, v, n, r->lo, r->hi, field);
     }
     case K_INT: {
-        char *end;
-        long x = strtol(v, &end, 10);
-        if (!*v || *end || x < (long)r->lo || x > (long)r->hi)
-            return bad(c, R_STAGE_ERR_VALUE, "%s: expected a whole number in %g..%g, got '%s'", r->key, r->lo, r->hi,
-                       Q(v));
+        /* digits only, no sign: "+7", "0x7" and "1e3" are refused */
+        size_t nd = strspn(v, "0123456789");
+        long x = nd && nd <= 9 && !v[nd] ? strtol(v, NULL, 10) : -1;
+        if (x < 0 || x < (long)r->lo || x > (long)r->hi)
+            return bad(c, R_STAGE_ERR_VALUE, "%s: expected a whole number in %ld..%ld, got '%s'", r->key, (long)r->lo,
+                       (long)r->hi, Q(v));
         *(int *)field = (int)x;
         return true;
     }
