@@ -188,7 +188,7 @@ bench: $(BUILD)/ringside
 
 # The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
 # same commands must reproduce them byte for byte (tests/test_replay.sh).
-DEMO_REPLAYS := dojo:1 harbor:7 temple:23 shallows:31 snowfield:37 mistvale:41 plaza:43
+DEMO_REPLAYS := dojo:1 harbor:7 temple:23 shallows:31 snowfield:37 mistvale:41 plaza:43 quarry:47
 demo-replays: $(BUILD)/ringside
 	@for d in $(DEMO_REPLAYS); do \
 	    stage=$${d%%:*} seed=$${d##*:}; \

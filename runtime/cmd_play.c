@@ -32,7 +32,7 @@ static void help(void)
            "1 2 3 (or , . /); gamepads 1 and 2 too.  The 2-3-6 motion + punch is the\n"
            "special move.  Escape quits.  Matches follow one another until you quit.\n\n"
            "  --p1 / --p2 K    who plays each side (default: human vs cpu)\n"
-           "  --stage NAME     dojo, harbor, temple, shallows, snowfield, mistvale or plaza\n"
+           "  --stage NAME     dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry\n"
            "                   (default dojo)\n"
            "  --seed S         random seed (default: the clock); stored in recordings\n"
            "  --level L        CPU skill 0..3 (default 2)\n"

@@ -26,7 +26,7 @@ static void help(void)
            "  --seconds N   record exactly N seconds of game time; matches follow one\n"
            "                another (default: until the first match is over, at most %d s)\n"
            "  --seed S      game and CPU random seed (default 1)\n"
-           "  --stage NAME  dojo, harbor, temple, shallows, snowfield, mistvale or plaza, or 0..%d\n                (default dojo)\n"
+           "  --stage NAME  dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry, or 0..%d\n                (default dojo)\n"
            "  --level L     CPU skill 0..3 (default 2)\n"
            "  --quiet       no progress line\n",
            MATCH_LIMIT_S, G_STAGES - 1);

@@ -24,7 +24,7 @@ in vec3 v_proj;
 in float v_lod;
 uniform sampler2D u_silhouette;
 uniform vec3 u_ring_color;
-uniform int u_material; // 0 planks; 1 planks, paving on the ground; 2 a building
+uniform int u_material; // 0 planks; 1 planks, paving on the ground; 2 a building; 3 a hole's inside
 #endif
 #ifdef FIGHTER
 uniform sampler2D u_normal_map;
@@ -47,6 +47,10 @@ vec3 hdr_out(vec3 c)
 void main()
 {
     vec3 n = normalize(v_normal);
+#ifdef STAGE
+    if (u_material == 3)
+        n = -n; // the crater is the sphere's inside
+#endif
     vec3 v = normalize(u_eye - v_world);
 #ifdef FIGHTER
     // normal map in tangent space (capsule uv: u around, v along the bone)
@@ -79,6 +83,13 @@ void main()
         vec2 f = fract(v_world.xz);
         float joint = min(smoothstep(0.0, 0.03, min(f.x, f.y)), smoothstep(0.0, 0.03, min(1.0 - f.x, 1.0 - f.y)));
         albedo = vec3(0.46, 0.44, 0.41) * tone * (0.6 + 0.4 * joint);
+    } else if (u_material == 3) {
+        // broken boards over packed earth and rubble, darker deeper down
+        vec3 cell = floor(v_world * 9.0);
+        float grit = fract(sin(dot(cell, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
+        float depth = clamp(-v_world.y / 0.4, 0.0, 1.0);
+        albedo = mix(u_ring_color * 0.8, vec3(0.42, 0.36, 0.29), smoothstep(0.0, 0.12, depth));
+        albedo *= (0.7 + 0.3 * grit) * mix(1.0, 0.6, depth);
     } else if (u_material == 2) {
         // concrete with a grid of glass windows (3.5 m floors, 2.5 m bays)
         float along = abs(n.x) > 0.5 ? v_world.z : v_world.x;

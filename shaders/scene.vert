@@ -24,6 +24,7 @@ uniform mat4 u_light_proj;     // the silhouette projector
 uniform vec3 u_light_dir;      // towards the key light
 uniform vec3 u_waist[2];       // the casters' waists
 uniform float u_lod_start, u_lod_scale;
+uniform int u_material;        // 3: a hole's inside, seen from within the sphere
 out vec3 v_proj;               // projector uv, z: 1 when this vertex may receive
 out float v_lod;
 #endif
@@ -63,7 +64,7 @@ void main()
     vec3 w = distance(world.xyz, u_waist[0]) < distance(world.xyz, u_waist[1]) ? u_waist[0] : u_waist[1];
     float d = distance(world.xyz, w);
     vec4 lp = u_light_proj * world;
-    bool facing = dot(v_normal, u_light_dir) > 0.0;
+    bool facing = dot(u_material == 3 ? -v_normal : v_normal, u_light_dir) > 0.0;
     bool behind = dot(world.xyz - w, u_light_dir) > 0.0;
     v_proj = vec3(lp.xy * 0.5 + 0.5, facing && !behind ? 1.0 : 0.0);
     v_lod = clamp((d - u_lod_start) * u_lod_scale, 0.0, 4.0);

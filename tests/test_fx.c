@@ -64,6 +64,8 @@ static bool wants(const r_stage *st, const char *module)
         return st->fog;
     if (!strcmp(module, "afterimage"))
         return st->afterimage != R_AFTERIMAGE_OFF;
+    if (!strcmp(module, "holes"))
+        return st->holes;
     if (!strcmp(module, "lspsm")) /* the map and its focus; the buildings pass draws buildings */
         return st->lspsm || st->buildings > 0;
     T_ASSERTF(false, "unknown effect module '%s': add it here", module);
@@ -76,7 +78,7 @@ static bool wants(const r_stage *st, const char *module)
 static void t_effects_run_only_where_asked(void)
 {
     plat *p = t_context("egl");
-    static const char *const stages[] = {"dojo", "harbor", "temple", "sunless", "shallows", "snowfield", "mistvale", "plaza"};
+    static const char *const stages[] = {"dojo", "harbor", "temple", "sunless", "shallows", "snowfield", "mistvale", "plaza", "quarry"};
     t_fb f;
     t_fb_make(&f, W, H);
     int ran_somewhere[16] = {0};
@@ -87,7 +89,8 @@ static void t_effects_run_only_where_asked(void)
         rs_err e = {0};
         T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
         g_state prev, cur;
-        t_state_at("dojo", 400, &prev, &cur);
+        /* holes are game state: the quarry demo's own match has them */
+        t_state_at(st.holes ? "quarry" : "dojo", st.holes ? 3000 : 400, &prev, &cur);
         for (int k = 0; k < 10; k++) { /* ticks 400..409: fast limbs among them */
             draw(r, &f, &prev, &cur);
             for (int m = 0; m < r_fx_nmodules; m++) {

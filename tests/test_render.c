@@ -172,6 +172,7 @@ static void t_golden_egl(void)
     golden_after("egl", "snowfield", 900, 120); /* footprints in the snow, texture-space light */
     golden_after("egl", "mistvale", 700, 120);  /* mist stirred by the fight, fog at the horizon */
     golden_after("egl", "plaza", 1500, 30);     /* LSPSM: the landmark's shadow across the ring */
+    golden("egl", "quarry", 3000);              /* nine holes cut into the ring with stencil */
     plat_destroy(p);
 }
 

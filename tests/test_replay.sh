@@ -16,7 +16,7 @@ t_record_is_reproducible() {
 
 t_demos_are_current() {
     # the bundled demos are exactly what 'make demo-replays' makes now
-    for d in dojo:1 harbor:7 temple:23 shallows:31 snowfield:37 mistvale:41 plaza:43; do
+    for d in dojo:1 harbor:7 temple:23 shallows:31 snowfield:37 mistvale:41 plaza:43 quarry:47; do
         stage=${d%%:*} seed=${d##*:}
         "$RS_BIN" record --ai --quiet --stage "$stage" --seed "$seed" -o "$stage.rsr" 2>/dev/null || return 1
         cmp "$stage.rsr" "$SRC/demos/$stage.rsr" ||
@@ -47,7 +47,7 @@ t_hashes_same_at_O0_O2_and_in_ringside() {
     for o in O0 O2; do
         [ -x "$BIN_DIR/tests/simhash-$o" ] || { echo "missing $BIN_DIR/tests/simhash-$o"; return 1; }
     done
-    for d in dojo harbor temple shallows snowfield mistvale plaza; do
+    for d in dojo harbor temple shallows snowfield mistvale plaza quarry; do
         "$BIN_DIR/tests/simhash-O0" "$SRC/demos/$d.rsr" >o0.txt || { echo "O0 build fails $d"; return 1; }
         "$BIN_DIR/tests/simhash-O2" "$SRC/demos/$d.rsr" >o2.txt || { echo "O2 build fails $d"; return 1; }
         "$RS_BIN" replay verify --quiet --hashes r.txt "$SRC/demos/$d.rsr" 2>/dev/null || return 1
@@ -60,7 +60,7 @@ t_hashes_same_at_O0_O2_and_in_ringside() {
 
 t_hashes_same_with_clang() {
     [ -x "$BIN_DIR/tests/simhash-clang" ] || t_skip_case "clang not installed"
-    for d in dojo harbor temple shallows snowfield mistvale plaza; do
+    for d in dojo harbor temple shallows snowfield mistvale plaza quarry; do
         "$BIN_DIR/tests/simhash-clang" "$SRC/demos/$d.rsr" >c.txt || { echo "clang build fails $d"; return 1; }
         "$BIN_DIR/tests/simhash-O2" "$SRC/demos/$d.rsr" >g.txt || return 1
         cmp c.txt g.txt || { echo "$d: clang and gcc hashes differ"; return 1; }

@@ -5,13 +5,14 @@
 #include "g_local.h"
 
 const g_stage_def g_stages[G_STAGES] = {
-    {"dojo", FX(4.0), false},
-    {"harbor", FX(3.5), true},
-    {"temple", FX(4.5), false},
-    {"shallows", FX(4.0), false},  /* ankle-deep water over the ring (water) */
-    {"snowfield", FX(4.0), false}, /* fresh snow on the ring (snow) */
-    {"mistvale", FX(4.5), false},  /* mist that limbs stir (fog map) */
-    {"plaza", FX(4.0), false},     /* a city square: buildings cast LSPSM shadows */
+    {"dojo", FX(4.0), false, false},
+    {"harbor", FX(3.5), true, false},
+    {"temple", FX(4.5), false, false},
+    {"shallows", FX(4.0), false, false},  /* ankle-deep water over the ring (water) */
+    {"snowfield", FX(4.0), false, false}, /* fresh snow on the ring (snow) */
+    {"mistvale", FX(4.5), false, false},  /* mist that limbs stir (fog map) */
+    {"plaza", FX(4.0), false, false},     /* a city square: buildings cast LSPSM shadows */
+    {"quarry", FX(4.0), false, true}, /* heavy hits leave holes in the floor (stencil holes) */
 };
 
 #define WALK_F_SPEED FX(0.030)
@@ -68,6 +69,8 @@ static void start_round(g_state *st, bool new_match)
 {
     if (new_match) {
         st->round = 1;
+        st->nholes = 0, st->hole_seq = 0;
+        memset(st->holes, 0, sizeof st->holes);
         st->match_winner = st->matches == 0 ? -1 : st->match_winner;
     } else {
         st->round++;
@@ -326,6 +329,13 @@ static void apply_hit(g_state *st, const g_state *before, int a, int d, g_events
         fd->vy = FX(0.035);
         fd->stun = 0;
         emit(ev, G_EV_KNOCKDOWN, d + 1, 0);
+        if (g_stages[st->stage].destructible) {
+            /* a crater where the blow drives the fighter into the floor:
+             * bigger for harder blows, a little off the fight line */
+            fx r = fx_clamp(FX(0.35) + m->damage * FX(0.012), FX(0.35), FX(0.75));
+            int32_t j = (int32_t)((uint32_t)(st->hole_seq + 1) * 2654435761u >> 24) - 128; /* -128..127 */
+            g_hole_add(st, fd->x + away * FX(0.7), j * (FX(0.35) / 128), r);
+        }
     } else {
         set_move(fd, G_MV_HITSTUN);
         fd->frame = 0;
@@ -519,6 +529,19 @@ size_t g_serialize(const g_state *st, uint8_t *buf)
         for (int k = 0; k < G_HIST; k++) {
             p = put32(p, f->hist_dir[k]);
             p = put32(p, f->hist_age[k]);
+        }
+    }
+    /* holes exist only on destructible stages: every other stage's hashes
+     * (and its replays' checkpoints) stay what they were */
+    if (st->stage >= 0 && st->stage < G_STAGES && g_stages[st->stage].destructible) {
+        int n = st->nholes < 0 ? 0 : st->nholes > G_MAX_HOLES ? G_MAX_HOLES : st->nholes;
+        p = put32(p, st->nholes);
+        p = put32(p, st->hole_seq);
+        for (int k = 0; k < n; k++) {
+            p = put32(p, st->holes[k].x);
+            p = put32(p, st->holes[k].z);
+            p = put32(p, st->holes[k].r);
+            p = put32(p, st->holes[k].id);
         }
     }
     return (size_t)(p - buf);

@@ -90,6 +90,16 @@ typedef struct g_fighter {
     int32_t hist_age[G_HIST];
 } g_fighter;
 
+/* A destruction hole (techniques D): a crater in the ring floor, centred
+ * at (x, z) on the ring top, `r` the radius of the sphere that cuts it
+ * (centred 0.4 r above the floor: 0.6 r deep, 0.92 r wide at the top).
+ * Holes are decoration: the fighters still stand on a flat floor. */
+#define G_MAX_HOLES 30
+typedef struct g_hole {
+    fx x, z, r;
+    int32_t id; /* order of creation in the match, from 1 */
+} g_hole;
+
 typedef struct g_state {
     uint64_t tick;
     uint64_t rng;
@@ -109,6 +119,11 @@ typedef struct g_state {
     int32_t flash_in;     /* ticks to the next lightning (storm stages), 0 = none */
     int32_t flash;        /* ticks of flash left */
     g_fighter f[2];
+    /* destructible stages only (else always empty, and not in the hash):
+     * craters that heavy hits leave in the ring floor, for the match */
+    int32_t nholes;
+    int32_t hole_seq;     /* holes made so far in the match */
+    g_hole holes[G_MAX_HOLES];
 } g_state;
 
 typedef enum g_event_type {
@@ -133,9 +148,10 @@ typedef struct g_stage_def {
     const char *name;
     fx ring_half;  /* ring edge at x = +-ring_half */
     bool storm;    /* random lightning flashes */
+    bool destructible; /* heavy hits leave holes in the ring floor */
 } g_stage_def;
 
-#define G_STAGES 7
+#define G_STAGES 8
 extern const g_stage_def g_stages[G_STAGES];
 
 void g_init(g_state *st, int stage, uint64_t seed);
@@ -144,7 +160,7 @@ void g_step(g_state *st, const g_input in[2], g_events *events);
 
 /* Canonical little-endian serialisation (no padding, fixed field order);
  * returns the size; buf needs G_STATE_BYTES. */
-#define G_STATE_BYTES 512
+#define G_STATE_BYTES 1024
 size_t g_serialize(const g_state *st, uint8_t *buf);
 uint64_t g_hash(const g_state *st);
 
@@ -156,6 +172,17 @@ void g_fighter_capsules(const g_state *st, int i, g_capsule out[G_BONES]);
 const char *g_move_name(int move);
 const char *g_event_name(int type);
 const char *g_result_name(int result);
+
+/* Destruction holes (g_holes.c).  g_hole_add places a crater of radius r
+ * near (x, z): the first of a few candidate spots across the ring that
+ * overlaps no hole and lies inside the ring; none: false, nothing changes.
+ * With G_MAX_HOLES already there, one goes first: the oldest that the
+ * camera cannot see (g_hole_in_view), else the oldest. */
+bool g_hole_add(g_state *st, fx x, fx z, fx r);
+/* Whether the crater lies in the game camera's view (r_game_camera's
+ * framing, at the cabinet's 16:9), from the state alone. */
+bool g_hole_in_view(const g_state *st, const g_hole *h);
+bool g_holes_overlap(const g_hole *a, const g_hole *b);
 
 /* 64-bit FNV-1a, used for the state hash. */
 uint64_t g_fnv1a(uint64_t h, const void *data, size_t n);

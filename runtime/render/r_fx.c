@@ -8,11 +8,12 @@
 #include "../game/g_game.h"
 
 extern const r_fx_module r_fx_water_module, r_fx_snow_module, r_fx_fog_module, r_fx_afterimage_module,
-    r_fx_lspsm_module;
+    r_fx_lspsm_module, r_fx_holes_module;
 
 const r_fx_module *const r_fx_modules[] = {
     &r_fx_fog_module,   /* first: the fog map is read by every later scene draw */
     &r_fx_lspsm_module, /* the shadow map, read by every later scene draw */
+    &r_fx_holes_module, /* before the other surfaces: it clears the frame (steps 1-3 of D) */
     &r_fx_water_module,
     &r_fx_snow_module,
     &r_fx_afterimage_module,

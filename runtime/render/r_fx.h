@@ -108,4 +108,7 @@ void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool unifo
  * (20x16 depth samples of the frame drawn last), "shadow" (16 floats). */
 bool r_fx_lspsm_read(r_game *r, const char *what, float *out);
 
+/* Holes (r_fx_holes.c): how many the frame drawn last cut into the ring. */
+int r_fx_holes_drawn(r_game *r);
+
 #endif

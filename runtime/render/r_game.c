@@ -717,7 +717,10 @@ static void run_scene(void *u)
     gl.CullFace(GL_BACK);
     gl.Disable(GL_BLEND);
     bool prepass = r_ran(f, r, "z_prepass");
-    gl.Clear(GL_COLOR_BUFFER_BIT | (prepass ? 0 : GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT));
+    /* the holes pass (techniques D, steps 1-3) cleared and drew already */
+    bool holes = r_ran(f, r, "holes");
+    if (!holes)
+        gl.Clear(GL_COLOR_BUFFER_BIT | (prepass ? 0 : GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT));
 
     /* fighters: over their own z-prepass depth when it ran */
     GLuint p = r->prog[P_FIGHTER];
@@ -744,13 +747,33 @@ static void run_scene(void *u)
     /* the ring and the ground, with the projected silhouette */
     p = r->prog[P_STAGE];
     gl.DepthFunc(GL_LESS);
+    r_stage_uniforms(r, p, r->stage.buildings > 0 ? 1 : 0);
+    gl.BindVertexArray(r->ring_vao);
+    if (!holes) {
+        gl.DrawElements(GL_TRIANGLES, r->ring_count, GL_UNSIGNED_INT, NULL);
+        return;
+    }
+    /* with holes (techniques D, steps 5 and 6): the indestructible parts,
+     * then the ring top's colour only where its own depth is still there
+     * (the holes pass put the craters' depth in the rest) */
+    gl.DrawElements(GL_TRIANGLES, R_RING_TOP_FIRST, GL_UNSIGNED_INT, NULL);
+    gl.DrawElements(GL_TRIANGLES, r->ring_count - R_RING_TOP_FIRST - 6, GL_UNSIGNED_INT,
+                    (const void *)((R_RING_TOP_FIRST + 6) * sizeof(unsigned)));
+    gl.DepthFunc(GL_EQUAL);
+    gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, (const void *)(R_RING_TOP_FIRST * sizeof(unsigned)));
+    gl.DepthFunc(GL_LESS);
+}
+
+void r_stage_uniforms(r_game *r, GLuint p, int material)
+{
+    frame *f = &r->f;
     r_camera_uniforms(r, p);
     r_bind_ibl(r, p);
     r_bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
-    gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
+    gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "mask_filter") && r_ran(f, r, "silhouette_mips"));
     r_fx_fog_bind(r, p, 6);
     r_fx_lspsm_bind(r, p, 4);
-    gl.Uniform1i(r_loc(p, "u_material"), r->stage.buildings > 0 ? 1 : 0);
+    gl.Uniform1i(r_loc(p, "u_material"), material);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
     gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
@@ -759,8 +782,6 @@ static void run_scene(void *u)
     gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
     gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
     gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
-    gl.BindVertexArray(r->ring_vao);
-    gl.DrawElements(GL_TRIANGLES, r->ring_count, GL_UNSIGNED_INT, NULL);
 }
 
 static void run_sky(void *u)

@@ -125,6 +125,7 @@ struct r_game {
     struct r_fx_fog *fog;
     struct r_fx_afterimage *afterimage;
     struct r_fx_lspsm *lspsm;
+    struct r_fx_holes *holes;
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
     bool have_last;
     frame f;
@@ -150,5 +151,11 @@ void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scen
 void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
 void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
+/* The P_STAGE program's uniforms for this frame (lighting, shadows, fog,
+ * LSPSM); material as scene.frag's u_material. */
+void r_stage_uniforms(r_game *r, GLuint p, int material);
+/* The ring mesh (build_ring): its box's +y face, the destructible ring
+ * top, is the 6 indices from here; the ground's box follows the ring's. */
+#define R_RING_TOP_FIRST 30
 
 #endif

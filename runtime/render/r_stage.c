@@ -29,7 +29,6 @@ typedef enum kind {
     K_BOOL,
     K_LIGHT,  /* r_paint_light: 8 numbers */
     K_FORMAT, /* r_hdr_format */
-    K_EFFECT, /* a bool whose "yes" is refused until issue 8 builds it */
     K_AFTERIMAGE, /* r_afterimage */
 } kind;
 
@@ -72,7 +71,7 @@ static const row rows[] = {
     {"water", K_BOOL, F(water), 0, 0, "no"},
     {"snow", K_BOOL, F(snow), 0, 0, "no"},
     {"fog", K_BOOL, F(fog), 0, 0, "no"},
-    {"holes", K_EFFECT, F(holes), 0, 0, "no"},
+    {"holes", K_BOOL, F(holes), 0, 0, "no"},
     {"lspsm", K_BOOL, F(lspsm), 0, 0, "no"},
     {"buildings", K_INT, F(buildings), 0, R_STAGE_MAX_BUILDINGS, "0"},
     {"buildings_seed", K_INT, F(buildings_seed), 0, 16777216, "1"},
@@ -320,14 +319,11 @@ static bool set(r_stage *st, const row *r, const char *v, const ctx *c)
         memcpy(field, f, sizeof f);
         return true;
     }
-    case K_BOOL:
-    case K_EFFECT: {
+    case K_BOOL: {
         bool b;
         if (!parse_bool(v, &b))
             return bad(c, R_STAGE_ERR_VALUE, "%s: expected yes or no (or true/false, on/off, 1/0), got '%s'", r->key,
                        Q(v));
-        if (b && r->kind == K_EFFECT)
-            return bad(c, R_STAGE_ERR_VALUE, "%s: stage effect not built yet (issue 8)", r->key);
         *(bool *)field = b;
         return true;
     }
@@ -559,7 +555,6 @@ int r_stage_format(const r_stage *st, char *out, size_t n)
             put(&s, "%.9g %.9g %.9g\n", f[0], f[1], f[2]);
             break;
         case K_BOOL:
-        case K_EFFECT:
             put(&s, "%s\n", *(const bool *)field ? "yes" : "no");
             break;
         case K_LIGHT: {

@@ -63,7 +63,7 @@ typedef struct r_stage {
     bool shadows;         /* SSFSM + blurred mipmap projection shadows */
     r_hdr_format hdr_format;
 
-    /* stage effects (docs/effects.md); "holes = yes" is refused until built */
+    /* stage effects (docs/effects.md) */
     bool water, snow, fog, holes;
     /* light space perspective shadow maps over the whole stage (techniques
      * C): the key light's shadows of the buildings (and the fighters) */

@@ -1,0 +1,190 @@
+/* Destruction holes with stencil (techniques D, issue 8).
+ *
+ * The game places the craters (g_holes.c: heavy hits on a destructible
+ * stage; part of the game state, so replays reproduce them).  The ring
+ * mesh never changes: each hole is a separate sphere, cut into the floor
+ * with the stencil buffer the way shadow volumes are.  One pass, "holes"
+ * (phase R_FX_PRE, on stages with `holes = yes` and frames with at least
+ * one hole), does the technique's steps 1-3; `scene` does 4-6:
+ *
+ *   1. the depth of the destructible terrain (the ring top), no colour;
+ *   2. per hole, nearest first: its volume into the stencil (front faces
+ *      that pass the depth test +1, back faces -1): non-zero where the
+ *      ring top lies inside the sphere;
+ *   3. the hole's inside (the sphere's inner surface) where the stencil is
+ *      set and the depth test fails against the ring top (GL_GREATER: the
+ *      part under the floor), writing its depth, so the fighters, the
+ *      shadows and everything after follow the crater's shape; the
+ *      stencil goes back to zero there, so a farther hole never shows
+ *      through a nearer one;
+ *   4. the fighters (scene), 5. the ring's sides and the ground,
+ *   6. the ring top's colour where its depth is still its own (GL_EQUAL:
+ *      scene.vert's gl_Position is invariant across programs).
+ * Shadows (7, 8) are the silhouette and mask passes, read by 3 and 6; the
+ * translucent passes (9, 10) come after the sky as before.
+ *
+ * Stencil: the low 7 bits; bit 0x80 stays the fighters' (R_STENCIL_FIGHTER). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../game/g_game.h"
+#include "r_local.h"
+
+#define SPHERE_SEG 32
+#define SPHERE_RINGS 8
+#define LIFT 0.4f /* the sphere's centre stands 0.4 r above the floor */
+#define STENCIL_HOLES 0x7F
+
+struct r_fx_holes {
+    GLuint vao, vbo, ibo;
+    GLsizei count;
+    int drawn; /* holes drawn in the frame drawn last */
+};
+
+static bool need_holes(void *u)
+{
+    r_game *r = u;
+    return r->holes && r->stage.holes && r->f.cur->nholes > 0;
+}
+
+static void model(const g_hole *h, float m[16])
+{
+    float rad = fx_to_float(h->r);
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = m[5] = m[10] = rad;
+    m[12] = fx_to_float(h->x), m[13] = LIFT * rad, m[14] = fx_to_float(h->z);
+    m[15] = 1;
+}
+
+typedef struct order {
+    float d2;
+    int i;
+} order;
+
+static int nearer_first(const void *a, const void *b)
+{
+    const order *x = a, *y = b;
+    if (x->d2 != y->d2)
+        return x->d2 < y->d2 ? -1 : 1;
+    return x->i - y->i;
+}
+
+static void run_holes(void *u)
+{
+    r_game *r = u;
+    struct r_fx_holes *hs = r->holes;
+    frame *f = &r->f;
+    const g_state *st = f->cur;
+    bool prepass = r_ran(f, r, "z_prepass");
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    gl.Viewport(0, 0, f->w, f->h);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gl.DepthMask(GL_TRUE);
+    gl.StencilMask(0xFF);
+    gl.ClearColor(0, 0, 0, 0);
+    gl.Clear(GL_COLOR_BUFFER_BIT | (prepass ? 0 : GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT));
+    gl.Disable(GL_BLEND);
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LESS);
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
+
+    /* 1: the destructible terrain's depth */
+    GLuint pd = r->prog[P_DEPTH], ps = r->prog[P_STAGE];
+    gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    r_camera_uniforms(r, pd);
+    gl.BindVertexArray(r->ring_vao);
+    gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, (const void *)(R_RING_TOP_FIRST * sizeof(unsigned)));
+
+    /* nearest first */
+    order o[G_MAX_HOLES];
+    int n = st->nholes > G_MAX_HOLES ? G_MAX_HOLES : st->nholes;
+    for (int i = 0; i < n; i++) {
+        float dx = fx_to_float(st->holes[i].x) - f->eye.x, dz = fx_to_float(st->holes[i].z) - f->eye.z;
+        o[i] = (order){dx * dx + f->eye.y * f->eye.y + dz * dz, i};
+    }
+    qsort(o, (size_t)n, sizeof o[0], nearer_first);
+
+    r_stage_uniforms(r, ps, 3); /* the crater's inside */
+    gl.Enable(GL_STENCIL_TEST);
+    gl.StencilMask(STENCIL_HOLES);
+    gl.BindVertexArray(hs->vao);
+    for (int k = 0; k < n; k++) {
+        float m[16];
+        model(&st->holes[o[k].i], m);
+        /* 2: the volume: +1 for front faces in front of the ring top, -1 for back faces */
+        gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        gl.DepthMask(GL_FALSE);
+        gl.DepthFunc(GL_LESS);
+        gl.StencilFunc(GL_ALWAYS, 0, STENCIL_HOLES);
+        gl.UseProgram(pd);
+        gl.UniformMatrix4fv(r_loc(pd, "u_bones"), 1, GL_FALSE, m);
+        gl.CullFace(GL_BACK);
+        gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR_WRAP);
+        gl.DrawElements(GL_TRIANGLES, hs->count, GL_UNSIGNED_INT, NULL);
+        gl.CullFace(GL_FRONT);
+        gl.StencilOp(GL_KEEP, GL_KEEP, GL_DECR_WRAP);
+        gl.DrawElements(GL_TRIANGLES, hs->count, GL_UNSIGNED_INT, NULL);
+        /* 3: the inside, under the floor, depth forced; stencil back to 0 */
+        gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        gl.DepthMask(GL_TRUE);
+        gl.DepthFunc(GL_GREATER);
+        gl.StencilFunc(GL_NOTEQUAL, 0, STENCIL_HOLES);
+        gl.StencilOp(GL_KEEP, GL_ZERO, GL_ZERO);
+        gl.UseProgram(ps);
+        gl.UniformMatrix4fv(r_loc(ps, "u_bones"), 1, GL_FALSE, m);
+        gl.DrawElements(GL_TRIANGLES, hs->count, GL_UNSIGNED_INT, NULL); /* back faces: the inner surface */
+    }
+    hs->drawn = n;
+    gl.Disable(GL_STENCIL_TEST);
+    gl.StencilMask(0xFF);
+    gl.StencilFunc(GL_ALWAYS, 0, 0xFF);
+    gl.StencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    gl.CullFace(GL_BACK);
+    gl.DepthFunc(GL_LESS);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gl.Uniform1i(r_loc(ps, "u_material"), 0);
+}
+
+static const r_pass holes_passes[] = {
+    {"holes", RES_ENV, RES_HDR | RES_DEPTH, need_holes, run_holes, RES_MASK | RES_SIL | RES_FOGMAP | RES_LSPSM},
+};
+
+static void holes_destroy(r_game *r)
+{
+    struct r_fx_holes *hs = r->holes;
+    if (!hs)
+        return;
+    r_free_mesh(&hs->vao, &hs->vbo, &hs->ibo);
+    free(hs);
+    r->holes = NULL;
+}
+
+static bool holes_create(r_game *r, rs_err *err)
+{
+    struct r_fx_holes *hs = calloc(1, sizeof *hs);
+    if (!hs)
+        return rs_fail(err, 1, "holes: out of memory");
+    r->holes = hs;
+    /* the unit sphere (a capsule of length 0) on bone 0: u_bones[0] places it */
+    r_mesh_data m = {0};
+    if (!r_mesh_capsule(&m, 0.0f, 1.0f, 0, SPHERE_SEG, SPHERE_RINGS)) {
+        r_mesh_free(&m);
+        holes_destroy(r);
+        return rs_fail(err, 1, "holes: out of memory");
+    }
+    r_upload_mesh(&m, &hs->vao, &hs->vbo, &hs->ibo);
+    hs->count = (GLsizei)m.ni;
+    r_mesh_free(&m);
+    RGL_CHECK("holes create");
+    return true;
+}
+
+const r_fx_module r_fx_holes_module = {"holes", holes_create, holes_destroy, NULL,
+                                       {holes_passes}, {(int)(sizeof holes_passes / sizeof holes_passes[0])}};
+
+int r_fx_holes_drawn(r_game *r)
+{
+    return r->holes ? r->holes->drawn : 0;
+}
