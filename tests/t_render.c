@@ -1,8 +1,12 @@
 /* Shared helpers of the renderer's GL tests (t_render.h). */
 #include "t_render.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
+#include "../runtime/render/r_game.h"
+#include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"
 #include "t.h"
 
@@ -42,4 +46,72 @@ void t_fb_free(t_fb *f)
 {
     gl.DeleteFramebuffers(1, &f->fbo);
     gl.DeleteRenderbuffers(2, f->rb);
+}
+
+r_game *t_game_new(bool mask)
+{
+    rs_err e = {0};
+    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
+    T_ASSERTF(r, "%s", e.msg);
+    return r;
+}
+
+void t_draw(r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h)
+{
+    rgl_error_reset();
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, w, h), "%s", r_game_error(r));
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    T_EQ(rgl_error_count(), 0);
+    T_EQ(gl.GetError(), GL_NO_ERROR);
+    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
+}
+
+bool t_pass_ran(r_game *r, const char *name)
+{
+    r_graph *g = r_game_graph(r);
+    int i = r_graph_find(g, name);
+    T_ASSERTF(i >= 0, "no pass '%s'", name);
+    return (g->last_ran >> i) & 1;
+}
+
+float *t_read(r_game *r, const char *what, int channels, int w, int h)
+{
+    float *px = malloc((size_t)w * (size_t)h * (size_t)channels * sizeof *px);
+    T_ASSERT(px);
+    int rw = 0, rh = 0;
+    T_ASSERTF(r_game_read_buffer(r, what, px, &rw, &rh), "no buffer '%s'", what);
+    T_EQ(rw, w);
+    T_EQ(rh, h);
+    return px;
+}
+
+void t_dump_hdr(const char *name, const float *px, int w, int h)
+{
+    const char *dir = getenv("T_DUMP");
+    if (!dir)
+        return;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.ppm", dir, name);
+    FILE *fp = fopen(path, "wb");
+    if (!fp)
+        return;
+    fprintf(fp, "P6\n%d %d\n255\n", w, h);
+    for (int y = h - 1; y >= 0; y--)
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++) {
+                float v = px[4 * ((size_t)y * w + x) + c];
+                v = v > 0 ? v / (1 + v) : 0;
+                fputc((int)(255 * powf(v, 1 / 2.2f) + 0.5f), fp);
+            }
+    fclose(fp);
+}
+
+void t_stage_extremes(r_stage *st)
+{
+    st->sun_intensity = R_HALF_MAX;
+    st->key.intensity = st->counter.intensity = R_HALF_MAX;
+    for (int c = 0; c < 3; c++)
+        st->sky_zenith[c] = st->sky_horizon[c] = st->ground[c] = R_HALF_MAX;
+    st->exposure = 1000;
 }

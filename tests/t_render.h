@@ -3,6 +3,7 @@
 #ifndef T_RENDER_H
 #define T_RENDER_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "../runtime/game/g_game.h"
@@ -18,5 +19,21 @@ typedef struct t_fb {
 
 void t_fb_make(t_fb *f, int w, int h);
 void t_fb_free(t_fb *f);
+
+/* A game renderer for tests (no IBL cache, quiet; mask: HDR alpha = the
+ * fighters' mask).  Fails the test when it cannot be made. */
+struct r_game *t_game_new(bool mask);
+/* One w x h frame into f, failing the test on any GL or pass-graph error. */
+void t_draw(struct r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h);
+/* Did the pass run in the frame drawn last (fails the test on a bad name)? */
+bool t_pass_ran(struct r_game *r, const char *name);
+/* r_game_read_buffer into a new w x h x channels array (free() it). */
+float *t_read(struct r_game *r, const char *what, int channels, int w, int h);
+/* The brightest look a stage file allows: every light, the sky and the
+ * ground at the fp16 maximum, exposure 1000 (the fp16 stress tests). */
+struct r_stage;
+void t_stage_extremes(struct r_stage *st);
+/* With T_DUMP=DIR: an HDR buffer (rgba, bottom-up) as DIR/NAME.ppm, v/(1+v) and gamma 2.2. */
+void t_dump_hdr(const char *name, const float *px, int w, int h);
 
 #endif

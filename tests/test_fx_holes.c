@@ -21,14 +21,6 @@
 enum { W = 320, H = 180 };
 #define TICK 3000 /* of the quarry demo: nine holes, both fighters up */
 
-static r_game *game_new(bool mask)
-{
-    rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
-    T_ASSERTF(r, "%s", e.msg);
-    return r;
-}
-
 static r_stage quarry(void)
 {
     r_stage st;
@@ -42,53 +34,19 @@ static void draw(r_game *r, t_fb *f, const r_stage *st, const g_state *prev, con
 {
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, st, &e), "%s", e.msg);
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
-}
-
-static bool pass_ran(r_game *r, const char *name)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, name);
-    T_ASSERTF(i >= 0, "no pass '%s'", name);
-    return (g->last_ran >> i) & 1;
+    t_draw(r, f, prev, cur, W, H);
 }
 
 static float *read(r_game *r, const char *what, int channels)
 {
-    float *px = malloc((size_t)W * H * (size_t)channels * sizeof *px);
-    T_ASSERT(px);
-    int w = 0, h = 0;
-    T_ASSERT(r_game_read_buffer(r, what, px, &w, &h));
-    T_EQ(w, W);
-    T_EQ(h, H);
-    return px;
+    return t_read(r, what, channels, W, H);
 }
 
 static void dump(const char *name, const float *px)
 {
-    const char *dir = getenv("T_DUMP");
-    if (!dir)
-        return;
-    char path[1024];
-    snprintf(path, sizeof path, "%s/holes_%s.ppm", dir, name);
-    FILE *fp = fopen(path, "wb");
-    if (!fp)
-        return;
-    fprintf(fp, "P6\n%d %d\n255\n", W, H);
-    for (int y = H - 1; y >= 0; y--)
-        for (int x = 0; x < W; x++)
-            for (int c = 0; c < 3; c++) {
-                float v = px[4 * ((size_t)y * W + x) + c];
-                v = v / (1 + v);
-                fputc((int)(255 * powf(v > 0 ? v : 0, 1 / 2.2f) + 0.5f), fp);
-            }
-    fclose(fp);
+    char n[64];
+    snprintf(n, sizeof n, "holes_%s", name);
+    t_dump_hdr(n, px, W, H);
 }
 
 /* Is pixel (x, y) (bottom-up) within a hole's rim, grown by `grow` pixels?
@@ -123,19 +81,19 @@ static void t_holes_cut_the_ring_only_there(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(true); /* mask mode: HDR alpha = the fighters */
+    r_game *r = t_game_new(true); /* mask mode: HDR alpha = the fighters */
     r_stage st = quarry();
     g_state prev, cur;
     t_state_at("quarry", TICK, &prev, &cur);
     T_ASSERTF(cur.nholes >= 5, "%d holes at tick %d", cur.nholes, TICK);
     draw(r, &f, &st, &prev, &cur);
-    T_ASSERT(pass_ran(r, "holes"));
+    T_ASSERT(t_pass_ran(r, "holes"));
     T_EQ(r_fx_holes_drawn(r), cur.nholes);
     float *on = read(r, "hdr", 4), *don = read(r, "depth", 1);
     g_state p0 = prev, c0 = cur;
     p0.nholes = c0.nholes = 0;
     draw(r, &f, &st, &p0, &c0);
-    T_ASSERT(!pass_ran(r, "holes"));
+    T_ASSERT(!t_pass_ran(r, "holes"));
     float *off = read(r, "hdr", 4), *doff = read(r, "depth", 1);
     dump("on", on), dump("off", off);
     int changed = 0, outside = 0, deeper = 0, mask = 0, bad = 0;
@@ -166,7 +124,7 @@ static void t_holes_cut_the_ring_only_there(void)
     /* the look without holes draws none, whatever the game state */
     st.holes = false;
     draw(r, &f, &st, &prev, &cur);
-    T_ASSERT(!pass_ran(r, "holes"));
+    T_ASSERT(!t_pass_ran(r, "holes"));
     r_game_destroy(r);
     t_fb_free(&f);
     plat_destroy(p);
@@ -179,7 +137,7 @@ static void t_thirty_holes_and_extremes(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st = quarry();
     g_state prev, cur;
     t_state_at("quarry", TICK, &prev, &cur);
@@ -190,15 +148,10 @@ static void t_thirty_holes_and_extremes(void)
     T_EQ(cur.nholes, G_MAX_HOLES);
     prev.nholes = 0;
     for (int pass = 0; pass < 2; pass++) {
-        if (pass) { /* fp16 extremes */
-            st.sun_intensity = R_HALF_MAX;
-            st.key.intensity = st.counter.intensity = R_HALF_MAX;
-            for (int c = 0; c < 3; c++)
-                st.sky_zenith[c] = st.sky_horizon[c] = st.ground[c] = R_HALF_MAX;
-            st.exposure = 1000;
-        }
+        if (pass)
+            t_stage_extremes(&st);
         draw(r, &f, &st, &prev, &cur);
-        T_ASSERT(pass_ran(r, "holes"));
+        T_ASSERT(t_pass_ran(r, "holes"));
         T_EQ(r_fx_holes_drawn(r), G_MAX_HOLES);
         float *px = read(r, "hdr", 4);
         dump(pass ? "thirty_extreme" : "thirty", px);

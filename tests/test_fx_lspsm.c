@@ -26,14 +26,6 @@ enum { W = 320, H = 180 };
 #endif
 #define FIGHTERS_APART 60 /* a tick of the dojo demo: both stand, 2.4 m apart */
 
-static r_game *game_new(bool mask)
-{
-    rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
-    T_ASSERTF(r, "%s", e.msg);
-    return r;
-}
-
 static r_stage plaza(void)
 {
     r_stage st;
@@ -51,53 +43,19 @@ static void set_stage(r_game *r, const r_stage *st)
 
 static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur)
 {
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
-}
-
-static bool pass_ran(r_game *r, const char *name)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, name);
-    T_ASSERTF(i >= 0, "no pass '%s'", name);
-    return (g->last_ran >> i) & 1;
+    t_draw(r, f, prev, cur, W, H);
 }
 
 static float *hdr(r_game *r)
 {
-    float *px = malloc((size_t)W * H * 4 * sizeof *px);
-    T_ASSERT(px);
-    int w = 0, h = 0;
-    T_ASSERT(r_game_read_buffer(r, "hdr", px, &w, &h));
-    T_EQ(w, W);
-    T_EQ(h, H);
-    return px;
+    return t_read(r, "hdr", 4, W, H);
 }
 
 static void dump(const char *name, const float *px)
 {
-    const char *dir = getenv("T_DUMP");
-    if (!dir)
-        return;
-    char path[1024];
-    snprintf(path, sizeof path, "%s/lspsm_%s.ppm", dir, name);
-    FILE *fp = fopen(path, "wb");
-    if (!fp)
-        return;
-    fprintf(fp, "P6\n%d %d\n255\n", W, H);
-    for (int y = H - 1; y >= 0; y--)
-        for (int x = 0; x < W; x++)
-            for (int c = 0; c < 3; c++) {
-                float v = px[4 * ((size_t)y * W + x) + c];
-                v = v / (1 + v); /* enough to look at */
-                fputc((int)(255 * powf(v > 0 ? v : 0, 1 / 2.2f) + 0.5f), fp);
-            }
-    fclose(fp);
+    char n[64];
+    snprintf(n, sizeof n, "lspsm_%s", name);
+    t_dump_hdr(n, px, W, H);
 }
 
 static float luma(const float *p)
@@ -123,11 +81,11 @@ static void t_buildings_cast_shadows(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st = plaza();
     set_stage(r, &st);
     draw_run(r, &f, "plaza", PLAZA_TICK, 2);
-    T_ASSERT(pass_ran(r, "lspsm_map") && pass_ran(r, "buildings") && pass_ran(r, "lspsm_focus"));
+    T_ASSERT(t_pass_ran(r, "lspsm_map") && t_pass_ran(r, "buildings") && t_pass_ran(r, "lspsm_focus"));
     float *on = hdr(r);
     float *map = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *map), *flag = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *flag);
     T_ASSERT(map && flag && r_fx_lspsm_read(r, "map", map) && r_fx_lspsm_read(r, "flag", flag));
@@ -139,7 +97,7 @@ static void t_buildings_cast_shadows(void)
     st.lspsm = false;
     set_stage(r, &st);
     draw_run(r, &f, "plaza", PLAZA_TICK, 2);
-    T_ASSERT(!pass_ran(r, "lspsm_map") && pass_ran(r, "buildings") && !pass_ran(r, "lspsm_focus"));
+    T_ASSERT(!t_pass_ran(r, "lspsm_map") && t_pass_ran(r, "buildings") && !t_pass_ran(r, "lspsm_focus"));
     float *off = hdr(r);
     dump("plaza_on", on), dump("plaza_off", off);
     double sum_on = 0, sum_off = 0;
@@ -170,7 +128,7 @@ static void t_culling_keeps_the_map(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st = plaza();
     set_stage(r, &st);
     size_t n = (size_t)R_LSPSM_MAP * R_LSPSM_MAP;
@@ -209,7 +167,7 @@ static void t_focus_reads_the_pattern_one_frame_late(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st = plaza();
     set_stage(r, &st);
     float *depth = malloc((size_t)W * H * sizeof *depth), samples[R_LSPSM_FOCUS_N], want[R_LSPSM_FOCUS_N];
@@ -291,7 +249,7 @@ static void t_fighters_no_self_shadow_but_each_others(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(true);
+    r_game *r = t_game_new(true);
     r_stage st = plaza();
     st.buildings = 0;
     st.shadows = false; /* with them, the screen-space mask casts the fighters and this map only the scenery */
@@ -358,7 +316,7 @@ static void t_parallel_and_antiparallel_light(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st = plaza();
     set_stage(r, &st);
     g_state prev, cur;
@@ -441,18 +399,13 @@ static void t_fp16_extremes(void)
     plat *p = t_context("egl");
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st = plaza();
-    st.sun_intensity = R_HALF_MAX;
-    st.key.intensity = R_HALF_MAX;
-    st.counter.intensity = R_HALF_MAX;
-    for (int c = 0; c < 3; c++)
-        st.sky_zenith[c] = st.sky_horizon[c] = st.ground[c] = R_HALF_MAX;
-    st.exposure = 1000;
+    t_stage_extremes(&st);
     st.buildings = R_STAGE_MAX_BUILDINGS;
     set_stage(r, &st);
     draw_run(r, &f, "plaza", 1500, 2);
-    T_ASSERT(pass_ran(r, "lspsm_map") && pass_ran(r, "buildings"));
+    T_ASSERT(t_pass_ran(r, "lspsm_map") && t_pass_ran(r, "buildings"));
     float *px = hdr(r);
     int bad = 0;
     for (size_t i = 0; i < (size_t)W * H * 4; i++)
@@ -473,7 +426,7 @@ static void t_deterministic(void)
     t_fb_make(&f, W, H);
     float *px[2];
     for (int k = 0; k < 2; k++) {
-        r_game *r = game_new(false);
+        r_game *r = t_game_new(false);
         r_stage st = plaza();
         set_stage(r, &st);
         draw_run(r, &f, "plaza", 1200, 5);

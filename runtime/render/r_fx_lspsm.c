@@ -173,24 +173,12 @@ static void run_buildings(void *u)
 {
     r_game *r = u;
     struct r_fx_lspsm *ls = r->lspsm;
-    frame *f = &r->f;
     GLuint p = r->prog[P_STAGE];
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
-    gl.Viewport(0, 0, f->w, f->h);
-    gl.Enable(GL_DEPTH_TEST);
-    gl.DepthFunc(GL_LESS);
-    gl.DepthMask(GL_TRUE);
-    gl.Enable(GL_CULL_FACE);
-    gl.CullFace(GL_BACK);
-    gl.Disable(GL_BLEND);
-    r_camera_uniforms(r, p);
-    r_bind_ibl(r, p);
-    /* no silhouette: the fighters' blurred shadow does not reach the buildings */
+    r_begin_opaque(r);
+    r_stage_uniforms(r, p, 2);
+    /* the fighters' blurred silhouette stops short of the buildings: this
+     * map casts them there (u_shadows 0 counts its fighter texels) */
     gl.Uniform1i(r_loc(p, "u_shadows"), 0);
-    r_fx_fog_bind(r, p, 6);
-    r_fx_lspsm_bind(r, p, 4);
-    gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
-    gl.Uniform1i(r_loc(p, "u_material"), 2);
     gl.BindVertexArray(ls->city_vao);
     gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
     gl.Uniform1i(r_loc(p, "u_material"), 0);

@@ -395,14 +395,7 @@ static void run_surface(void *u)
     struct r_fx_snow *s = r->snow;
     frame *f = &r->f;
     GLuint p = s->prog[S_SURFACE];
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
-    gl.Viewport(0, 0, f->w, f->h);
-    gl.Enable(GL_DEPTH_TEST);
-    gl.DepthFunc(GL_LESS);
-    gl.DepthMask(GL_TRUE);
-    gl.Enable(GL_CULL_FACE);
-    gl.CullFace(GL_BACK);
-    gl.Disable(GL_BLEND);
+    r_begin_opaque(r);
     r_camera_uniforms(r, p);
     r_bind_tex(p, "u_map", 0, GL_TEXTURE_2D, s->map_tex);
     r_bind_tex(p, "u_untouched", 1, GL_TEXTURE_2D, s->untouched_tex);

@@ -764,6 +764,18 @@ static void run_scene(void *u)
     gl.DepthFunc(GL_LESS);
 }
 
+void r_begin_opaque(r_game *r)
+{
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    gl.Viewport(0, 0, r->f.w, r->f.h);
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LESS);
+    gl.DepthMask(GL_TRUE);
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
+    gl.Disable(GL_BLEND);
+}
+
 void r_stage_uniforms(r_game *r, GLuint p, int material)
 {
     frame *f = &r->f;

@@ -154,6 +154,9 @@ void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
 /* The P_STAGE program's uniforms for this frame (lighting, shadows, fog,
  * LSPSM); material as scene.frag's u_material. */
 void r_stage_uniforms(r_game *r, GLuint p, int material);
+/* Opaque drawing into the HDR target: its FBO and the frame's viewport,
+ * depth test (less) and writes, back faces culled, no blending. */
+void r_begin_opaque(r_game *r);
 /* The ring mesh (build_ring): its box's +y face, the destructible ring
  * top, is the 6 indices from here; the ground's box follows the ring's. */
 #define R_RING_TOP_FIRST 30
