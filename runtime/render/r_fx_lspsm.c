@@ -59,7 +59,6 @@ struct r_fx_lspsm {
     r_mat4 pending_inv_vp;
     r_lspsm_focus focus;
     r_lspsm s;            /* this frame's matrices */
-    bool drawn;           /* the map was drawn this frame */
     /* the city */
     int nb;
     r_building b[R_CITY_MAX];
@@ -161,7 +160,6 @@ static void run_map(void *u)
     r_draw_fighters(r, p);
     gl.Disable(GL_POLYGON_OFFSET_FILL);
     gl.Disable(GL_DEPTH_CLAMP);
-    ls->drawn = true;
     ls->stats.casters_drawn = drawn;
     ls->stats.casters = ls->nb;
     ls->stats.range = d.far;
@@ -223,7 +221,7 @@ static const r_pass focus_passes[] = {
 void r_fx_lspsm_bind(r_game *r, GLuint p, int unit)
 {
     struct r_fx_lspsm *ls = r->lspsm;
-    bool on = ls && r->stage.lspsm && ls->drawn && r_ran(&r->f, r, "lspsm_map");
+    bool on = ls && r->stage.lspsm && r_ran(&r->f, r, "lspsm_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
     /* the two samplers get their own units whether on or not: samplers of
@@ -335,7 +333,6 @@ static bool lspsm_load(r_game *r, rs_err *err)
     free_city(ls);
     ls->pending = false;
     ls->focus.range = 0;
-    ls->drawn = false;
     memset(&ls->stats, 0, sizeof ls->stats);
     const r_stage *st = &r->stage;
     if (st->buildings <= 0)
