@@ -74,9 +74,9 @@ CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(fil
 LDLIBS  = $(CONF_LIBS) -lstdc++ -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
-LIB_SRC := $(wildcard runtime/*/*.c capture/*.c player/*.c service/*.c) \
-           $(filter-out runtime/main.c,$(wildcard runtime/*.c))
-MAIN_SRC := runtime/main.c
+LIB_SRC := $(wildcard runtime/*.c runtime/*/*.c capture/*.c player/*.c service/*.c) \
+           $(filter-out cmd/main.c,$(wildcard cmd/*.c))
+MAIN_SRC := cmd/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 

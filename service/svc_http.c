@@ -24,7 +24,7 @@
 #include "svc_local.h"
 #include "svc_log.h"
 #include "../capture/cap.h"
-#include "../runtime/cli.h"
+#include "../cmd/cli.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 

@@ -6,10 +6,10 @@
 #include <string.h>
 
 #include "cli.h"
-#include "platform/plat.h"
-#include "render/r_smoke.h"
-#include "util/rs_file.h"
-#include "util/rs_img.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_smoke.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_img.h"
 
 static void help(void)
 {

@@ -6,9 +6,9 @@
 #include <string.h>
 
 #include "cli.h"
-#include "platform/plat.h"
-#include "render/r_shader.h"
-#include "util/rs_file.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_shader.h"
+#include "../runtime/util/rs_file.h"
 
 static void help(void)
 {

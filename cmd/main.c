@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "platform/plat.h"
+#include "../runtime/platform/plat.h"
 
 static const cli_cmd commands[] = {
     {"info", cmd_info, "print the GL backend, driver and capabilities"},

@@ -17,7 +17,7 @@
 #include "../service/svc_local.h"
 #include "../service/svc_log.h"
 #include "cli.h"
-#include "util/rs_file.h"
+#include "../runtime/util/rs_file.h"
 
 static void help(void)
 {

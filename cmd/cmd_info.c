@@ -4,8 +4,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "gl/rgl.h"
-#include "platform/plat.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
 
 static void help(void)
 {

@@ -11,13 +11,13 @@
 #include <time.h>
 
 #include "cli.h"
-#include "game/g_ai.h"
-#include "gl/rgl.h"
-#include "replay/rp.h"
-#include "util/rs_file.h"
-#include "util/rs_progress.h"
-#include "platform/plat.h"
-#include "render/r_smoke.h"
+#include "../runtime/game/g_ai.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_progress.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_smoke.h"
 
 static void help(void)
 {

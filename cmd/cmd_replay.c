@@ -8,8 +8,8 @@
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "replay/rp.h"
-#include "util/rs_progress.h"
+#include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_progress.h"
 
 static void help(void)
 {

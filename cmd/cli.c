@@ -6,9 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "game/g_game.h"
-#include "platform/plat.h"
-#include "render/r_stage.h"
+#include "../runtime/game/g_game.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_stage.h"
 
 void cli_error(const char *cmd, const char *fmt, ...)
 {

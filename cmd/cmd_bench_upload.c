@@ -27,11 +27,11 @@
 #include "../player/mv_csp.h"
 #include "../player/mv_up.h"
 #include "cli.h"
-#include "gl/rgl.h"
-#include "platform/plat.h"
-#include "render/r_target.h"
-#include "util/rs_file.h"
-#include "util/rs_progress.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_target.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_progress.h"
 
 #define MAX_RUNS 15
 #define NFRAMES 8 /* distinct synthetic frames */

@@ -6,11 +6,11 @@
 #include <string.h>
 
 #include "cli.h"
-#include "game/g_ai.h"
-#include "game/g_game.h"
-#include "replay/rp.h"
-#include "util/rs_file.h"
-#include "util/rs_progress.h"
+#include "../runtime/game/g_ai.h"
+#include "../runtime/game/g_game.h"
+#include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_progress.h"
 
 #define MATCH_LIMIT_S 600
 

@@ -13,14 +13,14 @@
 
 #include "../capture/cap.h"
 #include "cli.h"
-#include "gl/rgl.h"
-#include "platform/plat.h"
-#include "render/r_game.h"
-#include "render/r_target.h"
-#include "replay/rp.h"
-#include "util/rs_chart.h"
-#include "util/rs_file.h"
-#include "util/rs_progress.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_game.h"
+#include "../runtime/render/r_target.h"
+#include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_chart.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_progress.h"
 
 #define MAX_RUNS 9
 

@@ -15,13 +15,13 @@
 #include "../player/mv_csp.h"
 #include "../player/mv_player.h"
 #include "cli.h"
-#include "gl/rgl.h"
-#include "input.h"
-#include "loop.h"
-#include "platform/plat.h"
-#include "render/r_target.h"
-#include "util/rs_file.h"
-#include "util/rs_img.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/input.h"
+#include "../runtime/loop.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_target.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_img.h"
 
 static void help(void)
 {
