@@ -3,6 +3,7 @@
 #   make            build (installs missing Debian packages first)
 #   make test       build and run every test; ends with "N passed, N failed, N skipped"
 #   make test-service  the service end to end (PostgreSQL, Chromium; docs/service.md)
+#   make check-layers  fail if a lower layer includes a higher one (make test runs it too)
 #   make asan       the test suite again under AddressSanitizer + UBSan (build-asan/)
 #   make debug      -O0 build with GL error checks in build-debug/
 #   make demo       the main job on the bundled default (see README)
@@ -47,7 +48,7 @@ endif
 
 STAMPS := build/deps
 # Goals that build nothing must not install packages or configure.
-NOBUILD_GOALS := clean help uninstall
+NOBUILD_GOALS := clean help uninstall check-layers
 ifneq ($(filter clean,$(MAKECMDGOALS)),)
 ifneq ($(filter-out clean,$(MAKECMDGOALS)),)
 $(error run 'make clean' on its own, then 'make $(filter-out clean,$(MAKECMDGOALS))')
@@ -84,7 +85,12 @@ LIB_CXX  := $(wildcard capture/*.cpp)
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
-.PHONY: all test test-service asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
+# lower layers never include higher ones (docs/architecture.md, Layers);
+# make test runs the same check as tests/test_layers.sh, planted violations too
+check-layers:
+	@tools/check-layers.sh
+
+.PHONY: check-layers all test test-service asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
