@@ -66,7 +66,7 @@ $(shell mkdir -p $(BUILD) && (echo '$(FLAGS_SIG)' | cmp -s - $(BUILD)/flags || e
 endif
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
-# the one C++ file: OpenImageIO's C face (capture/cap_oiio.cpp)
+# the one C++ file: OpenImageIO's C face (runtime/util/rs_oiio.cpp)
 CXX     ?= g++
 SAN_CXX := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(filter 1,$(WERROR)),-Werror) \
@@ -80,7 +80,7 @@ MAIN_SRC := cmd/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
-LIB_CXX  := $(wildcard capture/*.cpp)
+LIB_CXX  := $(wildcard runtime/util/*.cpp)
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 

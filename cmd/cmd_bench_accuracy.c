@@ -16,7 +16,6 @@
 #include <unistd.h>
 
 #include "../capture/cap.h"
-#include "../capture/cap_oiio.h"
 #include "../capture/cap_scale.h"
 #include "cli.h"
 #include "../runtime/gl/rgl.h"
@@ -32,6 +31,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_img.h"
+#include "../runtime/util/rs_oiio.h"
 #include "../runtime/util/rs_progress.h"
 
 static double psnr_rgb(const uint8_t *a, const float *ref, size_t npx)
@@ -415,11 +415,8 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
         gl.ReadPixels(0, 0, sw, sh, GL_RGBA, GL_UNSIGNED_BYTE, full);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
         rs_flip_rows(full, sw, sh, 4); /* top-down for the reference */
-        char oerr[512];
-        if (!cap_oiio_resize(full, sw, sh, ref, w, h, oerr, sizeof oerr)) {
-            rs_fail(&err, 1, "%s", oerr);
+        if (!rs_oiio_resize(full, sw, sh, ref, w, h, &err))
             goto done;
-        }
         for (int f = 0; f < CAP_FILTERS; f++) {
             gl.Finish();
             double t0 = rs_now();
@@ -445,7 +442,7 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     }
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     printf("bench accuracy: %d frames of demos/dojo.rsr, %dx%d to %dx%d, reference: %s resize (lanczos3)\n", frames,
-           sw, sh, w, h, cap_oiio_version());
+           sw, sh, w, h, rs_oiio_version());
     printf("%-12s %10s %12s\n", "filter", "PSNR dB", "ms/frame");
     FILE *cf = NULL;
     if (csv && *csv) {
