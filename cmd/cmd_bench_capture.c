@@ -12,13 +12,13 @@
 #include <unistd.h>
 
 #include "../capture/cap.h"
+#include "bench_chart.h"
 #include "cli.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/replay/rp.h"
-#include "../runtime/util/rs_chart.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
 
@@ -343,14 +343,14 @@ int bench_capture(int argc, char **argv)
         }
     }
     if (chart && *chart) {
-        rs_bar bars[16];
+        bench_bar bars[16];
         int nb = 0;
         for (int i = 0; i < nrun; i++)
             if (!(null_sink && runs[i].kind == 2))
-                bars[nb++] = (rs_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
+                bars[nb++] = (bench_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
         char title[128];
         snprintf(title, sizeof title, "capture fps, %dx%d to %dx%d, %s", b.sw, b.sh, b.w, b.h, sink);
-        if (!rs_chart_png(chart, title, "fps", bars, nb, &err))
+        if (!bench_chart_png(chart, title, "fps", bars, nb, &err))
             goto done;
     }
     status = RS_EXIT_OK;
