@@ -131,7 +131,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(BUILD)/obj/tests/t.o $(BUILD)/obj/tes
 # simhash: the simulation alone, at -O0 and at -O2, to prove both give the
 # same per-tick hashes (tests/test_replay.sh)
 SIM_SRC := $(wildcard runtime/game/*.c runtime/replay/*.c) runtime/util/rs_err.c runtime/util/rs_file.c \
-           runtime/util/rs_img.c tests/simhash.c
+           runtime/util/rs_hash.c tests/simhash.c
 $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/replay/*.h) $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(filter-out -O% -MMD -MP,$(CFLAGS)) $(subst simhash-,-,$(notdir $@)) $(LDFLAGS) -o $@ $(SIM_SRC) -lm

@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../capture/cap_writer.h"
 #include "../player/mv_csp.h"
 #include "../player/mv_player.h"
 #include "cli.h"
@@ -21,6 +20,7 @@
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 
 static void help(void)
@@ -102,7 +102,7 @@ static bool write_outputs(mv_cmd *s)
     r_read_pixels(s->target.fbo, s->w, s->h, 3, s->px);
     if (s->hashes)
         fprintf(s->hashes, "%" PRId64 " %" PRId64 " %016" PRIx64 "\n", tick, frame,
-                cap_frame_hash(s->px, (size_t)s->w * s->h * 3));
+                rs_fnv1a64(s->px, (size_t)s->w * s->h * 3));
     if (s->dump && frame >= 0 && frame != s->last_dumped) {
         char path[1100];
         snprintf(path, sizeof path, "%s/frame%06" PRId64 ".ppm", s->dump, frame);
