@@ -279,9 +279,7 @@ int bench_accuracy(int argc, char **argv)
         case 'R': if (!cli_int("--ibl-reference", optarg, 4, 512, &v)) return RS_EXIT_USAGE; ref_size = (int)v; break;
         case 'S': stage = optarg; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv);
         }
     }
     if (optind < argc) {

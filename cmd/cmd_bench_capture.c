@@ -217,9 +217,7 @@ int bench_capture(int argc, char **argv)
         case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv);
         }
     }
     rs_err err = {0};

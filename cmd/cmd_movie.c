@@ -233,8 +233,7 @@ int cmd_movie(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
-            cli_error("movie", "bad option or missing value '%s'", argv[optind - 1]);
-            status = cli_usage_error("movie");
+            status = cli_bad_option("movie", argv);
             goto done;
         }
     }

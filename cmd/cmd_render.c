@@ -196,9 +196,7 @@ int cmd_render(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("render", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("render");
+        default: return cli_bad_option("render", argv);
         }
     }
     if (optind + 1 != argc) {
