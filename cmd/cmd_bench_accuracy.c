@@ -18,6 +18,7 @@
 #include "../capture/cap.h"
 #include "../capture/cap_scale.h"
 #include "cli.h"
+#include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
@@ -398,17 +399,16 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
 
-    g_state prev, cur;
-    g_init(&cur, rp.stage, rp.seed);
-    uint64_t tick = 0;
+    /* frame fr: the state after tick 600 + 60 fr, the tick before it as prev */
+    job_render j;
+    if (!job_render_begin(&j, &(job_render_desc){.rp = &rp, .game = r, .target = &src, .name = demo, .first = 599,
+                                                 .end = 600 + 60 * (uint64_t)(frames - 1), .every = 60, .no_check = true},
+                          &err))
+        goto done;
     for (int fr = 0; fr < frames; fr++) {
-        uint64_t until = 600 + 60 * (uint64_t)fr;
-        while (tick < until) {
-            prev = cur;
-            g_step(&cur, &rp.inputs[2 * tick++], NULL);
-        }
+        if (job_render_next(&j, &err) <= 0)
+            goto done;
         gl.BindFramebuffer(GL_FRAMEBUFFER, src.fbo);
-        r_game_draw(r, &prev, &cur, 1.0f, sw, sh);
         gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
         gl.ReadPixels(0, 0, sw, sh, GL_RGBA, GL_UNSIGNED_BYTE, full);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
