@@ -56,8 +56,10 @@ int job_render_next(job_render *j, rs_err *err)
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     j->ms_draw += (rs_now() - t0) * 1e3;
     j->frames++;
-    if (!ok)
-        return rs_fail(err, 1, "frame %" PRIu64 ": %s", at, r_game_error(d->game)), -1;
+    if (!ok) {
+        rs_fail(err, 1, "frame %" PRIu64 ": %s", at, r_game_error(d->game));
+        return -1;
+    }
     if (d->cap && !cap_frame(d->cap, d->target->tex, err))
         return -1;
     return 1;
