@@ -67,7 +67,7 @@ $(shell mkdir -p $(BUILD) && (echo '$(FLAGS_SIG)' | cmp -s - $(BUILD)/flags || e
 endif
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
-# the one C++ file: OpenImageIO's C face (capture/cap_oiio.cpp)
+# the one C++ file: OpenImageIO's C face (runtime/util/rs_oiio.cpp)
 CXX     ?= g++
 SAN_CXX := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(filter 1,$(WERROR)),-Werror) \
@@ -81,7 +81,7 @@ MAIN_SRC := cmd/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
-LIB_CXX  := $(wildcard capture/*.cpp)
+LIB_CXX  := $(wildcard runtime/util/*.cpp)
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
@@ -137,7 +137,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(BUILD)/obj/tests/t.o $(BUILD)/obj/tes
 # simhash: the simulation alone, at -O0 and at -O2, to prove both give the
 # same per-tick hashes (tests/test_replay.sh)
 SIM_SRC := $(wildcard runtime/game/*.c runtime/replay/*.c) runtime/util/rs_err.c runtime/util/rs_file.c \
-           runtime/util/rs_img.c tests/simhash.c
+           runtime/util/rs_hash.c tests/simhash.c
 $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/replay/*.h) $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(filter-out -O% -MMD -MP,$(CFLAGS)) $(subst simhash-,-,$(notdir $@)) $(LDFLAGS) -o $@ $(SIM_SRC) -lm

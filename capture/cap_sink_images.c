@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "../runtime/util/rs_file.h"
-#include "cap_oiio.h"
+#include "../runtime/util/rs_oiio.h"
 #include "cap_sink.h"
 
 typedef struct seq {
@@ -63,14 +63,15 @@ static bool img_open(cap_sink *s, rs_err *err)
 static bool img_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *err)
 {
     seq *q = s->impl;
-    char path[1100], part[1120], msg[768];
+    char path[1100], part[1120];
     frame_path(s, index, path, sizeof path);
     snprintf(part, sizeof part, "%s.part", path);
     if (!q)
         return rs_fail(err, 1, "%s: the image sequence is not open", path);
-    if (!cap_oiio_write(part, q->ext, s->w, s->h, frame, msg, sizeof msg)) {
+    rs_err oerr = {0};
+    if (!rs_oiio_write(part, q->ext, s->w, s->h, frame, &oerr)) {
         unlink(part);
-        return rs_fail(err, 1, "%s", msg);
+        return rs_fail(err, 1, "%s", oerr.msg);
     }
     if (rename(part, path) != 0) {
         unlink(part);

@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_progress.h"
 
 struct cap_writer {
@@ -43,22 +44,12 @@ struct cap_writer {
     rs_err err;
 };
 
-uint64_t cap_frame_hash(const uint8_t *p, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 /* Writes one frame; called by the writer thread (or inline at queue 0). */
 static bool write_one(cap_writer *w, const uint8_t *frame, uint64_t index, rs_err *err)
 {
     double t0 = rs_now();
     if (w->hashes && fprintf(w->hashes, "%llu %016llx\n", (unsigned long long)(index + w->sink->index_base),
-                             (unsigned long long)cap_frame_hash(frame, w->frame_bytes)) < 0)
+                             (unsigned long long)rs_fnv1a64(frame, w->frame_bytes)) < 0)
         return rs_fail(err, 1, "writing the frame hash list failed at frame %llu",
                        (unsigned long long)(index + w->sink->index_base));
     bool ok = w->sink->ops->write(w->sink, frame, index, err);

@@ -38,7 +38,4 @@ void cap_writer_cancel(cap_writer *w, uint8_t *slot);
  * the first error of the writer (disk full, encoder failure). */
 bool cap_writer_finish(cap_writer *w, cap_writer_stats *stats, rs_err *err);
 
-/* 64-bit FNV-1a of a frame, as written to --hashes. */
-uint64_t cap_frame_hash(const uint8_t *frame, size_t n);
-
 #endif

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "../runtime/game/g_game.h"
 #include "../runtime/platform/plat.h"
@@ -24,6 +25,12 @@ int cli_usage_error(const char *cmd)
 {
     fprintf(stderr, "ringside %s: see 'ringside %s --help'\n", cmd, cmd);
     return RS_EXIT_USAGE;
+}
+
+int cli_bad_option(const char *cmd, char *const *argv)
+{
+    cli_error(cmd, "bad option or missing value '%s'", argv[optind - 1]);
+    return cli_usage_error(cmd);
 }
 
 bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out)

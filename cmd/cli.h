@@ -5,8 +5,6 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#define RS_VERSION "0.1.0"
-
 enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2 };
 
 typedef struct cli_cmd {
@@ -25,6 +23,10 @@ bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out);
 void cli_error(const char *cmd, const char *fmt, ...);
 /* Unknown option or missing argument: prints the hint to --help; returns RS_EXIT_USAGE. */
 int cli_usage_error(const char *cmd);
+/* The tail of every option loop, for getopt_long's '?' (opterr 0, so it
+ * printed nothing): names the bad option, prints the hint to --help and
+ * returns RS_EXIT_USAGE.  argv: the vector getopt_long was given. */
+int cli_bad_option(const char *cmd, char *const *argv);
 
 int cmd_info(int argc, char **argv);
 int cmd_smoke(int argc, char **argv);

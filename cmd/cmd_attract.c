@@ -511,8 +511,7 @@ int cmd_attract(int argc, char **argv)
         case 'q': a->quiet = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
-            cli_error("attract", "bad option or missing value '%s'", argv[optind - 1]);
-            status = cli_usage_error("attract");
+            status = cli_bad_option("attract", argv);
             goto done;
         }
     }

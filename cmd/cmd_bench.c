@@ -138,9 +138,7 @@ static int bench_sim(int argc, char **argv)
         case 'c': csv = optarg; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv);
         }
     }
     uint64_t ticks = (uint64_t)hours * 3600 * G_HZ;
@@ -269,9 +267,7 @@ int cmd_bench(int argc, char **argv)
             break;
         case 'c': csv = optarg; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv + 1);
         }
     }
     if (w < R_SMOKE_MIN_SIZE || h < R_SMOKE_MIN_SIZE) {

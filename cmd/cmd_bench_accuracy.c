@@ -16,9 +16,9 @@
 #include <unistd.h>
 
 #include "../capture/cap.h"
-#include "../capture/cap_oiio.h"
 #include "../capture/cap_scale.h"
 #include "cli.h"
+#include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
@@ -32,6 +32,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_img.h"
+#include "../runtime/util/rs_oiio.h"
 #include "../runtime/util/rs_progress.h"
 
 static double psnr_rgb(const uint8_t *a, const float *ref, size_t npx)
@@ -279,9 +280,7 @@ int bench_accuracy(int argc, char **argv)
         case 'R': if (!cli_int("--ibl-reference", optarg, 4, 512, &v)) return RS_EXIT_USAGE; ref_size = (int)v; break;
         case 'S': stage = optarg; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv);
         }
     }
     if (optind < argc) {
@@ -400,26 +399,22 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
 
-    g_state prev, cur;
-    g_init(&cur, rp.stage, rp.seed);
-    uint64_t tick = 0;
+    /* frame fr: the state after tick 600 + 60 fr, the tick before it as prev */
+    job_render j;
+    if (!job_render_begin(&j, &(job_render_desc){.rp = &rp, .game = r, .target = &src, .name = demo, .first = 599,
+                                                 .end = 600 + 60 * (uint64_t)(frames - 1), .every = 60, .no_check = true},
+                          &err))
+        goto done;
     for (int fr = 0; fr < frames; fr++) {
-        uint64_t until = 600 + 60 * (uint64_t)fr;
-        while (tick < until) {
-            prev = cur;
-            g_step(&cur, &rp.inputs[2 * tick++], NULL);
-        }
+        if (job_render_next(&j, &err) <= 0)
+            goto done;
         gl.BindFramebuffer(GL_FRAMEBUFFER, src.fbo);
-        r_game_draw(r, &prev, &cur, 1.0f, sw, sh);
         gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
         gl.ReadPixels(0, 0, sw, sh, GL_RGBA, GL_UNSIGNED_BYTE, full);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
         rs_flip_rows(full, sw, sh, 4); /* top-down for the reference */
-        char oerr[512];
-        if (!cap_oiio_resize(full, sw, sh, ref, w, h, oerr, sizeof oerr)) {
-            rs_fail(&err, 1, "%s", oerr);
+        if (!rs_oiio_resize(full, sw, sh, ref, w, h, &err))
             goto done;
-        }
         for (int f = 0; f < CAP_FILTERS; f++) {
             gl.Finish();
             double t0 = rs_now();
@@ -445,7 +440,7 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     }
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     printf("bench accuracy: %d frames of demos/dojo.rsr, %dx%d to %dx%d, reference: %s resize (lanczos3)\n", frames,
-           sw, sh, w, h, cap_oiio_version());
+           sw, sh, w, h, rs_oiio_version());
     printf("%-12s %10s %12s\n", "filter", "PSNR dB", "ms/frame");
     FILE *cf = NULL;
     if (csv && *csv) {

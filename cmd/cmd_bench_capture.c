@@ -12,13 +12,14 @@
 #include <unistd.h>
 
 #include "../capture/cap.h"
+#include "bench_chart.h"
 #include "cli.h"
+#include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/replay/rp.h"
-#include "../runtime/util/rs_chart.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
 
@@ -67,25 +68,6 @@ static double peak_rss_mb(void)
     return kb / 1024;
 }
 
-/* The state at the first benchmarked tick (simulation only, not timed). */
-static void seek(const bench *b, g_state *st)
-{
-    g_init(st, b->rp.stage, b->rp.seed);
-    for (uint64_t t = 0; t < b->start; t++)
-        g_step(st, &b->rp.inputs[2 * t], NULL);
-}
-
-static double draw_frame(bench *b, g_state *prev, g_state *cur, uint64_t tick)
-{
-    double t0 = rs_now();
-    *prev = *cur;
-    g_step(cur, &b->rp.inputs[2 * tick], NULL);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, b->t.fbo);
-    r_game_draw(b->r, prev, cur, 1.0f, b->sw, b->sh);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    return (rs_now() - t0) * 1e3;
-}
-
 /* A sink that keeps frames in memory (to feed writer-only). */
 static bool mem_open(cap_sink *s, rs_err *e)
 {
@@ -107,15 +89,31 @@ static bool mem_close(cap_sink *s, bool ok, rs_err *e)
 }
 static const cap_sink_ops mem_ops = {"memory", mem_open, mem_write, mem_close};
 
+/* The frames from b->start through j (its seek done before the clock
+ * starts), drawn and, with c, captured.  Render time is simulate + draw
+ * calls (job_render's ms_draw), not the capture. */
+static bool draw_frames(job_render *j, cap *c, double *render_ms, rs_err *err)
+{
+    j->d.cap = c;
+    int more;
+    while ((more = job_render_next(j, err)) > 0) {
+    }
+    *render_ms = j->ms_draw;
+    return more == 0;
+}
+
 static bool do_run(bench *b, run *r, rs_err *err)
 {
-    g_state prev, cur;
-    seek(b, &cur);
+    job_render j; /* seeks to b->start: simulation only, not timed */
+    if (!job_render_begin(&j, &(job_render_desc){.rp = &b->rp, .game = b->r, .target = &b->t, .first = b->start,
+                                                 .end = b->start + (uint64_t)b->frames, .no_check = true},
+                          err))
+        return false;
     reset_peak_rss();
     double t0 = rs_now(), render_ms = 0;
     if (r->kind == 1) { /* render only */
-        for (int f = 0; f < b->frames; f++)
-            render_ms += draw_frame(b, &prev, &cur, b->start + (uint64_t)f);
+        if (!draw_frames(&j, NULL, &render_ms, err))
+            return false;
         gl.Finish();
     } else if (r->kind == 2) { /* writer only: frames from memory into the sink */
         cap_sink s;
@@ -147,11 +145,7 @@ static bool do_run(bench *b, run *r, rs_err *err)
                           &s, err);
         if (!c)
             return false;
-        bool ok = true;
-        for (int f = 0; f < b->frames && ok; f++) {
-            render_ms += draw_frame(b, &prev, &cur, b->start + (uint64_t)f);
-            ok = cap_frame(c, b->t.tex, err);
-        }
+        bool ok = draw_frames(&j, c, &render_ms, err);
         if (!cap_close(c, ok, &r->st, err) || !ok)
             return false;
     }
@@ -217,9 +211,7 @@ int bench_capture(int argc, char **argv)
         case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv);
         }
     }
     rs_err err = {0};
@@ -343,14 +335,14 @@ int bench_capture(int argc, char **argv)
         }
     }
     if (chart && *chart) {
-        rs_bar bars[16];
+        bench_bar bars[16];
         int nb = 0;
         for (int i = 0; i < nrun; i++)
             if (!(null_sink && runs[i].kind == 2))
-                bars[nb++] = (rs_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
+                bars[nb++] = (bench_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
         char title[128];
         snprintf(title, sizeof title, "capture fps, %dx%d to %dx%d, %s", b.sw, b.sh, b.w, b.h, sink);
-        if (!rs_chart_png(chart, title, "fps", bars, nb, &err))
+        if (!bench_chart_png(chart, title, "fps", bars, nb, &err))
             goto done;
     }
     status = RS_EXIT_OK;

@@ -345,9 +345,7 @@ int bench_upload(int argc, char **argv)
             break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("bench", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("bench");
+        default: return cli_bad_option("bench", argv);
         }
     }
     if (optind < argc) {

@@ -35,9 +35,7 @@ int cmd_info(int argc, char **argv)
         case 'b': d.backend = optarg; break;
         case 'd': d.debug = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("info", "bad option '%s'", argv[optind - 1]);
-            return cli_usage_error("info");
+        default: return cli_bad_option("info", argv);
         }
     }
     if (optind < argc) {

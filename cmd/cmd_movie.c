@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../capture/cap_writer.h"
 #include "../player/mv_csp.h"
 #include "../player/mv_player.h"
 #include "cli.h"
@@ -21,6 +20,7 @@
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 
 static void help(void)
@@ -102,7 +102,7 @@ static bool write_outputs(mv_cmd *s)
     r_read_pixels(s->target.fbo, s->w, s->h, 3, s->px);
     if (s->hashes)
         fprintf(s->hashes, "%" PRId64 " %" PRId64 " %016" PRIx64 "\n", tick, frame,
-                cap_frame_hash(s->px, (size_t)s->w * s->h * 3));
+                rs_fnv1a64(s->px, (size_t)s->w * s->h * 3));
     if (s->dump && frame >= 0 && frame != s->last_dumped) {
         char path[1100];
         snprintf(path, sizeof path, "%s/frame%06" PRId64 ".ppm", s->dump, frame);
@@ -233,8 +233,7 @@ int cmd_movie(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
-            cli_error("movie", "bad option or missing value '%s'", argv[optind - 1]);
-            status = cli_usage_error("movie");
+            status = cli_bad_option("movie", argv);
             goto done;
         }
     }

@@ -212,8 +212,7 @@ int cmd_play(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
-            cli_error("play", "bad option or missing value '%s'", argv[optind - 1]);
-            status = cli_usage_error("play");
+            status = cli_bad_option("play", argv);
             goto done;
         }
     }

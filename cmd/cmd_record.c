@@ -68,9 +68,7 @@ int cmd_record(int argc, char **argv)
             break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("record", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("record");
+        default: return cli_bad_option("record", argv);
         }
     }
     if (optind < argc) {

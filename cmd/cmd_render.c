@@ -11,6 +11,7 @@
 
 #include "../capture/cap.h"
 #include "cli.h"
+#include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
@@ -73,27 +74,6 @@ static void on_signal(int sig)
 {
     (void)sig;
     stop_requested = 1;
-}
-
-/* The replay's own proof: after `done` ticks, the state hash must match
- * the checkpoint (every interval ticks) and, at the end, the final hash. */
-static bool check_sync(const rp_replay *rp, const g_state *st, uint64_t done, size_t *next, const char *name,
-                       uint64_t *desync, rs_err *err)
-{
-    bool at_check = done % (uint64_t)rp->interval == 0 && *next < rp->ncheck;
-    bool last = done == rp->ticks;
-    if (!at_check && !last)
-        return true;
-    uint64_t h = g_hash(st), want = at_check ? rp->checkpoints[(*next)++] : rp->final_hash;
-    if (h == want && (!last || h == rp->final_hash))
-        return true;
-    if (h == want)
-        want = rp->final_hash;
-    *desync = done;
-    return rs_fail(err, RP_ERR_DESYNC,
-                   "%s: desync at tick %" PRIu64 ": the game's state hash %016" PRIx64 " is not the replay's %016" PRIx64
-                   " (its inputs no longer reproduce the recorded match); nothing written",
-                   name, done, h, want);
 }
 
 /* --progress-fd: machine-readable progress, at most 4 lines a second. */
@@ -204,9 +184,7 @@ int cmd_render(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("render", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("render");
+        default: return cli_bad_option("render", argv);
         }
     }
     if (optind + 1 != argc) {
@@ -290,41 +268,36 @@ int cmd_render(int argc, char **argv)
     if (!cp)
         goto done;
 
-    g_state prev, cur;
-    g_init(&cur, rp.stage, rp.seed);
     rs_progress prog;
     rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet);
-    bool ok = true;
-    size_t next_check = 0;
-    uint64_t desync_at = 0;
     double last_report = 0;
     report_progress((int)progress_fd, 0, t_end - t_first, &last_report);
-    for (uint64_t tick = 0; tick < t_first && ok; tick++) {
-        g_step(&cur, &rp.inputs[2 * tick], NULL);
-        ok = check_sync(&rp, &cur, tick + 1, &next_check, replay, &desync_at, &err);
-    }
-    for (uint64_t tick = t_first; tick < t_end && ok; tick++) {
+    job_render j;
+    bool ok = job_render_begin(
+        &j, &(job_render_desc){.rp = &rp, .game = r, .target = &t, .cap = cp, .name = replay, .first = t_first, .end = t_end},
+        &err);
+    while (ok && j.tick < t_end) {
+        uint64_t tick = j.tick; /* every tick is a frame */
         if (stop_requested) {
             ok = false;
             rs_fail(&err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
                     out, tick, t_end);
             break;
         }
-        prev = cur;
-        g_step(&cur, &rp.inputs[2 * tick], NULL);
-        if (!(ok = check_sync(&rp, &cur, tick + 1, &next_check, replay, &desync_at, &err)))
+        ok = job_render_next(&j, &err) > 0;
+        if (j.desync)
             break;
-        gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-        ok = r_game_draw(r, &prev, &cur, 1.0f, cd.src_w, cd.src_h);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-        if (!ok)
-            rs_fail(&err, 1, "frame %" PRIu64 ": %s", tick, r_game_error(r));
-        ok = ok && cap_frame(cp, t.tex, &err);
         rs_progress_update(&prog, tick + 1 - t_first);
         report_progress((int)progress_fd, tick + 1 - t_first, t_end - t_first, &last_report);
     }
-    if (desync_at && progress_fd >= 0)
-        dprintf((int)progress_fd, "desync %" PRIu64 "\n", desync_at);
+    if (j.desync) {
+        /* the render's own words: the replay's message, and that no output is left */
+        ok = false;
+        size_t n = strlen(err.msg);
+        snprintf(err.msg + n, sizeof err.msg - n, "; nothing written");
+        if (progress_fd >= 0)
+            dprintf((int)progress_fd, "desync %" PRIu64 "\n", j.desync);
+    }
     double secs = rs_progress_end(&prog);
     if (passes)
         r_game_report(r, stderr);

@@ -149,9 +149,7 @@ int cmd_replay(int argc, char **argv)
         case 'H': hashes = optarg; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("replay", "bad option or missing value '%s'", argv[optind]);
-            return cli_usage_error("replay");
+        default: return cli_bad_option("replay", argv + 1);
         }
     }
     if (optind + 1 != argc - 1) {

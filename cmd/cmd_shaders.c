@@ -45,9 +45,7 @@ int cmd_shaders(int argc, char **argv)
         case 'b': d.backend = optarg; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("shaders", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("shaders");
+        default: return cli_bad_option("shaders", argv);
         }
     }
     if (optind < argc) {

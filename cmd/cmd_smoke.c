@@ -48,9 +48,7 @@ int cmd_smoke(int argc, char **argv)
         case 'b': d.backend = optarg; break;
         case 'n': check = false; break;
         case 'h': help(); return RS_EXIT_OK;
-        default:
-            cli_error("smoke", "bad option or missing value '%s'", argv[optind - 1]);
-            return cli_usage_error("smoke");
+        default: return cli_bad_option("smoke", argv);
         }
     }
     if (optind < argc) {

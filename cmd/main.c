@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "../runtime/platform/plat.h"
+#include "../runtime/util/rs_version.h"
 
 static const cli_cmd commands[] = {
     {"info", cmd_info, "print the GL backend, driver and capabilities"},

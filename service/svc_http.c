@@ -24,9 +24,9 @@
 #include "svc_local.h"
 #include "svc_log.h"
 #include "../capture/cap.h"
-#include "../cmd/cli.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_version.h"
 
 /* --- upload checks and Range parsing: plain functions, unit-tested --- */
 

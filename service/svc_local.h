@@ -1,5 +1,6 @@
 /* The daemon's shared state: what the supervisor loop (svc_daemon.c) and
- * the HTTP threads (svc_http.c) both see.
+ * the HTTP threads (svc_http.c) both see, built by svc_serve (svc_main.c).
+ * Private to service/: the rest of the program sees svc.h.
  *
  * DESIGN (threads):
  *  - the supervisor thread (main) owns workers[], the supervisor's store

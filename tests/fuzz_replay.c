@@ -10,7 +10,7 @@
 
 #include <string.h>
 
-#include "../runtime/util/rs_img.h" /* rs_crc32 */
+#include "../runtime/util/rs_hash.h"
 
 static void one(const uint8_t *data, size_t size);
 

@@ -321,9 +321,46 @@ static void t_demos_verify(void)
     }
 }
 
+/* rp_check_tick, tick by tick, agrees with rp_verify: a clean replay passes
+ * every tick; a flipped input fails at the first checkpoint after it, with
+ * RP_ERR_DESYNC and a message naming the file and the tick. */
+static void t_check_tick_agrees_with_verify(void)
+{
+    rp_replay rp;
+    record(&rp, 5, 0, 3000);
+    for (int flip = 0; flip < 2; flip++) {
+        rp_replay m = rp;
+        m.inputs = malloc((size_t)rp.ticks * 2);
+        memcpy(m.inputs, rp.inputs, (size_t)rp.ticks * 2);
+        if (flip)
+            m.inputs[2 * (1234 - 1)] ^= G_IN_GUARD;
+        g_state st;
+        g_init(&st, m.stage, m.seed);
+        size_t next = 0;
+        uint64_t failed = 0;
+        rs_err e = {0};
+        for (uint64_t t = 0; t < m.ticks && !failed; t++) {
+            g_step(&st, &m.inputs[2 * t], NULL);
+            if (!rp_check_tick(&m, &st, t + 1, &next, "x.rsr", &e))
+                failed = t + 1;
+        }
+        if (!flip) {
+            T_EQ(failed, 0);
+            T_EQ(next, m.ncheck);
+        } else {
+            T_EQ(failed, 1260);
+            T_EQ(e.code, RP_ERR_DESYNC);
+            T_ASSERTF(strstr(e.msg, "x.rsr: desync at tick 1260: ") == e.msg, "%s", e.msg);
+        }
+        free(m.inputs);
+    }
+    rp_free(&rp);
+}
+
 T_MAIN({"roundtrip", t_roundtrip}, {"three_minutes_under_16k", t_three_minutes_under_16k},
        {"corruption_cases", t_corruption_cases}, {"oversized_file", t_oversized_file},
        {"random_corruption", t_random_corruption},
        {"flipped_input_desyncs_at_its_checkpoint", t_flipped_input_desyncs_at_its_checkpoint},
        {"write_read_back_and_failures", t_write_read_back_and_failures}, {"short_recording", t_short_recording},
-       {"header_result_checked", t_header_result_checked}, {"demos_verify", t_demos_verify})
+       {"header_result_checked", t_header_result_checked}, {"demos_verify", t_demos_verify},
+       {"check_tick_agrees_with_verify", t_check_tick_agrees_with_verify})

@@ -9,7 +9,9 @@
 
 #include "../runtime/util/rs_err.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
+#include "../runtime/util/rs_oiio.h"
 #include "t.h"
 
 static void t_err_one_line(void)
@@ -271,8 +273,36 @@ static void t_flip_rows(void)
     T_ASSERT(!memcmp(px, want, sizeof want));
 }
 
+/* The frame hash's values are stored in every --hashes list: they must not move. */
+static void t_hash_vectors(void)
+{
+    T_EQ(rs_fnv1a64("", 0), 0xcbf29ce484222325ull);
+    T_EQ(rs_fnv1a64("a", 1), 0xaf63dc4c8601ec8cull);
+    T_EQ(rs_fnv1a64("foobar", 6), 0x85944171f73967e8ull);
+    T_EQ(rs_crc32(0, "", 0), 0u);
+    T_EQ(rs_crc32(0, "123456789", 9), 0xcbf43926u);
+    /* continued in two pieces, the same as in one */
+    T_EQ(rs_crc32(rs_crc32(0, "1234", 4), "56789", 5), 0xcbf43926u);
+}
+
+/* OpenImageIO's failures come back as rs_err ids naming the file. */
+static void t_oiio_errors(void)
+{
+    rs_err err = {0};
+    int w = 0, h = 0;
+    float *px = (float *)&w; /* must be reset to NULL */
+    T_ASSERT(!rs_oiio_read_float("/nonexistent/env.exr", &w, &h, &px, &err));
+    T_ASSERT(px == NULL);
+    T_ASSERT(err.code == RS_OIIO_ERR_READ || err.code == RS_OIIO_ERR_NOT_BUILT);
+    T_ASSERT(strstr(err.msg, "/nonexistent/env.exr") != NULL);
+    T_ASSERT(!strchr(err.msg, '\n'));
+    T_ASSERT(!strcmp(rs_oiio_error_text(RS_OIIO_ERR_OK), "ok"));
+    T_ASSERT(!strcmp(rs_oiio_error_text(RS_OIIO_ERR_COUNT), "unknown OpenImageIO error"));
+}
+
 T_MAIN({"err_one_line", t_err_one_line}, {"read_file_limits", t_read_file_limits},
        {"png_roundtrip", t_png_roundtrip}, {"png_failure_leaves_nothing", t_png_failure_leaves_nothing},
        {"png_disk_full", t_png_disk_full},
        {"pnm_roundtrip", t_pnm_roundtrip}, {"pnm_bad_input", t_pnm_bad_input},
-       {"pnm_random_corruption", t_pnm_random_corruption}, {"flip_rows", t_flip_rows})
+       {"pnm_random_corruption", t_pnm_random_corruption}, {"flip_rows", t_flip_rows},
+       {"hash_vectors", t_hash_vectors}, {"oiio_errors", t_oiio_errors})

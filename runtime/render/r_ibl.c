@@ -21,7 +21,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../../capture/cap_oiio.h"
+#include "../util/rs_oiio.h"
 
 #define PI 3.14159265358979323846
 /* The cache key does not cover these: change one, bump R_IBL_FORMAT_VERSION. */
@@ -186,11 +186,11 @@ static void sky_radiance(const env_src *src, const double d[3], double c[3])
  * that NaN or Inf in user data can never reach an average. */
 static bool src_load(env_src *src, const char *path, rs_err *err)
 {
-    char msg[600];
+    rs_err oerr = {0};
     int w = 0, h = 0;
     float *px = NULL;
-    if (!cap_oiio_read_float(path, &w, &h, &px, msg, sizeof msg))
-        return rs_fail(err, R_IBL_ERR_FILE, "%s", msg);
+    if (!rs_oiio_read_float(path, &w, &h, &px, &oerr))
+        return rs_fail(err, R_IBL_ERR_FILE, "%s", oerr.msg);
     if (w == 2 * h) {
         src->kind = SRC_EQUIRECT;
         src->edge = h / 2; /* a quarter turn of latitude, like a face edge */

@@ -491,3 +491,21 @@ bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t, uin
     res->ok = true;
     return true;
 }
+
+bool rp_check_tick(const rp_replay *rp, const g_state *st, uint64_t done, size_t *next, const char *name,
+                   rs_err *err)
+{
+    bool at_check = done % (uint64_t)rp->interval == 0 && *next < rp->ncheck;
+    bool last = done == rp->ticks;
+    if (!at_check && !last)
+        return true;
+    uint64_t h = g_hash(st), want = at_check ? rp->checkpoints[(*next)++] : rp->final_hash;
+    if (h == want && (!last || h == rp->final_hash))
+        return true;
+    if (h == want) /* the checkpoint matched, the final hash (same tick) did not */
+        want = rp->final_hash;
+    return rs_fail(err, RP_ERR_DESYNC,
+                   "%s: desync at tick %llu: the game's state hash %016llx is not the replay's %016llx (its inputs "
+                   "no longer reproduce the recorded match)",
+                   name, (unsigned long long)done, (unsigned long long)h, (unsigned long long)want);
+}

@@ -82,4 +82,15 @@ typedef struct rp_verify_result {
 bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t done, uint64_t total, void *user),
                void *user, rp_verify_result *res, rs_err *err);
 
+/* rp_verify's check one tick at a time, for callers that re-simulate the
+ * replay themselves (render): after `done` ticks, with the game in state st,
+ * the state hash must equal the checkpoint due at that tick (every interval
+ * ticks) and, after the last tick, the final hash.  *next counts the
+ * checkpoints passed: start it at 0 and call once per tick, in order.
+ * Ticks with nothing due pass without hashing.  A mismatch fails with
+ * RP_ERR_DESYNC: "NAME: desync at tick T: the game's state hash ... is not
+ * the replay's ...". */
+bool rp_check_tick(const rp_replay *rp, const g_state *st, uint64_t done, size_t *next, const char *name,
+                   rs_err *err);
+
 #endif

@@ -7,27 +7,10 @@
 #include <string.h>
 
 #include "rs_file.h"
+#include "rs_hash.h"
 
 /* Largest image we accept from a file: 16384 x 16384 x 4. */
 #define RS_IMG_MAX_DIM 16384
-
-uint32_t rs_crc32(uint32_t crc, const void *data, size_t n)
-{
-    static uint32_t table[256];
-    if (!table[1]) {
-        for (uint32_t i = 0; i < 256; i++) {
-            uint32_t c = i;
-            for (int k = 0; k < 8; k++)
-                c = (c & 1) ? 0xedb88320u ^ (c >> 1) : c >> 1;
-            table[i] = c;
-        }
-    }
-    const uint8_t *p = data;
-    crc = ~crc;
-    while (n--)
-        crc = table[(crc ^ *p++) & 0xff] ^ (crc >> 8);
-    return ~crc;
-}
 
 static void be32(uint8_t *p, uint32_t v)
 {

@@ -1,13 +1,13 @@
-#include "rs_chart.h"
+#include "bench_chart.h"
 
 #include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "../render/r_font.h"
-#include "rs_file.h"
-#include "rs_img.h"
+#include "../runtime/render/r_font.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_img.h"
 
 typedef struct canvas {
     int w, h;
@@ -37,7 +37,7 @@ static void text(canvas *c, int x, int y, int scale, const char *s, const uint8_
     }
 }
 
-bool rs_chart_png(const char *path, const char *title, const char *unit, const rs_bar *bars, int n, rs_err *err)
+bool bench_chart_png(const char *path, const char *title, const char *unit, const bench_bar *bars, int n, rs_err *err)
 {
     const int label_w = 230, bar_max = 460, row_h = 26, top = 48;
     canvas c = {label_w + bar_max + 120, top + n * row_h + 20, NULL};

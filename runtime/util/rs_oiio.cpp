@@ -1,0 +1,140 @@
+// OpenImageIO behind a C interface (see rs_oiio.h).  Kept to what ringside
+// needs: a reference resize, image files for sequences, and float images
+// for image-based lighting (runtime/render/r_ibl.c).
+extern "C" { /* rs_err.h is a C header without its own extern "C" */
+#include "rs_err.h"
+}
+#include "rs_oiio.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#ifdef RS_HAVE_OIIO
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+using namespace OIIO;
+
+/* rs_fail folds the multi-line messages OpenImageIO gives into one line */
+static bool fail(rs_err *err, rs_oiio_error code, const char *what, const std::string &why)
+{
+    rs_fail(err, code, "%s: %s", what, why.c_str());
+    return false;
+}
+
+extern "C" bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err)
+{
+    ImageSpec in_spec(sw, sh, 4, TypeDesc::UINT8);
+    ImageBuf src(in_spec, const_cast<uint8_t *>(rgba));
+    ImageSpec out_spec(w, h, 4, TypeDesc::FLOAT);
+    ImageBuf dst(out_spec);
+    if (!ImageBufAlgo::resize(dst, src))
+        return fail(err, RS_OIIO_ERR_RESIZE, "OpenImageIO resize", dst.geterror());
+    if (!dst.get_pixels(ROI(0, w, 0, h, 0, 1, 0, 4), TypeDesc::FLOAT, out))
+        return fail(err, RS_OIIO_ERR_RESIZE, "OpenImageIO resize", dst.geterror());
+    for (size_t i = 0; i < (size_t)w * h * 4; i++)
+        out[i] *= 255.0f;
+    return true;
+}
+
+extern "C" bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
+{
+    auto o = ImageOutput::create(ext + 1); /* by format name: path may end in .part */
+    if (!o)
+        return fail(err, RS_OIIO_ERR_WRITE, path, "OpenImageIO cannot write " + std::string(ext) + ": " + OIIO::geterror());
+    ImageSpec spec(w, h, 4, TypeDesc::UINT8);
+    if (!std::strcmp(ext, ".exr"))
+        spec.set_format(TypeDesc::HALF);
+    spec.alpha_channel = 3;
+    if (!o->open(path, spec))
+        return fail(err, RS_OIIO_ERR_WRITE, path, o->geterror());
+    bool ok = o->write_image(TypeDesc::UINT8, rgba);
+    std::string e = ok ? "" : o->geterror();
+    if (!o->close() && ok) {
+        ok = false;
+        e = o->geterror();
+    }
+    return ok ? true : fail(err, RS_OIIO_ERR_WRITE, path, e.empty() ? "write failed" : e);
+}
+
+extern "C" bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)
+{
+    *rgb = nullptr;
+    auto in = ImageInput::open(path);
+    if (!in)
+        return fail(err, RS_OIIO_ERR_READ, path, "cannot read image: " + OIIO::geterror());
+    const ImageSpec &spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
+        return fail(err, RS_OIIO_ERR_FORMAT, path, "not a 2-D image (" + std::to_string(spec.width) + "x" +
+                                         std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
+                                         " channels)");
+    if (spec.width > RS_OIIO_MAX_SIDE || spec.height > RS_OIIO_MAX_SIDE)
+        return fail(err, RS_OIIO_ERR_FORMAT, path, std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                         " is larger than " + std::to_string(RS_OIIO_MAX_SIDE) + "x" +
+                                         std::to_string(RS_OIIO_MAX_SIDE));
+    size_t npix = (size_t)spec.width * (size_t)spec.height;
+    float *p = (float *)std::malloc(npix * 3 * sizeof(float));
+    if (!p)
+        return fail(err, RS_OIIO_ERR_MEMORY, path, "out of memory for " + std::to_string(spec.width) + "x" +
+                                         std::to_string(spec.height) + " RGB floats");
+    int nch = spec.nchannels >= 3 ? 3 : 1;
+    /* x stride of three floats: a grey image lands in the first of each triple */
+    if (!in->read_image(0, 0, 0, nch, TypeDesc::FLOAT, p, 3 * sizeof(float))) {
+        std::string e = in->geterror();
+        std::free(p);
+        return fail(err, RS_OIIO_ERR_READ, path, e.empty() ? "read failed" : e);
+    }
+    if (nch == 1)
+        for (size_t k = 0; k < npix; k++)
+            p[3 * k + 1] = p[3 * k + 2] = p[3 * k];
+    in->close();
+    *w = spec.width;
+    *h = spec.height;
+    *rgb = p;
+    return true;
+}
+
+extern "C" const char *rs_oiio_version(void)
+{
+    static char v[64];
+    std::snprintf(v, sizeof v, "OpenImageIO %s", OIIO_VERSION_STRING);
+    return v;
+}
+
+#endif
+
+extern "C" const char *rs_oiio_error_text(rs_oiio_error e)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        RS_OIIO_ERRORS(X)
+#undef X
+    };
+    return (unsigned)e < RS_OIIO_ERR_COUNT ? text[e] : "unknown OpenImageIO error";
+}
+
+#ifndef RS_HAVE_OIIO
+extern "C" bool rs_oiio_resize(const uint8_t *, int, int, float *, int, int, rs_err *err)
+{
+    rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "this build has no OpenImageIO (install libopenimageio-dev and rebuild)");
+    return false;
+}
+extern "C" bool rs_oiio_write(const char *path, const char *, int, int, const uint8_t *, rs_err *err)
+{
+    rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "%s: this build has no OpenImageIO, so no image sequences", path);
+    return false;
+}
+extern "C" bool rs_oiio_read_float(const char *path, int *, int *, float **rgb, rs_err *err)
+{
+    *rgb = nullptr;
+    rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "%s: built without OpenImageIO, so no image environments (install "
+                                             "libopenimageio-dev and rebuild)", path);
+    return false;
+}
+extern "C" const char *rs_oiio_version(void)
+{
+    return "no OpenImageIO in this build";
+}
+#endif

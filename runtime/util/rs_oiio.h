@@ -1,0 +1,61 @@
+/* rs_oiio: the C face of OpenImageIO (C++ only), runtime/util/rs_oiio.cpp,
+ * the one C++ file in ringside.  It sits in util because both the engine
+ * (IBL environment maps, runtime/render/r_ibl.c) and capture (image
+ * sequences, the accuracy benchmark's reference resize) use it.
+ * Available when configure finds OpenImageIO (RS_HAVE_OIIO); otherwise
+ * every function fails with RS_OIIO_ERR_NOT_BUILT. */
+#ifndef RS_OIIO_H
+#define RS_OIIO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rs_err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RS_OIIO_ERRORS(X)                                                  \
+    X(OK, "ok")                                                            \
+    X(NOT_BUILT, "this build has no OpenImageIO")                          \
+    X(READ, "the image could not be read")                                 \
+    X(WRITE, "the image could not be written")                             \
+    X(FORMAT, "not a 2-D image of a size we accept")                       \
+    X(RESIZE, "the resize failed")                                         \
+    X(MEMORY, "out of memory")
+
+typedef enum rs_oiio_error {
+#define X(id, text) RS_OIIO_ERR_##id,
+    RS_OIIO_ERRORS(X)
+#undef X
+        RS_OIIO_ERR_COUNT
+} rs_oiio_error;
+
+const char *rs_oiio_error_text(rs_oiio_error e);
+
+/* Resizes an RGBA8 image (rows top-down) with ImageBufAlgo::resize and its
+ * default filter for downsizing (lanczos3); out: w*h*4 floats in 0..255. */
+bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err);
+
+/* Writes an RGBA8 image (rows top-down) in the format of the extension
+ * `ext` (".png", ".exr", ".tif") to `path`, whatever path's own name. */
+bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err);
+
+/* Reads the first subimage of an image file as float RGB (rows top-down):
+ * the first three channels, or channel 0 as grey when there are fewer.
+ * *rgb is malloc'd, w*h*3 floats; values are as stored, without colour
+ * conversion (NaN and Inf included: the caller decides).  Images over 16384 x 16384 are
+ * refused so user data cannot make us allocate without bound. */
+#define RS_OIIO_MAX_SIDE 16384
+bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err);
+
+/* "OpenImageIO 2.4.7", or a note that it is not built in. */
+const char *rs_oiio_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
