@@ -59,14 +59,14 @@ bool cap_check_sizes(int sw, int sh, int w, int h, rs_err *err)
 bool cap_check_sizes_for(cap_pixfmt fmt, int sw, int sh, int w, int h, rs_err *err)
 {
     if (w <= 0 || h <= 0 || sw <= 0 || sh <= 0)
-        return rs_fail(err, 1, "sizes must be positive (render %dx%d, output %dx%d)", sw, sh, w, h);
+        return rs_fail(err, CAP_ERR_SIZE, "sizes must be positive (render %dx%d, output %dx%d)", sw, sh, w, h);
     if (fmt == CAP_I420 && ((w | h) & 1))
-        return rs_fail(err, 1, "output size %dx%d: width and height must be even for 4:2:0 video", w, h);
+        return rs_fail(err, CAP_ERR_SIZE, "output size %dx%d: width and height must be even for 4:2:0 video", w, h);
     if (w > sw || h > sh)
-        return rs_fail(err, 1, "output size %dx%d is larger than the render size %dx%d (downscale only)", w, h, sw,
+        return rs_fail(err, CAP_ERR_SIZE, "output size %dx%d is larger than the render size %dx%d (downscale only)", w, h, sw,
                        sh);
     if (sw > w * CAP_MAX_SCALE || sh > h * CAP_MAX_SCALE)
-        return rs_fail(err, 1, "render size %dx%d is more than %d times the output size %dx%d", sw, sh, CAP_MAX_SCALE,
+        return rs_fail(err, CAP_ERR_SIZE, "render size %dx%d is more than %d times the output size %dx%d", sw, sh, CAP_MAX_SCALE,
                        w, h);
     return true;
 }
@@ -91,7 +91,7 @@ static bool make_target(target *t, int w, int h, int n, GLenum ifmt, GLenum fmt,
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE)
-        return rs_fail(err, 1, "capture: %dx%d target incomplete (%s)", w, h, rgl_enum_name(st));
+        return rs_fail(err, CAP_ERR_GL, "capture: %dx%d target incomplete (%s)", w, h, rgl_enum_name(st));
     return true;
 }
 
@@ -197,7 +197,7 @@ static bool map_oldest(cap *c)
     c->fence[i] = 0;
     c->mapped++;
     if (r == GL_WAIT_FAILED) {
-        rs_fail(&c->err, 1, "capture: waiting for a readback fence failed (GL error)");
+        rs_fail(&c->err, CAP_ERR_GL, "capture: waiting for a readback fence failed (GL error)");
         return false;
     }
     uint8_t *slot = cap_writer_acquire(c->writer); /* may wait on a full queue: the writer counts it */
@@ -214,7 +214,7 @@ static bool map_oldest(cap *c)
     c->st.ms_map_copy += (rs_now() - t1) * 1e3;
     if (!p) { /* never hand a stale slot to the writer */
         cap_writer_cancel(c->writer, slot);
-        rs_fail(&c->err, 1, "capture: mapping a pixel buffer of %zu bytes failed (GL error)", c->frame_bytes);
+        rs_fail(&c->err, CAP_ERR_GL, "capture: mapping a pixel buffer of %zu bytes failed (GL error)", c->frame_bytes);
         return false;
     }
     return cap_writer_submit(c->writer, slot);
@@ -224,7 +224,7 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
 {
     cap *c = calloc(1, sizeof *c);
     if (!c) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, CAP_ERR_NOMEM, "out of memory");
         return NULL;
     }
     c->d = *desc;
@@ -243,7 +243,7 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
     if (!cap_check_sizes_for(c->fmt, c->d.src_w, c->d.src_h, c->d.w, c->d.h, err))
         goto fail;
     if (c->d.pbo < 1 || c->d.pbo > CAP_MAX_PBO) {
-        rs_fail(err, 1, "PBO ring of %d: expected 1..%d", c->d.pbo, CAP_MAX_PBO);
+        rs_fail(err, CAP_ERR_ARG, "PBO ring of %d: expected 1..%d", c->d.pbo, CAP_MAX_PBO);
         goto fail;
     }
     if (c->gpu && !gpu_setup(c, err))
@@ -253,7 +253,7 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
         c->small = malloc((size_t)c->d.w * c->d.h * 4);
         c->direct = malloc(c->frame_bytes);
         if (!c->full || !c->small || !c->direct) {
-            rs_fail(err, 1, "out of memory for capture buffers");
+            rs_fail(err, CAP_ERR_NOMEM, "out of memory for capture buffers");
             goto fail;
         }
         gl.GenFramebuffers(1, &c->read_fbo);
@@ -371,7 +371,7 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err)
     /* the hash list belongs to this output: it must be whole before the output is committed */
     if (wok && c->d.hashes && (fflush(c->d.hashes) != 0 || ferror(c->d.hashes))) {
         wok = false;
-        rs_fail(&werr, 1, "the frame hash list: write failed");
+        rs_fail(&werr, CAP_ERR_WRITE, "the frame hash list: write failed");
     }
     bool good = ok && !c->failed && wok;
     rs_err cerr = {0};
@@ -386,7 +386,7 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err)
         else if (good && !cok)
             *err = cerr;
         else if (!good || !cok)
-            rs_fail(err, 1, "capture failed");
+            rs_fail(err, CAP_ERR_FAILED, "capture failed");
     }
     c->st.high_water = ws.high_water;
     c->st.ms_write = ws.write_ms;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "../runtime/util/rs_file.h"
+#include "cap_sink.h" /* CAP_ERRORS */
 
 bool cap_out_is_stream(const char *path)
 {
@@ -20,13 +21,16 @@ bool cap_out_open(cap_out *o, const char *path, rs_err *err)
     o->device = cap_out_is_stream(path);
     struct stat st;
     if (!o->device && stat(path, &st) == 0 && !S_ISREG(st.st_mode))
-        return rs_fail(err, 1, "%s: exists and is not a regular file (nor a device or pipe to stream to)", path);
+        return rs_fail(err, CAP_ERR_CREATE, "%s: exists and is not a regular file (nor a device or pipe to stream to)", path);
     snprintf(o->tmp, sizeof o->tmp, o->device ? "%s" : "%s.part", path);
-    if (!o->device && !rs_mkdirs_for(path, err))
+    if (!o->device && !rs_mkdirs_for(path, err)) {
+        if (err)
+            err->code = CAP_ERR_CREATE; /* rs_file's failure, as one of ours */
         return false;
+    }
     o->f = fopen(o->tmp, "wb");
     if (!o->f)
-        return rs_fail(err, 1, "%s: cannot create: %s", o->tmp, strerror(errno));
+        return rs_fail(err, CAP_ERR_CREATE, "%s: cannot create: %s", o->tmp, strerror(errno));
     setvbuf(o->f, NULL, _IOFBF, 1 << 20);
     return true;
 }
@@ -35,7 +39,7 @@ bool cap_out_write(cap_out *o, const void *data, size_t n, rs_err *err)
 {
     errno = 0;
     if (fwrite(data, 1, n, o->f) != n)
-        return rs_fail(err, 1, "%s: write failed: %s", o->path, strerror(errno ? errno : EIO));
+        return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", o->path, strerror(errno ? errno : EIO));
     return true;
 }
 
@@ -59,12 +63,12 @@ bool cap_out_close(cap_out *o, bool ok, rs_err *err)
         if (!good) {
             if (!o->device)
                 unlink(o->tmp);
-            return rs_fail(err, 1, "%s: write failed: %s", o->path, strerror(e ? e : EIO));
+            return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", o->path, strerror(e ? e : EIO));
         }
         if (!o->device && rename(o->tmp, o->path) != 0) {
             e = errno;
             unlink(o->tmp);
-            return rs_fail(err, 1, "%s: cannot rename %s into place: %s", o->path, o->tmp, strerror(e));
+            return rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename %s into place: %s", o->path, o->tmp, strerror(e));
         }
         return true;
     }

@@ -1,4 +1,5 @@
 #include "cap_scale.h"
+#include "cap_sink.h" /* CAP_ERRORS */
 
 #include <stdlib.h>
 #include <string.h>
@@ -34,7 +35,7 @@ cap_scaler *cap_scaler_create(cap_filter f, int sw, int sh, int w, int h, rs_err
 {
     cap_scaler *s = calloc(1, sizeof *s);
     if (!s) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, CAP_ERR_NOMEM, "out of memory");
         return NULL;
     }
     *s = (cap_scaler){.f = f, .sw = sw, .sh = sh, .w = w, .h = h};
@@ -60,7 +61,7 @@ cap_scaler *cap_scaler_create(cap_filter f, int sw, int sh, int w, int h, rs_err
         GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
         if (st != GL_FRAMEBUFFER_COMPLETE) {
-            rs_fail(err, 1, "lanczos3: RGBA16F %dx%d target incomplete (%s)", w, sh, rgl_enum_name(st));
+            rs_fail(err, CAP_ERR_GL, "lanczos3: RGBA16F %dx%d target incomplete (%s)", w, sh, rgl_enum_name(st));
             cap_scaler_destroy(s);
             return NULL;
         }

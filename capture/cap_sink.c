@@ -37,6 +37,16 @@ const char *cap_sink_formats(void)
 #endif
 }
 
+const char *cap_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        CAP_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_CAP, text, (int)(sizeof text / sizeof text[0]));
+}
+
 bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err)
 {
     memset(s, 0, sizeof *s);
@@ -48,14 +58,14 @@ bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err)
     const char *iext;
     if (strchr(path, '%')) {
         if (!cap_images_pattern_ok(path, &iext))
-            return rs_fail(err, 1, "%s: an image sequence needs one %%d or %%0Nd (two digits at most) in the file name and .png, .exr or .tif (e.g. frame%%06d.png)",
+            return rs_fail(err, CAP_ERR_OUTPUT, "%s: an image sequence needs one %%d or %%0Nd (two digits at most) in the file name and .png, .exr or .tif (e.g. frame%%06d.png)",
                            path);
 #ifdef RS_HAVE_OIIO
         s->ops = &cap_sink_images;
         s->fmt = CAP_RGBA;
         return true;
 #else
-        return rs_fail(err, 1, "%s: this build has no OpenImageIO, so no image sequences (use .y4m)", path);
+        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this build has no OpenImageIO, so no image sequences (use .y4m)", path);
 #endif
     }
     if (!strcmp(path, "null:")) {
@@ -71,8 +81,8 @@ bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err)
         s->ops = &cap_sink_ffmpeg;
         return cap_ffmpeg_check(path, ext, err);
 #else
-        return rs_fail(err, 1, "%s: this build has no FFmpeg libraries, so no %s output (use .y4m)", path, ext);
+        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this build has no FFmpeg libraries, so no %s output (use .y4m)", path, ext);
 #endif
     }
-    return rs_fail(err, 1, "%s: unknown output type '%s' (this build writes %s)", path, ext, cap_sink_formats());
+    return rs_fail(err, CAP_ERR_OUTPUT, "%s: unknown output type '%s' (this build writes %s)", path, ext, cap_sink_formats());
 }

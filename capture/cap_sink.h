@@ -13,6 +13,30 @@
 
 #include "../runtime/util/rs_err.h"
 
+/* Error ids (rs_err.h) of the whole capture pipeline: sizes, sinks,
+ * outputs, the writer and the GL readback. */
+#define CAP_ERRORS(X)                                                                                  \
+    X(SIZE, "bad sizes: not positive, odd for 4:2:0, or not a downscale of at most 8x")               \
+    X(ARG, "a bad capture setting (PBO ring size) or a sink used before it was opened")               \
+    X(OUTPUT, "unknown output type, or an image-sequence name without a frame number")                \
+    X(NOT_BUILT, "this build (or its FFmpeg) cannot write that kind of output")                        \
+    X(CREATE, "cannot create the output (not a regular file, no directory, no permission)")           \
+    X(WRITE, "writing the output or the frame hash list failed (disk full, I/O error, rename)")       \
+    X(ENCODER, "the encoder or the container refused the frames")                                     \
+    X(GL, "the GL side of capture failed (target incomplete, fence or mapping)")                      \
+    X(NOMEM, "out of memory, or no writer thread")                                                     \
+    X(FAILED, "the capture was closed as failed with no more precise reason")
+
+typedef enum cap_error {
+    CAP_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_CAP),
+#define X(id, text) CAP_ERR_##id,
+    CAP_ERRORS(X)
+#undef X
+        CAP_ERR_END
+} cap_error;
+
+const char *cap_error_text(int code);
+
 /* Frame layouts a sink can take. */
 typedef enum cap_pixfmt {
     CAP_I420, /* planar Y, then Cb, then Cr at half size: BT.709 limited range, chroma sited at the centre */

@@ -38,21 +38,21 @@ static const char *ext_of(const char *path)
     return dot ? dot : "";
 }
 
-static int fail_av(rs_err *err, const char *path, const char *what, int code)
+static int fail_av(rs_err *err, int id, const char *path, const char *what, int code)
 {
     char msg[AV_ERROR_MAX_STRING_SIZE] = "";
     av_strerror(code, msg, sizeof msg);
-    return rs_fail(err, 1, "%s: %s: %s", path, what, msg);
+    return rs_fail(err, id, "%s: %s: %s", path, what, msg);
 }
 
 bool cap_ffmpeg_check(const char *path, const char *ext, rs_err *err)
 {
     av_log_set_level(AV_LOG_ERROR); /* encoder statistics are noise on our stderr */
     if (!avcodec_find_encoder_by_name(encoder_name(ext)))
-        return rs_fail(err, 1, "%s: this FFmpeg has no %s encoder for %s output (use .y4m, or an FFmpeg built with it)",
+        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this FFmpeg has no %s encoder for %s output (use .y4m, or an FFmpeg built with it)",
                        path, encoder_name(ext), ext);
     if (!av_guess_format(container(ext), NULL, NULL))
-        return rs_fail(err, 1, "%s: this FFmpeg has no %s muxer", path, container(ext));
+        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this FFmpeg has no %s muxer", path, container(ext));
     return true;
 }
 
@@ -63,13 +63,13 @@ static bool drain(cap_sink *s, ff_impl *f, rs_err *err)
         if (r == AVERROR(EAGAIN) || r == AVERROR_EOF)
             return true;
         if (r < 0)
-            return fail_av(err, s->path, "encoder", r);
+            return fail_av(err, CAP_ERR_ENCODER, s->path, "encoder", r);
         f->pkt->duration = 1; /* one frame, in the encoder's 1/60 */
         av_packet_rescale_ts(f->pkt, f->enc->time_base, f->st->time_base);
         f->pkt->stream_index = f->st->index;
         r = av_interleaved_write_frame(f->fmt, f->pkt); /* takes the packet's reference */
         if (r < 0)
-            return fail_av(err, s->path, "write failed", r);
+            return fail_av(err, CAP_ERR_WRITE, s->path, "write failed", r);
     }
 }
 
@@ -79,14 +79,14 @@ static bool ff_open(cap_sink *s, rs_err *err)
 {
     ff_impl *f = calloc(1, sizeof *f);
     if (!f)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, CAP_ERR_NOMEM, "out of memory");
     s->impl = f;
     const char *ext = ext_of(s->path);
     snprintf(f->part, sizeof f->part, "%s.part", s->path);
     const AVCodec *codec = avcodec_find_encoder_by_name(encoder_name(ext));
     int r = avformat_alloc_output_context2(&f->fmt, NULL, container(ext), f->part);
     if (r < 0 || !codec) {
-        fail_av(err, s->path, "cannot set up the container", r < 0 ? r : AVERROR_ENCODER_NOT_FOUND);
+        fail_av(err, CAP_ERR_ENCODER, s->path, "cannot set up the container", r < 0 ? r : AVERROR_ENCODER_NOT_FOUND);
         goto fail;
     }
     f->st = avformat_new_stream(f->fmt, NULL);
@@ -94,7 +94,7 @@ static bool ff_open(cap_sink *s, rs_err *err)
     f->frame = av_frame_alloc();
     f->pkt = av_packet_alloc();
     if (!f->st || !f->enc || !f->frame || !f->pkt) {
-        rs_fail(err, 1, "%s: out of memory", s->path);
+        rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", s->path);
         goto fail;
     }
     AVCodecContext *e = f->enc;
@@ -121,25 +121,25 @@ static bool ff_open(cap_sink *s, rs_err *err)
     if (f->fmt->oformat->flags & AVFMT_GLOBALHEADER)
         e->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
     if ((r = avcodec_open2(e, codec, NULL)) < 0) {
-        fail_av(err, s->path, "cannot open the encoder", r);
+        fail_av(err, CAP_ERR_ENCODER, s->path, "cannot open the encoder", r);
         goto fail;
     }
     avcodec_parameters_from_context(f->st->codecpar, e);
     f->st->time_base = e->time_base;
     f->st->avg_frame_rate = e->framerate;
     if ((r = avio_open(&f->fmt->pb, f->part, AVIO_FLAG_WRITE)) < 0) {
-        fail_av(err, f->part, "cannot create", r);
+        fail_av(err, CAP_ERR_CREATE, f->part, "cannot create", r);
         goto fail;
     }
     if ((r = avformat_write_header(f->fmt, NULL)) < 0) {
-        fail_av(err, s->path, "cannot write the header", r);
+        fail_av(err, CAP_ERR_WRITE, s->path, "cannot write the header", r);
         goto fail;
     }
     f->frame->format = e->pix_fmt;
     f->frame->width = s->w;
     f->frame->height = s->h;
     if ((r = av_frame_get_buffer(f->frame, 0)) < 0) {
-        fail_av(err, s->path, "frame buffer", r);
+        fail_av(err, CAP_ERR_NOMEM, s->path, "frame buffer", r);
         goto fail;
     }
     return true;
@@ -153,7 +153,7 @@ static bool ff_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *
     ff_impl *f = s->impl;
     int r = av_frame_make_writable(f->frame);
     if (r < 0)
-        return fail_av(err, s->path, "frame buffer", r);
+        return fail_av(err, CAP_ERR_NOMEM, s->path, "frame buffer", r);
     const uint8_t *plane = frame;
     for (int p = 0; p < 3; p++) {
         int pw = p ? s->w / 2 : s->w, ph = p ? s->h / 2 : s->h;
@@ -165,7 +165,7 @@ static bool ff_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *
     if ((r = avcodec_send_frame(f->enc, f->frame)) < 0) {
         char what[64];
         snprintf(what, sizeof what, "encoding frame %llu", (unsigned long long)index);
-        return fail_av(err, s->path, what, r);
+        return fail_av(err, CAP_ERR_ENCODER, s->path, what, r);
     }
     return drain(s, f, err);
 }
@@ -179,20 +179,20 @@ static bool ff_close(cap_sink *s, bool ok, rs_err *err)
     if (good) {
         int r = avcodec_send_frame(f->enc, NULL); /* flush delayed frames */
         if (r < 0 && r != AVERROR_EOF)
-            good = fail_av(err, s->path, "flushing the encoder", r);
+            good = fail_av(err, CAP_ERR_ENCODER, s->path, "flushing the encoder", r);
         else
             good = drain(s, f, err);
         if (good && (r = av_write_trailer(f->fmt)) < 0)
-            good = fail_av(err, s->path, "write failed", r);
+            good = fail_av(err, CAP_ERR_WRITE, s->path, "write failed", r);
     }
     if (f->fmt && f->fmt->pb) {
         int perr = f->fmt->pb->error;
         avio_closep(&f->fmt->pb);
         if (good && perr < 0)
-            good = fail_av(err, s->path, "write failed", perr);
+            good = fail_av(err, CAP_ERR_WRITE, s->path, "write failed", perr);
     }
     if (good && rename(f->part, s->path) != 0)
-        good = rs_fail(err, 1, "%s: cannot rename %s into place", s->path, f->part);
+        good = rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename %s into place", s->path, f->part);
     if (!good)
         unlink(f->part);
     av_packet_free(&f->pkt);

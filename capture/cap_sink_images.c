@@ -48,16 +48,20 @@ static bool img_open(cap_sink *s, rs_err *err)
     seq *q = calloc(1, sizeof *q);
     const char *ext;
     if (!q)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, CAP_ERR_NOMEM, "out of memory");
     if (!cap_images_pattern_ok(s->path, &ext)) {
         free(q);
-        return rs_fail(err, 1, "%s: expected an image sequence pattern like name%%06d.png", s->path);
+        return rs_fail(err, CAP_ERR_OUTPUT, "%s: expected an image sequence pattern like name%%06d.png", s->path);
     }
     snprintf(q->ext, sizeof q->ext, "%s", ext);
     s->impl = q;
     char first[1100];
     frame_path(s, 0, first, sizeof first);
-    return rs_mkdirs_for(first, err);
+    if (rs_mkdirs_for(first, err))
+        return true;
+    if (err)
+        err->code = CAP_ERR_CREATE; /* rs_file's failure, as one of ours */
+    return false;
 }
 
 static bool img_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *err)
@@ -67,15 +71,15 @@ static bool img_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err 
     frame_path(s, index, path, sizeof path);
     snprintf(part, sizeof part, "%s.part", path);
     if (!q)
-        return rs_fail(err, 1, "%s: the image sequence is not open", path);
+        return rs_fail(err, CAP_ERR_ARG, "%s: the image sequence is not open", path);
     rs_err oerr = {0};
     if (!rs_oiio_write(part, q->ext, s->w, s->h, frame, &oerr)) {
         unlink(part);
-        return rs_fail(err, 1, "%s", oerr.msg);
+        return rs_fail(err, CAP_ERR_WRITE, "%s", oerr.msg);
     }
     if (rename(part, path) != 0) {
         unlink(part);
-        return rs_fail(err, 1, "%s: cannot rename into place", path);
+        return rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename into place", path);
     }
     s->frames = index + 1;
     return true;

@@ -10,7 +10,7 @@ static bool y4m_open(cap_sink *s, rs_err *err)
 {
     cap_out *o = calloc(1, sizeof *o);
     if (!o)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, CAP_ERR_NOMEM, "out of memory");
     if (!cap_out_open(o, s->path, err)) {
         free(o);
         return false;

@@ -50,7 +50,7 @@ static bool write_one(cap_writer *w, const uint8_t *frame, uint64_t index, rs_er
     double t0 = rs_now();
     if (w->hashes && fprintf(w->hashes, "%llu %016llx\n", (unsigned long long)(index + w->sink->index_base),
                              (unsigned long long)rs_fnv1a64(frame, w->frame_bytes)) < 0)
-        return rs_fail(err, 1, "writing the frame hash list failed at frame %llu",
+        return rs_fail(err, CAP_ERR_WRITE, "writing the frame hash list failed at frame %llu",
                        (unsigned long long)(index + w->sink->index_base));
     bool ok = w->sink->ops->write(w->sink, frame, index, err);
     w->st.write_ms += (rs_now() - t0) * 1e3;
@@ -94,7 +94,7 @@ cap_writer *cap_writer_start(cap_sink *sink, size_t frame_bytes, int queue_cap, 
 {
     cap_writer *w = calloc(1, sizeof *w);
     if (!w) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, CAP_ERR_NOMEM, "out of memory");
         return NULL;
     }
     w->sink = sink;
@@ -106,7 +106,7 @@ cap_writer *cap_writer_start(cap_sink *sink, size_t frame_bytes, int queue_cap, 
     w->free_stack = malloc(sizeof(uint8_t *) * (size_t)w->nslots);
     w->ready = malloc(sizeof(uint8_t *) * (size_t)w->nslots);
     if (!w->mem || !w->free_stack || !w->ready) {
-        rs_fail(err, 1, "out of memory for %d frame slots of %zu bytes", w->nslots, frame_bytes);
+        rs_fail(err, CAP_ERR_NOMEM, "out of memory for %d frame slots of %zu bytes", w->nslots, frame_bytes);
         goto fail;
     }
     for (int i = 0; i < w->nslots; i++)
@@ -115,7 +115,7 @@ cap_writer *cap_writer_start(cap_sink *sink, size_t frame_bytes, int queue_cap, 
     pthread_cond_init(&w->cv_free, NULL);
     pthread_cond_init(&w->cv_ready, NULL);
     if (w->threaded && pthread_create(&w->thread, NULL, writer_main, w) != 0) {
-        rs_fail(err, 1, "cannot start the writer thread");
+        rs_fail(err, CAP_ERR_NOMEM, "cannot start the writer thread");
         pthread_mutex_destroy(&w->mu);
         pthread_cond_destroy(&w->cv_free);
         pthread_cond_destroy(&w->cv_ready);

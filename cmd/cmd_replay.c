@@ -99,7 +99,7 @@ static int verify(const char *path, const char *hashes_path, bool quiet)
     bool ran = rp_verify(&rp, hf, on_progress, &prog, &res, &err);
     double secs = rs_progress_end(&prog);
     if (hf && hf != stdout && fclose(hf) != 0 && ran)
-        ran = rs_fail(&err, RP_ERR_IO, "%s: write failed", hashes_path);
+        ran = rs_fail(&err, RP_ERR_WRITE, "%s: write failed", hashes_path);
     int status = RS_EXIT_FAIL;
     if (!ran) {
         cli_error("replay", "%s: %s", path, err.msg);

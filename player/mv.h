@@ -25,14 +25,26 @@ enum { MV_BT601 = 0, MV_BT709 = 1 };
  * TOPLEFT on even columns and even rows (DV PAL; Y4M 420paldv) */
 enum { MV_CHROMA_CENTER = 0, MV_CHROMA_LEFT = 1, MV_CHROMA_TOPLEFT = 2 };
 
-enum {
-    MV_ERR_OPEN = 1, /* cannot open or read the file */
-    MV_ERR_FORMAT,   /* not a movie we understand: bad header, bad tag */
-    MV_ERR_UNSUPPORTED, /* valid, but a format we do not play (10-bit, alpha, ...) */
-    MV_ERR_TRUNCATED,   /* the file ends inside a frame */
-    MV_ERR_DECODE,      /* the decoder failed mid-stream */
-    MV_ERR_NOMEM,
-};
+/* Error ids (rs_err.h) of every movie source, the decoder thread and the
+ * uploader. */
+#define MV_ERRORS(X)                                                                       \
+    X(OPEN, "cannot open or read the file")                                                \
+    X(FORMAT, "not a movie we understand: bad header, bad tag, bad size")                  \
+    X(UNSUPPORTED, "a valid movie in a format we do not play (10-bit, alpha, interlaced)") \
+    X(TRUNCATED, "the file ends inside a frame")                                           \
+    X(DECODE, "the decoder failed mid-stream")                                             \
+    X(NOMEM, "out of memory, or no thread to decode with")                                 \
+    X(ARG, "a bad argument from the caller (slot count)")
+
+typedef enum mv_error {
+    MV_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_MV),
+#define X(id, text) MV_ERR_##id,
+    MV_ERRORS(X)
+#undef X
+        MV_ERR_END
+} mv_error;
+
+const char *mv_error_text(int code);
 
 typedef struct mv_info {
     int w, h;             /* luma size, >= 1 */

@@ -88,7 +88,7 @@ static void *run(void *arg)
 mv_dec *mv_dec_start(mv_src *src, uint8_t *const *slots, int nslots, rs_err *err)
 {
     if (nslots < 1 || nslots > MV_DEC_MAX_SLOTS) {
-        rs_fail(err, MV_ERR_NOMEM, "decoder: %d slots (1..%d)", nslots, MV_DEC_MAX_SLOTS);
+        rs_fail(err, MV_ERR_ARG, "decoder: %d slots (1..%d)", nslots, MV_DEC_MAX_SLOTS);
         return NULL;
     }
     mv_dec *d = calloc(1, sizeof *d);

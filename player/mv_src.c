@@ -5,6 +5,16 @@
 
 #include "mv.h"
 
+const char *mv_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        MV_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_MV, text, (int)(sizeof text / sizeof text[0]));
+}
+
 void mv_info_planes(mv_info *i)
 {
     if (i->mono) {

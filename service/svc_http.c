@@ -28,15 +28,44 @@
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_version.h"
 
-/* --- upload checks and Range parsing: plain functions, unit-tested --- */
+/* --- error ids, upload checks and Range parsing: plain functions, unit-tested --- */
+
+const char *svc_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        SVC_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_SVC, text, (int)(sizeof text / sizeof text[0]));
+}
+
+/* The one place where an error becomes an HTTP status. */
+static const struct {
+    int id;
+    unsigned short status;
+} http_status[] = {
+    {SVC_ERR_EMPTY, 400},     {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
+    {SVC_ERR_BAD_BODY, 400},  {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
+    {SVC_ERR_GONE, 410},      {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
+    {SVC_ERR_NOMEM, 500},
+};
+
+unsigned svc_http_status(int code)
+{
+    for (size_t i = 0; i < sizeof http_status / sizeof http_status[0]; i++)
+        if (http_status[i].id == code)
+            return http_status[i].status;
+    return RS_ERR_MODULE(code) == RS_ERR_MOD_SVC_STORE ? 503 : 500;
+}
 
 bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, const char *name, svc_job *j,
                       rs_err *err)
 {
     if (len == 0)
-        return rs_fail(err, 400, "empty upload: send the replay file (.rsr) as the request body");
+        return rs_fail(err, SVC_ERR_EMPTY, "empty upload: send the replay file (.rsr) as the request body");
     if (len > (size_t)cfg->max_upload)
-        return rs_fail(err, 413, "%s: %zu bytes is over the upload limit of %ld bytes", name, len, cfg->max_upload);
+        return rs_fail(err, SVC_ERR_TOO_LARGE, "%s: %zu bytes is over the upload limit of %ld bytes", name, len, cfg->max_upload);
     /* the tick count (byte 20) first: a small file can declare days of
      * run-length coded play, and decoding it would allocate 2 bytes a tick */
     if (len >= 28 && !memcmp(data, RP_MAGIC, 4)) {
@@ -44,21 +73,21 @@ bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, co
         for (int k = 0; k < 8; k++)
             ticks |= (uint64_t)data[20 + k] << (8 * k);
         if (ticks > (uint64_t)cfg->max_seconds * 60 && ticks <= RP_MAX_TICKS)
-            return rs_fail(err, 400, "%s: the replay lasts %llu s; this service renders at most %d s (max_seconds)",
+            return rs_fail(err, SVC_ERR_TOO_LONG, "%s: the replay lasts %llu s; this service renders at most %d s (max_seconds)",
                            name, (unsigned long long)((ticks + 59) / 60), cfg->max_seconds);
     }
     rp_replay rp = {0};
     rs_err perr = {0};
     if (!rp_decode(data, len, name, &rp, &perr))
-        return rs_fail(err, 400, "%s", perr.msg);
+        return rs_fail(err, SVC_ERR_REPLAY, "%s", perr.msg);
     j->frames_total = (int64_t)rp.ticks;
     rp_free(&rp);
     if (j->frames_total == 0)
-        return rs_fail(err, 400, "%s: the replay has no ticks: nothing to render", name);
+        return rs_fail(err, SVC_ERR_REPLAY, "%s: the replay has no ticks: nothing to render", name);
     /* a small file can describe days of play (inputs are run-length coded):
      * one job must not hold a worker for that long */
     if (j->frames_total > (int64_t)cfg->max_seconds * 60)
-        return rs_fail(err, 400, "%s: the replay lasts %lld s; this service renders at most %d s (max_seconds)", name,
+        return rs_fail(err, SVC_ERR_TOO_LONG, "%s: the replay lasts %lld s; this service renders at most %d s (max_seconds)", name,
                        (long long)((j->frames_total + 59) / 60), cfg->max_seconds);
     return true;
 }
@@ -144,8 +173,9 @@ static enum MHD_Result reply_json(struct MHD_Connection *c, unsigned status, svc
     return r;
 }
 
-static enum MHD_Result reply_error(struct MHD_Connection *c, unsigned status, const char *fmt, ...) RS_PRINTF(3, 4);
-static enum MHD_Result reply_error(struct MHD_Connection *c, unsigned status, const char *fmt, ...)
+/* An error answer: the status comes from the error id (svc_http_status). */
+static enum MHD_Result reply_error(struct MHD_Connection *c, int id, const char *fmt, ...) RS_PRINTF(3, 4);
+static enum MHD_Result reply_error(struct MHD_Connection *c, int id, const char *fmt, ...)
 {
     char msg[1024];
     va_list ap;
@@ -154,7 +184,7 @@ static enum MHD_Result reply_error(struct MHD_Connection *c, unsigned status, co
     va_end(ap);
     svc_buf b = {0};
     svc_json_error(&b, msg);
-    return reply_json(c, status, &b);
+    return reply_json(c, svc_http_status(id), &b);
 }
 
 static bool append(req *q, const char *data, size_t n, long limit)
@@ -245,9 +275,8 @@ static bool parse_id(const char *s, size_t n, int64_t *id)
 }
 
 /* A refused upload: counted for /metrics, logged, answered. */
-static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, unsigned status, const char *fmt, ...)
-    RS_PRINTF(4, 5);
-static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, unsigned status, const char *fmt, ...)
+static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, int id, const char *fmt, ...) RS_PRINTF(4, 5);
+static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, int id, const char *fmt, ...)
 {
     char msg[1024];
     va_list ap;
@@ -257,18 +286,18 @@ static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, unsigned 
     pthread_mutex_lock(&d->mu);
     d->uploads_rejected++;
     pthread_mutex_unlock(&d->mu);
-    svc_log(SVC_LOG_INFO, -1, "upload refused (%u): %s", status, msg);
-    return reply_error(c, status, "%s", msg);
+    svc_log(SVC_LOG_INFO, -1, "upload refused (%u): %s", svc_http_status(id), msg);
+    return reply_error(c, id, "%s", msg);
 }
 
 static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     if (q->oom)
-        return reply_error(c, 500, "out of memory reading the upload");
+        return reply_error(c, SVC_ERR_NOMEM, "out of memory reading the upload");
     if (q->bad)
-        return reject(d, c, 400, "%s", q->bad);
+        return reject(d, c, SVC_ERR_BAD_BODY, "%s", q->bad);
     if (q->too_large)
-        return reject(d, c, 413, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
+        return reject(d, c, SVC_ERR_TOO_LARGE, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
     const char *v;
     if (!q->size[0] && (v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "size")))
         snprintf(q->size, sizeof q->size, "%s", v);
@@ -290,28 +319,28 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         long w, h;
         char x, extra;
         if (sscanf(q->size, "%ld%c%ld%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
-            return reject(d, c, 400, "size '%s': expected WxH, such as 640x360", q->size);
+            return reject(d, c, SVC_ERR_BAD_PARAM, "size '%s': expected WxH, such as 640x360", q->size);
         if (w < 16 || h < 16 || w > d->cfg.max_width || h > d->cfg.max_height || (w | h) & 1)
-            return reject(d, c, 400, "size %ldx%ld: each side must be even, at least 16 and at most %dx%d", w, h,
+            return reject(d, c, SVC_ERR_BAD_PARAM, "size %ldx%ld: each side must be even, at least 16 and at most %dx%d", w, h,
                                d->cfg.max_width, d->cfg.max_height);
         j.width = (int)w, j.height = (int)h;
         rs_err serr = {0};
         if (!cap_check_sizes_for(CAP_I420, d->cfg.render_width, d->cfg.render_height, j.width, j.height, &serr))
-            return reject(d, c, 400, "size %s: %s", q->size, serr.msg);
+            return reject(d, c, SVC_ERR_BAD_PARAM, "size %s: %s", q->size, serr.msg);
     }
     if (q->format[0]) {
         if (strcmp(q->format, "mp4") && strcmp(q->format, "webm") && strcmp(q->format, "mkv"))
-            return reject(d, c, 400, "format '%s': expected mp4, webm or mkv", q->format);
+            return reject(d, c, SVC_ERR_BAD_PARAM, "format '%s': expected mp4, webm or mkv", q->format);
         snprintf(j.format, sizeof j.format, "%s", q->format);
     }
     rs_err err = {0};
     if (!svc_check_upload(&d->cfg, q->body, q->len, j.name, &j, &err))
-        return reject(d, c, (unsigned)err.code, "%s", err.msg);
+        return reject(d, c, err.code, "%s", err.msg);
     j.replay = q->body;
     j.replay_len = q->len;
     if (!d->http_store->ops->submit(d->http_store, &j, &err)) {
         svc_log(SVC_LOG_ERROR, -1, "could not queue an upload: %s", err.msg);
-        return reply_error(c, 503, "the queue is unavailable: %s", err.msg);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     }
     svc_log(SVC_LOG_INFO, j.id, "queued %s (%zu bytes, %" PRId64 " frames, %dx%d %s)", j.name, q->len, j.frames_total,
             j.width, j.height, j.format);
@@ -354,9 +383,9 @@ static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, int64
     rs_err err = {0};
     int r = d->http_store->ops->get(d->http_store, id, &j, &err);
     if (r < 0)
-        return reply_error(c, 503, "the queue is unavailable: %s", err.msg);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     if (r == 0)
-        return reply_error(c, 404, "no job %" PRId64, id);
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
     overlay_live(d, &j);
     svc_buf b = {0};
     svc_json_job(&b, &j, d->cfg.max_attempts);
@@ -370,20 +399,20 @@ static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
     int64_t before = 0, lim;
     const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "limit");
     if (v && (!parse_id(v, strlen(v), &lim) || lim > 500))
-        return reply_error(c, 400, "limit '%s': expected 1..500", v);
+        return reply_error(c, SVC_ERR_BAD_PARAM, "limit '%s': expected 1..500", v);
     if (v)
         limit = (long)lim;
     v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "before");
     if (v && !parse_id(v, strlen(v), &before))
-        return reply_error(c, 400, "before '%s': expected a job id", v);
+        return reply_error(c, SVC_ERR_BAD_PARAM, "before '%s': expected a job id", v);
     svc_job *jobs = calloc((size_t)limit, sizeof *jobs);
     if (!jobs)
-        return reply_error(c, 500, "out of memory");
+        return reply_error(c, SVC_ERR_NOMEM, "out of memory");
     rs_err err = {0};
     int n = d->http_store->ops->list(d->http_store, before, (int)limit, jobs, &err);
     if (n < 0) {
         free(jobs);
-        return reply_error(c, 503, "the queue is unavailable: %s", err.msg);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     }
     svc_buf b = {0};
     svc_buf_add(&b, "{\"jobs\":[", 9);
@@ -406,13 +435,13 @@ static enum MHD_Result do_cancel(svc_daemon *d, struct MHD_Connection *c, int64_
     rs_err err = {0};
     int r = d->http_store->ops->cancel(d->http_store, id, &err);
     if (r < 0)
-        return reply_error(c, 503, "the queue is unavailable: %s", err.msg);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     if (r == 0)
-        return reply_error(c, 404, "no job %" PRId64, id);
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
     if (r == 2) {
         svc_job j;
         const char *st = d->http_store->ops->get(d->http_store, id, &j, &err) == 1 ? svc_state_name(j.state) : "over";
-        return reply_error(c, 409, "job %" PRId64 " is already %s", id, st);
+        return reply_error(c, SVC_ERR_CONFLICT, "job %" PRId64 " is already %s", id, st);
     }
     svc_log(SVC_LOG_INFO, id, "cancelled by a client");
     return do_get_job(d, c, id);
@@ -424,11 +453,11 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, int64_t 
     rs_err err = {0};
     int r = d->http_store->ops->get(d->http_store, id, &j, &err);
     if (r < 0)
-        return reply_error(c, 503, "the queue is unavailable: %s", err.msg);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     if (r == 0)
-        return reply_error(c, 404, "no job %" PRId64, id);
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
     if (j.state != SVC_DONE)
-        return reply_error(c, 404, "job %" PRId64 " is %s: its %s exists once it is done", id, svc_state_name(j.state),
+        return reply_error(c, SVC_ERR_NOT_FOUND, "job %" PRId64 " is %s: its %s exists once it is done", id, svc_state_name(j.state),
                            video ? "video" : "hash list");
     char path[1100];
     if (video)
@@ -442,7 +471,7 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, int64_t 
         if (fd >= 0)
             close(fd);
         svc_log(SVC_LOG_WARN, id, "%s: %s (a shared output directory not mounted here?)", path, strerror(e));
-        return reply_error(c, 410, "job %" PRId64 " is done but %s is missing on this server", id, path);
+        return reply_error(c, SVC_ERR_GONE, "job %" PRId64 " is done but %s is missing on this server", id, path);
     }
     uint64_t len = (uint64_t)st.st_size, first = 0, last = len ? len - 1 : 0;
     int rr = video ? svc_parse_range(MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Range"), len, &first, &last) : 0;
@@ -452,7 +481,7 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, int64_t 
         char cr[64];
         snprintf(cr, sizeof cr, "bytes */%" PRIu64, len);
         MHD_add_response_header(resp, "Content-Range", cr);
-        enum MHD_Result ret = MHD_queue_response(c, 416, resp);
+        enum MHD_Result ret = MHD_queue_response(c, svc_http_status(SVC_ERR_RANGE), resp);
         MHD_destroy_response(resp);
         return ret;
     }
@@ -504,7 +533,7 @@ static enum MHD_Result do_health(svc_daemon *d, struct MHD_Connection *c)
         svc_json_str(&b, err.msg);
         svc_buf_add(&b, "}\n", 2);
     }
-    return reply_json(c, ok ? 200 : 503, &b);
+    return reply_json(c, ok ? 200 : svc_http_status(err.code), &b);
 }
 
 static enum MHD_Result do_metrics(svc_daemon *d, struct MHD_Connection *c)
@@ -512,7 +541,7 @@ static enum MHD_Result do_metrics(svc_daemon *d, struct MHD_Connection *c)
     int64_t counts[SVC_NSTATES];
     rs_err err = {0};
     if (!d->http_store->ops->counts(d->http_store, counts, &err))
-        return reply(c, 503, "text/plain", err.msg, strlen(err.msg));
+        return reply(c, svc_http_status(err.code), "text/plain", err.msg, strlen(err.msg));
     svc_buf b = {0};
     svc_buf_printf(&b, "# HELP ringside_queue_depth Jobs waiting for a worker.\n# TYPE ringside_queue_depth gauge\n"
                        "ringside_queue_depth %" PRId64 "\n",
@@ -580,30 +609,30 @@ static enum MHD_Result route(svc_daemon *d, struct MHD_Connection *c, const char
 {
     bool get = !strcmp(method, "GET") || !strcmp(method, "HEAD");
     if (!strcmp(url, "/") || !strcmp(url, "/index.html"))
-        return get ? do_dashboard(d, c) : reply_error(c, 405, "%s /: only GET", method);
+        return get ? do_dashboard(d, c) : reply_error(c, SVC_ERR_METHOD, "%s /: only GET", method);
     if (!strcmp(url, "/healthz"))
-        return get ? do_health(d, c) : reply_error(c, 405, "%s %s: only GET", method, url);
+        return get ? do_health(d, c) : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
     if (!strcmp(url, "/metrics"))
-        return get ? do_metrics(d, c) : reply_error(c, 405, "%s %s: only GET", method, url);
+        return get ? do_metrics(d, c) : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
     if (!strcmp(url, "/jobs") || !strcmp(url, "/jobs/"))
-        return get ? do_list(d, c) : reply_error(c, 405, "%s /jobs: expected GET or POST", method);
+        return get ? do_list(d, c) : reply_error(c, SVC_ERR_METHOD, "%s /jobs: expected GET or POST", method);
     if (!strncmp(url, "/jobs/", 6)) {
         const char *p = url + 6, *slash = strchr(p, '/');
         size_t n = slash ? (size_t)(slash - p) : strlen(p);
         int64_t id;
         if (!parse_id(p, n, &id))
-            return reply_error(c, 404, "%s: not a job id", url);
+            return reply_error(c, SVC_ERR_NOT_FOUND, "%s: not a job id", url);
         if (!slash) {
             if (get)
                 return do_get_job(d, c, id);
             if (!strcmp(method, "DELETE"))
                 return do_cancel(d, c, id);
-            return reply_error(c, 405, "%s %s: expected GET or DELETE", method, url);
+            return reply_error(c, SVC_ERR_METHOD, "%s %s: expected GET or DELETE", method, url);
         }
         if (!strcmp(slash, "/video") || !strcmp(slash, "/hashes"))
-            return get ? do_file(d, c, id, slash[1] == 'v') : reply_error(c, 405, "%s %s: only GET", method, url);
+            return get ? do_file(d, c, id, slash[1] == 'v') : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
     }
-    return reply_error(c, 404, "%s: no such resource (see /jobs, /healthz, /metrics)", url);
+    return reply_error(c, SVC_ERR_NOT_FOUND, "%s: no such resource (see /jobs, /healthz, /metrics)", url);
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url, const char *method,
@@ -626,7 +655,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         pthread_mutex_unlock(&d->mu);
         if (draining) {
             q->done = true;
-            return reply_error(c, 503, "the daemon is shutting down: not accepting jobs");
+            return reply_error(c, SVC_ERR_DRAINING, "the daemon is shutting down: not accepting jobs");
         }
         const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
         if (cl && strtoull(cl, NULL, 10) > (unsigned long long)d->cfg.max_upload) {
@@ -636,7 +665,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             pthread_mutex_unlock(&d->mu);
             svc_log(SVC_LOG_INFO, -1, "upload refused (413): Content-Length %s is over max_upload %ld", cl,
                     d->cfg.max_upload);
-            return reply_error(c, 413, "the upload (%s bytes) is over the limit of %ld bytes (max_upload)", cl,
+            return reply_error(c, SVC_ERR_TOO_LARGE, "the upload (%s bytes) is over the limit of %ld bytes (max_upload)", cl,
                                d->cfg.max_upload);
         }
         const char *ct = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Type");

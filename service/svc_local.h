@@ -48,6 +48,36 @@ typedef struct svc_daemon {
 } svc_daemon;
 
 /* svc_http.c */
+/* Error ids (rs_err.h) of refused uploads and requests.  Each becomes an
+ * HTTP status in one table, svc_http_status, never through rs_err.code. */
+#define SVC_ERRORS(X)                                                           \
+    X(EMPTY, "empty upload")                                                    \
+    X(TOO_LARGE, "the upload is over max_upload")                               \
+    X(TOO_LONG, "the replay lasts longer than max_seconds")                     \
+    X(REPLAY, "the upload is not a replay this service can render")             \
+    X(BAD_BODY, "a malformed request body")                                     \
+    X(BAD_PARAM, "a bad request parameter (size, format, limit, before)")       \
+    X(NOT_FOUND, "no such job or resource, or the file does not exist yet")     \
+    X(CONFLICT, "the job is already over")                                      \
+    X(GONE, "a finished job's file is missing on this server")                  \
+    X(RANGE, "the byte range asked for is outside the file")                    \
+    X(METHOD, "the resource does not take that method")                         \
+    X(DRAINING, "the daemon is shutting down and takes no new jobs")            \
+    X(NOMEM, "out of memory")
+
+typedef enum svc_error {
+    SVC_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC),
+#define X(id, text) SVC_ERR_##id,
+    SVC_ERRORS(X)
+#undef X
+        SVC_ERR_END
+} svc_error;
+
+const char *svc_error_text(int code);
+/* The HTTP status for an error id: SVC ids by the table in svc_http.c,
+ * every queue store id 503 (the queue is unavailable), anything else 500. */
+unsigned svc_http_status(int code);
+
 struct MHD_Daemon;
 struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err);
 void svc_http_stop(struct MHD_Daemon *h);

@@ -32,6 +32,16 @@ static bool has_prefix(const char *s, const char *p)
     return strncmp(s, p, strlen(p)) == 0;
 }
 
+const char *svc_store_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        SVC_STORE_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_SVC_STORE, text, (int)(sizeof text / sizeof text[0]));
+}
+
 svc_store *svc_store_open(const char *spec, rs_err *err)
 {
     if (has_prefix(spec, "postgres://") || has_prefix(spec, "postgresql://"))
@@ -41,12 +51,12 @@ svc_store *svc_store_open(const char *spec, rs_err *err)
     else {
         size_t n = strlen(spec);
         if (n < 3 || strcmp(spec + n - 3, ".db") != 0) {
-            rs_fail(err, 1, "queue '%s': expected sqlite:PATH, a path ending in .db, or postgres://...", spec);
+            rs_fail(err, SVC_STORE_ERR_SPEC, "queue '%s': expected sqlite:PATH, a path ending in .db, or postgres://...", spec);
             return NULL;
         }
     }
     if (!*spec) {
-        rs_fail(err, 1, "queue 'sqlite:': the database path is missing");
+        rs_fail(err, SVC_STORE_ERR_SPEC, "queue 'sqlite:': the database path is missing");
         return NULL;
     }
     return svc_store_sqlite_open(spec, err);

@@ -43,6 +43,29 @@ typedef enum {
 } svc_state;
 const char *svc_state_name(int st);
 
+/* Error ids (rs_err.h) of every backend.  "No such job" and "already
+ * over" are not errors: get and cancel say them in their return values. */
+#define SVC_STORE_ERRORS(X)                                                                \
+    X(SPEC, "the queue setting names no backend or no database")                           \
+    X(NOT_BUILT, "this build has no driver for that backend")                              \
+    X(OPEN, "cannot open or connect to the queue database")                                \
+    X(SCHEMA, "not a ringside queue (other tables or columns), or no schema could be made") \
+    X(BUSY, "the database stayed locked past the busy timeout")                            \
+    X(QUERY, "a statement failed")                                                         \
+    X(CONNECTION, "lost the connection to the database and could not reconnect")           \
+    X(TOO_LARGE, "the replay is too large to queue")                                       \
+    X(NOMEM, "out of memory")
+
+typedef enum svc_store_error {
+    SVC_STORE_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC_STORE),
+#define X(id, text) SVC_STORE_ERR_##id,
+    SVC_STORE_ERRORS(X)
+#undef X
+        SVC_STORE_ERR_END
+} svc_store_error;
+
+const char *svc_store_error_text(int code);
+
 #define SVC_NAME_MAX 128
 #define SVC_ERROR_MAX 512
 #define SVC_OWNER_MAX 128

@@ -177,7 +177,7 @@ static bool pg_fail(pg_store *s, rs_err *err, const char *what, const PGresult *
     const char *m = r ? PQresultErrorField(r, PG_DIAG_MESSAGE_PRIMARY) : NULL;
     char msg[512];
     one_line(msg, sizeof msg, m ? m : s->conn ? PQerrorMessage(s->conn) : "out of memory");
-    return rs_fail(err, 1, "%s: %s: %s", s->label, what, msg);
+    return rs_fail(err, SVC_STORE_ERR_QUERY, "%s: %s: %s", s->label, what, msg);
 }
 
 /* One statement; the result on success (PQclear it), NULL with err filled.
@@ -198,7 +198,7 @@ static PGresult *run(pg_store *s, const char *what, const char *sql, const param
                 continue;
             char msg[512];
             one_line(msg, sizeof msg, PQerrorMessage(s->conn));
-            rs_fail(err, 1, "%s: %s: lost the connection and could not reconnect: %s", s->label, what, msg);
+            rs_fail(err, SVC_STORE_ERR_CONNECTION, "%s: %s: lost the connection and could not reconnect: %s", s->label, what, msg);
             return NULL;
         }
         pg_fail(s, err, what, r);
@@ -224,7 +224,7 @@ static bool pg_submit(svc_store *bs, svc_job *j, rs_err *err)
 {
     pg_store *s = S(bs);
     if (j->replay_len > INT_MAX) /* libpq's lengths are ints (and bytea stops at 1 GiB) */
-        return rs_fail(err, 1, "%s: replay of %zu bytes is too large to queue", s->label, j->replay_len);
+        return rs_fail(err, SVC_STORE_ERR_TOO_LARGE, "%s: replay of %zu bytes is too large to queue", s->label, j->replay_len);
     params p = {0};
     p_text(&p, j->name);
     p_i64(&p, j->width);
@@ -271,7 +271,7 @@ static int pg_claim(svc_store *bs, const char *owner, int lease_s, svc_job *out,
         int n = PQgetlength(r, 0, 17);
         out->replay = malloc(n > 0 ? (size_t)n : 1);
         if (!out->replay) {
-            rs_fail(err, 1, "out of memory reading job %lld's replay", (long long)out->id);
+            rs_fail(err, SVC_STORE_ERR_NOMEM, "out of memory reading job %lld's replay", (long long)out->id);
             rc = -1;
         } else {
             memcpy(out->replay, PQgetvalue(r, 0, 17), (size_t)n);
@@ -572,6 +572,8 @@ static bool create_schema(pg_store *s, rs_err *err)
     /* a jobs table that is not ours (another program's) */
     if (!exec_ok(s, "SELECT " JOB_COLS ", replay FROM jobs LIMIT 0", "check the jobs table", err)) {
         rs_err_prefix(err, "%s: table jobs is not a ringside queue", s->label);
+        if (err)
+            err->code = SVC_STORE_ERR_SCHEMA;
         return false;
     }
     return true;
@@ -581,7 +583,7 @@ svc_store *svc_store_pg_open(const char *conninfo, rs_err *err)
 {
     pg_store *s = calloc(1, sizeof *s);
     if (!s) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, SVC_STORE_ERR_NOMEM, "out of memory");
         return NULL;
     }
     s->base.ops = &pg_ops;
@@ -594,14 +596,14 @@ svc_store *svc_store_pg_open(const char *conninfo, rs_err *err)
     s->conn = PQconnectdbParams(keys, vals, 1);
     make_label(s);
     if (!s->conn) {
-        rs_fail(err, 1, "%s: out of memory", s->label);
+        rs_fail(err, SVC_STORE_ERR_NOMEM, "%s: out of memory", s->label);
         goto fail;
     }
     if (PQstatus(s->conn) != CONNECTION_OK) {
         char msg[512];
         one_line(msg, sizeof msg, PQerrorMessage(s->conn));
         scrub(msg, conninfo);
-        rs_fail(err, 1, "%s: cannot open the queue database: %s", s->label, msg);
+        rs_fail(err, SVC_STORE_ERR_OPEN, "%s: cannot open the queue database: %s", s->label, msg);
         goto fail;
     }
     PQsetNoticeProcessor(s->conn, quiet, NULL);
@@ -618,7 +620,7 @@ fail:
 svc_store *svc_store_pg_open(const char *conninfo, rs_err *err)
 {
     (void)conninfo; /* may hold a password: not repeated */
-    rs_fail(err, 1, "postgres: this ringside was built without libpq (install libpq-dev and rebuild)");
+    rs_fail(err, SVC_STORE_ERR_NOT_BUILT, "postgres: this ringside was built without libpq (install libpq-dev and rebuild)");
     return NULL;
 }
 

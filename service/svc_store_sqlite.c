@@ -45,9 +45,22 @@ static const char schema[] =
     " replay BLOB NOT NULL);"
     "CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, id);";
 
+/* BUSY when another connection held the lock past the busy timeout; OPEN
+ * when the file cannot be opened or is no database (SQLite opens lazily). */
+static int sq_code(sq_store *s)
+{
+    switch (sqlite3_errcode(s->db)) {
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED: return SVC_STORE_ERR_BUSY;
+    case SQLITE_NOTADB:
+    case SQLITE_CANTOPEN: return SVC_STORE_ERR_OPEN;
+    default: return SVC_STORE_ERR_QUERY;
+    }
+}
+
 static bool sq_fail(sq_store *s, rs_err *err, const char *what)
 {
-    return rs_fail(err, 1, "%s: %s: %s", s->path, what, sqlite3_errmsg(s->db));
+    return rs_fail(err, sq_code(s), "%s: %s: %s", s->path, what, sqlite3_errmsg(s->db));
 }
 
 static void copy_text(char *dst, size_t n, const unsigned char *src)
@@ -91,7 +104,7 @@ static bool exec(sq_store *s, const char *sql, rs_err *err)
 {
     char *msg = NULL;
     if (sqlite3_exec(s->db, sql, NULL, NULL, &msg) != SQLITE_OK) {
-        rs_fail(err, 1, "%s: %s", s->path, msg ? msg : sqlite3_errmsg(s->db));
+        rs_fail(err, sq_code(s), "%s: %s", s->path, msg ? msg : sqlite3_errmsg(s->db));
         sqlite3_free(msg);
         return false;
     }
@@ -165,7 +178,7 @@ static int sq_claim(svc_store *bs, const char *owner, int lease_s, svc_job *out,
     int n = sqlite3_column_bytes(st, 17);
     out->replay = malloc(n > 0 ? (size_t)n : 1);
     if (!out->replay) {
-        rs_fail(err, 1, "out of memory reading job %lld's replay", (long long)out->id);
+        rs_fail(err, SVC_STORE_ERR_NOMEM, "out of memory reading job %lld's replay", (long long)out->id);
         goto out;
     }
     if (n > 0)
@@ -401,7 +414,7 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
 {
     sq_store *s = calloc(1, sizeof *s);
     if (!s) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, SVC_STORE_ERR_NOMEM, "out of memory");
         return NULL;
     }
     s->base.ops = &sq_ops;
@@ -409,7 +422,7 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
     pthread_mutex_init(&s->mu, NULL);
     if (sqlite3_open_v2(path, &s->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, NULL) !=
         SQLITE_OK) {
-        rs_fail(err, 1, "%s: cannot open the queue database: %s", path,
+        rs_fail(err, SVC_STORE_ERR_OPEN, "%s: cannot open the queue database: %s", path,
                 s->db ? sqlite3_errmsg(s->db) : "out of memory");
         goto fail;
     }
@@ -423,7 +436,7 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
     int foreign = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int(st, 0) : -1;
     sqlite3_finalize(st);
     if (foreign != 0) {
-        rs_fail(err, 1, "%s: not a ringside queue (it holds other tables)", path);
+        rs_fail(err, SVC_STORE_ERR_SCHEMA, "%s: not a ringside queue (it holds other tables)", path);
         goto fail;
     }
     /* WAL: HTTP readers never wait for the supervisor's writes.  Setting it
@@ -438,13 +451,20 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
             goto fail;
         sqlite3_sleep(25);
     }
-    if (!exec(s, "PRAGMA synchronous=FULL", err) || !exec(s, schema, err))
+    if (!exec(s, "PRAGMA synchronous=FULL", err))
         goto fail;
+    if (!exec(s, schema, err)) {
+        if (err && err->code == SVC_STORE_ERR_QUERY)
+            err->code = SVC_STORE_ERR_SCHEMA; /* another program's jobs table, say */
+        goto fail;
+    }
     st = prep(s, "SELECT id, state, name, width, height, format, frames_done, frames_total, fps, attempts,"
                  " desync_tick, error, owner, created, started, finished, claimed_until, replay FROM jobs LIMIT 0",
               err);
     if (!st) {
         rs_err_prefix(err, "%s: not a ringside queue", path);
+        if (err)
+            err->code = SVC_STORE_ERR_SCHEMA;
         goto fail;
     }
     sqlite3_finalize(st);
@@ -458,7 +478,7 @@ fail:
 
 svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
 {
-    rs_fail(err, 1, "%s: this ringside was built without SQLite (install libsqlite3-dev and rebuild)", path);
+    rs_fail(err, SVC_STORE_ERR_NOT_BUILT, "%s: this ringside was built without SQLite (install libsqlite3-dev and rebuild)", path);
     return NULL;
 }
 

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "../capture/cap.h"
@@ -32,10 +33,10 @@ static bool f_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *e
     if (f->delay_us)
         usleep((useconds_t)f->delay_us);
     if (index != f->next || frame[0] != (uint8_t)index || frame[7] != (uint8_t)(index >> 8))
-        return rs_fail(e, 1, "frame %llu out of order or torn", (unsigned long long)index);
+        return rs_fail(e, CAP_ERR_FAILED, "frame %llu out of order or torn", (unsigned long long)index);
     f->next++;
     if (f->fail_at && index + 1 == f->fail_at)
-        return rs_fail(e, 1, "fake: No space left on device");
+        return rs_fail(e, CAP_ERR_WRITE, "fake: No space left on device");
     return true;
 }
 static bool f_close(cap_sink *s, bool ok, rs_err *e)
@@ -109,6 +110,7 @@ static void t_writer_error_reaches_the_game_thread(void)
         rs_err e = {0};
         run_queue(capn, 100, 500, 37, &ok, &st, &f, &e);
         T_ASSERT(!ok);
+        T_EQ(e.code, CAP_ERR_WRITE); /* the sink's own id, carried across the thread */
         T_CONTAINS(e.msg, "No space left on device");
         T_EQ(st.frames, 36); /* frames before the failing one */
         T_ASSERT(f.next <= 40); /* the writer stopped: it did not write the rest */
@@ -179,11 +181,70 @@ static void t_sizes(void)
     rs_err e = {0};
     T_ASSERT(cap_check_sizes(1280, 720, 640, 360, &e));
     T_ASSERT(!cap_check_sizes(1280, 720, 641, 360, &e));
+    T_EQ(e.code, CAP_ERR_SIZE);
     T_CONTAINS(e.msg, "must be even");
     T_ASSERT(!cap_check_sizes(640, 360, 1280, 720, &e));
+    T_EQ(e.code, CAP_ERR_SIZE);
     T_CONTAINS(e.msg, "larger than the render size");
     T_ASSERT(!cap_check_sizes(1280, 720, 100, 90, &e));
+    T_EQ(e.code, CAP_ERR_SIZE);
     T_CONTAINS(e.msg, "more than 8 times");
+    T_ASSERT(!cap_check_sizes(0, 720, 100, 90, &e));
+    T_EQ(e.code, CAP_ERR_SIZE);
+}
+
+/* The sink errors a caller can act on, each with its id (no GL needed). */
+static void t_sink_errors(void)
+{
+    cap_sink s;
+    rs_err e = {0};
+    T_ASSERT(!cap_sink_for("out.avi", 64, 64, &s, &e));
+    T_EQ(e.code, CAP_ERR_OUTPUT);
+    T_CONTAINS(e.msg, "out.avi: unknown output type '.avi'");
+    T_ASSERT(!cap_sink_for("frame%d%d.png", 64, 64, &s, &e));
+    T_EQ(e.code, CAP_ERR_OUTPUT);
+    /* a directory where the output should go */
+    char dir[600];
+    snprintf(dir, sizeof dir, "%s/d.y4m", t_tmpdir());
+    T_ASSERT(mkdir(dir, 0755) == 0);
+    T_ASSERTF(cap_sink_for(dir, 64, 64, &s, &e), "%s", e.msg);
+    T_ASSERT(!s.ops->open(&s, &e));
+    T_EQ(e.code, CAP_ERR_CREATE);
+    T_CONTAINS(e.msg, "exists and is not a regular file");
+    /* a parent that is a file */
+    char file[600], below[700];
+    snprintf(file, sizeof file, "%s/f", t_tmpdir());
+    t_write(t_tmpdir(), "f", "x");
+    snprintf(below, sizeof below, "%s/sub/o.y4m", file);
+    T_ASSERTF(cap_sink_for(below, 64, 64, &s, &e), "%s", e.msg);
+    T_ASSERT(!s.ops->open(&s, &e));
+    T_EQ(e.code, CAP_ERR_CREATE);
+    /* disk full: the frames are buffered, the failure shows when they are flushed */
+    T_ASSERTF(cap_sink_for("/dev/full", 64, 64, &s, &e), "%s", e.msg);
+    T_ASSERTF(s.ops->open(&s, &e), "%s", e.msg);
+    static uint8_t frame[64 * 64 * 3 / 2];
+    bool ok = true;
+    for (uint64_t i = 0; ok && i < 400; i++) /* more than the 1 MiB buffer */
+        ok = s.ops->write(&s, frame, i, &e);
+    ok = s.ops->close(&s, ok, &e) && ok;
+    T_ASSERT(!ok);
+    T_EQ(e.code, CAP_ERR_WRITE);
+    T_CONTAINS(e.msg, "/dev/full: write failed: No space left on device");
+}
+
+/* Every id has a text, and no two share one. */
+static void t_error_ids_have_texts(void)
+{
+    T_EQ(RS_ERR_MODULE(CAP_ERR_BASE + 1), RS_ERR_MOD_CAP);
+    T_EQ(RS_ERR_MODULE(CAP_ERR_END - 1), RS_ERR_MOD_CAP);
+    T_ASSERT(!strcmp(rs_err_module_name(CAP_ERR_WRITE), "capture"));
+    for (int a = CAP_ERR_BASE + 1; a < CAP_ERR_END; a++) {
+        const char *t = cap_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = CAP_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, cap_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(cap_error_text(CAP_ERR_END), "?"));
 }
 
 /* A test picture in a texture: gradients and hard edges; `shift` moves
@@ -303,4 +364,5 @@ T_MAIN({"queue_cap_holds", t_queue_cap_holds}, {"inline_queue", t_inline_queue},
        {"writer_error_reaches_the_game_thread", t_writer_error_reaches_the_game_thread},
        {"hash_is_fnv1a", t_hash_is_fnv1a}, {"cpu_yuv_known_colours", t_cpu_yuv_known_colours},
        {"cpu_downscale_averages_and_flips", t_cpu_downscale_averages_and_flips}, {"sizes", t_sizes},
+       {"sink_errors", t_sink_errors}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"gpu_matches_cpu_egl", t_gpu_matches_cpu_egl}, {"gpu_matches_cpu_osmesa", t_gpu_matches_cpu_osmesa})

@@ -230,8 +230,20 @@ static void t_queue_error_after_frames(void)
     }
     T_EQ(got, 5);
     T_EQ(r, MV_DEC_ERROR);
+    T_EQ(mv_dec_error(d)->code, MV_ERR_DECODE);
     T_CONTAINS(mv_dec_error(d)->msg, "frame 5: broken");
     mv_dec_stop(d);
+}
+
+static void t_queue_bad_slot_count(void)
+{
+    fake_src f;
+    fake_init(&f, 100, 5, 0);
+    uint8_t mem[1][64], *slots[1] = {mem[0]};
+    rs_err err = {0};
+    T_ASSERT(!mv_dec_start(&f.base, slots, 0, &err));
+    T_EQ(err.code, MV_ERR_ARG);
+    T_CONTAINS(err.msg, "decoder: 0 slots");
 }
 
 static void t_queue_bounded_stop(void)
@@ -482,6 +494,7 @@ CASE(y4m_gray_709_pc, "y4m", "gray", 320, 240, MV_BT709, true)
 
 T_MAIN({"pacing", t_pacing}, {"csp_levels", t_csp_levels}, {"csp_roundtrip", t_csp_roundtrip},
        {"queue_order", t_queue_order}, {"queue_error_after_frames", t_queue_error_after_frames},
+       {"queue_bad_slot_count", t_queue_bad_slot_count},
        {"queue_bounded_stop", t_queue_bounded_stop}, {"colour_h264_420_709_tv", t_colour_h264_420_709_tv},
        {"colour_h264_420_601_tv_odd", t_colour_h264_420_601_tv_odd},
        {"colour_h264_422_709_pc", t_colour_h264_422_709_pc}, {"colour_h264_444_601_pc", t_colour_h264_444_601_pc},

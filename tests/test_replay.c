@@ -76,8 +76,9 @@ static void t_three_minutes_under_16k(void)
     }
 }
 
-/* Patches bytes, recomputes the CRC, expects decode to fail with `want`. */
-static void expect_bad(const uint8_t *good, size_t n, size_t off, const void *bytes, size_t k, bool fix_crc,
+/* Patches bytes, recomputes the CRC, expects decode to fail with id
+ * `code` and a message holding `want`. */
+static void expect_bad(const uint8_t *good, size_t n, size_t off, const void *bytes, size_t k, bool fix_crc, int code,
                        const char *want1, const char *want2)
 {
     uint8_t *b = malloc(n);
@@ -91,6 +92,7 @@ static void expect_bad(const uint8_t *good, size_t n, size_t off, const void *by
     rp_replay rp;
     rs_err e = {0};
     T_ASSERTF(!rp_decode(b, n, "x.rsr", &rp, &e), "patch at %zu accepted", off);
+    T_ASSERTF(e.code == code, "patch at %zu: %s, want %s (%s)", off, rp_error_text(e.code), rp_error_text(code), e.msg);
     T_CONTAINS(e.msg, "x.rsr: ");
     T_CONTAINS(e.msg, want1);
     if (want2)
@@ -108,29 +110,31 @@ static void t_corruption_cases(void)
     encode(&rp, &g, &n);
     const uint8_t v2[2] = {2, 0}, zero8[8] = {0}, big8[8] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0, 0};
     const uint8_t st99[4] = {99, 0, 0, 0}, iv0[2] = {0, 0}, k3 = 3, w7 = 7, flag[2] = {1, 0}, r9 = 9;
-    expect_bad(g, n, 0, "RSRQ", 4, false, "not a ringside replay", "byte 0");
-    expect_bad(g, n, 4, v2, 2, false, "format version 2 at byte 4", "this build reads 1");
-    expect_bad(g, n, 100, "\xAA", 1, false, "checksum mismatch", "file damaged");
-    expect_bad(g, n, 6, flag, 2, true, "unknown flags", "byte 6");
-    expect_bad(g, n, 8, st99, 4, true, "stage id 99 at byte 8", NULL);
-    expect_bad(g, n, 20, zero8, 8, true, "tick count 0 at byte 20", NULL);
-    expect_bad(g, n, 20, big8, 8, true, "out of range", "byte 20");
-    expect_bad(g, n, 28, iv0, 2, true, "checkpoint interval 0 at byte 28", NULL);
-    expect_bad(g, n, 30, &k3, 1, true, "player 1 kind 3 at byte 30", NULL);
-    expect_bad(g, n, 32, &w7, 1, true, "winner 7 at byte 32", NULL);
-    expect_bad(g, n, 33, &r9, 1, true, "rounds won 9 at byte 33", NULL);
-    expect_bad(g, n, 35, &k3, 1, true, "reserved byte 35 is 3", NULL);
+    expect_bad(g, n, 0, "RSRQ", 4, false, RP_ERR_MAGIC, "not a ringside replay", "byte 0");
+    expect_bad(g, n, 4, v2, 2, false, RP_ERR_VERSION, "format version 2 at byte 4", "this build reads 1");
+    expect_bad(g, n, 100, "\xAA", 1, false, RP_ERR_CHECKSUM, "checksum mismatch", "file damaged");
+    expect_bad(g, n, 6, flag, 2, true, RP_ERR_FIELD, "unknown flags", "byte 6");
+    expect_bad(g, n, 8, st99, 4, true, RP_ERR_FIELD, "stage id 99 at byte 8", NULL);
+    expect_bad(g, n, 20, zero8, 8, true, RP_ERR_FIELD, "tick count 0 at byte 20", NULL);
+    expect_bad(g, n, 20, big8, 8, true, RP_ERR_FIELD, "out of range", "byte 20");
+    expect_bad(g, n, 28, iv0, 2, true, RP_ERR_FIELD, "checkpoint interval 0 at byte 28", NULL);
+    expect_bad(g, n, 30, &k3, 1, true, RP_ERR_FIELD, "player 1 kind 3 at byte 30", NULL);
+    expect_bad(g, n, 32, &w7, 1, true, RP_ERR_FIELD, "winner 7 at byte 32", NULL);
+    expect_bad(g, n, 33, &r9, 1, true, RP_ERR_FIELD, "rounds won 9 at byte 33", NULL);
+    expect_bad(g, n, 35, &k3, 1, true, RP_ERR_FIELD, "reserved byte 35 is 3", NULL);
     /* input section: a run past the tick count, opposite directions */
     const uint8_t huge_run[5] = {0xff, 0xff, 0xff, 0x7f, 0x00};
-    expect_bad(g, n, 40, huge_run, 4, true, "goes past the tick count", "byte 40");
+    expect_bad(g, n, 40, huge_run, 4, true, RP_ERR_FIELD, "goes past the tick count", "byte 40");
     const uint8_t updown[3] = {0x01, 0x03, 0x00}; /* run 1, p1 = up|down */
-    expect_bad(g, n, 40, updown, 3, true, "holds opposite directions", "byte 41");
+    expect_bad(g, n, 40, updown, 3, true, RP_ERR_FIELD, "holds opposite directions", "byte 41");
     /* truncated: everything from a valid prefix (fails at the CRC or a
      * section check, never reads past the end) */
     rp_replay out;
     rs_err e = {0};
     for (size_t cut = 0; cut < n; cut += (cut < 64 ? 1 : 37)) {
         T_ASSERTF(!rp_decode(g, cut, "x.rsr", &out, &e), "a %zu-byte prefix was accepted", cut);
+        T_ASSERTF(cut < 4 ? e.code == RP_ERR_MAGIC : e.code == RP_ERR_TRUNCATED || e.code == RP_ERR_CHECKSUM,
+                  "%zu-byte prefix: %s (%s)", cut, rp_error_text(e.code), e.msg);
         T_CONTAINS(e.msg, "x.rsr");
     }
     /* trailing garbage with a fixed CRC */
@@ -141,6 +145,7 @@ static void t_corruption_cases(void)
     for (int i = 0; i < 4; i++)
         longer[n - 1 + (size_t)i] = (uint8_t)(c >> (8 * i));
     T_ASSERT(!rp_decode(longer, n + 3, "x.rsr", &out, &e));
+    T_EQ(e.code, RP_ERR_FIELD);
     T_CONTAINS(e.msg, "unexpected bytes");
     free(longer);
     free(g);
@@ -157,8 +162,10 @@ static void t_oversized_file(void)
     rp_replay rp;
     rs_err e = {0};
     T_ASSERT(!rp_read(path, &rp, &e));
+    T_EQ(e.code, RP_ERR_TOO_BIG);
     T_CONTAINS(e.msg, "huge.rsr: larger than the limit");
     T_ASSERT(!rp_read("/nonexistent/a.rsr", &rp, &e));
+    T_EQ(e.code, RP_ERR_OPEN);
     T_CONTAINS(e.msg, "/nonexistent/a.rsr: cannot open");
 }
 
@@ -208,6 +215,7 @@ static void t_random_corruption(void)
             rp_free(&again);
             rp_free(&out);
         } else {
+            T_ASSERTF(RS_ERR_MODULE(e.code) == RS_ERR_MOD_RP && e.code != RP_ERR_NOMEM, "code %d: %s", e.code, e.msg);
             T_CONTAINS(e.msg, "fuzz.rsr: ");
         }
     }
@@ -256,6 +264,7 @@ static void t_write_read_back_and_failures(void)
     rp_free(&back);
     snprintf(path, sizeof path, "%s/none/a.rsr", t_tmpdir());
     T_ASSERT(!rp_write(path, &rp, &e));
+    T_EQ(e.code, RP_ERR_WRITE);
     T_CONTAINS(e.msg, "cannot create");
     /* disk full half way: error, nothing left behind */
     signal(SIGXFSZ, SIG_IGN);
@@ -266,6 +275,7 @@ static void t_write_read_back_and_failures(void)
     snprintf(path, sizeof path, "%s/full.rsr", t_tmpdir());
     snprintf(part, sizeof part, "%s.part", path);
     T_ASSERT(!rp_write(path, &rp, &e));
+    T_EQ(e.code, RP_ERR_WRITE);
     T_CONTAINS(e.msg, "full.rsr: write failed");
     T_ASSERT(access(path, F_OK) != 0 && access(part, F_OK) != 0);
     T_ASSERT(setrlimit(RLIMIT_FSIZE, &old) == 0);
@@ -300,6 +310,34 @@ static void t_header_result_checked(void)
     T_ASSERT(rp_verify(&rp, NULL, NULL, NULL, &res, &e));
     T_ASSERT(!res.ok && res.header_mismatch && res.desync_tick == 0);
     rp_free(&rp);
+}
+
+static void t_empty_recording_refused(void)
+{
+    rp_recorder rec;
+    rp_rec_init(&rec, 0, 1, RP_CPU, RP_CPU);
+    rs_err e = {0};
+    char path[512];
+    snprintf(path, sizeof path, "%s/empty.rsr", t_tmpdir());
+    T_ASSERT(!rp_rec_save(&rec, path, &e));
+    T_EQ(e.code, RP_ERR_RECORD);
+    T_CONTAINS(e.msg, "nothing recorded");
+}
+
+/* Every id has a text, and no two share one: an id added to RP_ERRORS
+ * without a meaningful text fails here. */
+static void t_error_ids_have_texts(void)
+{
+    T_EQ(RS_ERR_MODULE(RP_ERR_BASE + 1), RS_ERR_MOD_RP);
+    T_EQ(RS_ERR_MODULE(RP_ERR_END - 1), RS_ERR_MOD_RP);
+    T_ASSERT(!strcmp(rs_err_module_name(RP_ERR_DESYNC), "replay"));
+    for (int a = RP_ERR_BASE + 1; a < RP_ERR_END; a++) {
+        const char *t = rp_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = RP_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, rp_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(rp_error_text(0), "ok") && !strcmp(rp_error_text(RP_ERR_END), "?"));
 }
 
 static void t_demos_verify(void)
@@ -362,5 +400,6 @@ T_MAIN({"roundtrip", t_roundtrip}, {"three_minutes_under_16k", t_three_minutes_u
        {"random_corruption", t_random_corruption},
        {"flipped_input_desyncs_at_its_checkpoint", t_flipped_input_desyncs_at_its_checkpoint},
        {"write_read_back_and_failures", t_write_read_back_and_failures}, {"short_recording", t_short_recording},
-       {"header_result_checked", t_header_result_checked}, {"demos_verify", t_demos_verify},
+       {"header_result_checked", t_header_result_checked}, {"empty_recording_refused", t_empty_recording_refused},
+       {"error_ids_have_texts", t_error_ids_have_texts}, {"demos_verify", t_demos_verify},
        {"check_tick_agrees_with_verify", t_check_tick_agrees_with_verify})

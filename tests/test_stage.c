@@ -62,7 +62,7 @@ static const char *parse_bad(const char *text, int code)
     r_stage st;
     rs_err_clear(&e);
     T_ASSERTF(!parse(&st, "stages/x.stage", text, &e), "accepted: %s", text);
-    T_ASSERTF(e.code == code, "code %d, want %d: %s", e.code, code, e.msg);
+    T_ASSERTF(e.code == code, "%s, want %s: %s", r_stage_error_text(e.code), r_stage_error_text(code), e.msg);
     return e.msg;
 }
 
@@ -240,7 +240,7 @@ static void t_layout(void)
     /* a UTF-8 byte-order mark before the first key, and only there */
     parse_ok(&st, "\xef\xbb\xbfname = bom\r\ngame = harbor\r\n");
     T_ASSERT(!strcmp(st.name, "bom") && st.game_index == 1);
-    T_CONTAINS(parse_bad("name = a\n\xef\xbb\xbfgame = dojo\n", R_STAGE_ERR_SYNTAX), "stages/x.stage:2: unknown key");
+    T_CONTAINS(parse_bad("name = a\n\xef\xbb\xbfgame = dojo\n", R_STAGE_ERR_UNKNOWN_KEY), "stages/x.stage:2: unknown key");
 }
 
 static void t_syntax_errors(void)
@@ -251,16 +251,16 @@ static void t_syntax_errors(void)
     T_CONTAINS(m, "'sun yes'");
     m = parse_bad("# c\n = 3\n", R_STAGE_ERR_SYNTAX);
     T_CONTAINS(m, "stages/x.stage:2: missing key before '='");
-    m = parse_bad("name = a\ngame = dojo\nsunn = yes\n", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("name = a\ngame = dojo\nsunn = yes\n", R_STAGE_ERR_UNKNOWN_KEY);
     T_CONTAINS(m, "stages/x.stage:3: unknown key 'sunn' (did you mean 'sun'?)");
-    m = parse_bad("Gamma = 2\n", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("Gamma = 2\n", R_STAGE_ERR_UNKNOWN_KEY);
     T_CONTAINS(m, "stages/x.stage:1: unknown key 'Gamma' (did you mean 'gamma'?)");
-    m = parse_bad("name = a\nwidget = 3\n", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("name = a\nwidget = 3\n", R_STAGE_ERR_UNKNOWN_KEY);
     T_CONTAINS(m, "stages/x.stage:2: unknown key 'widget' (keys are listed in docs/stages.md)");
-    m = parse_bad("name = a\ngamma = 2\n# x\ngame = dojo\n\n\n\n\ngamma = 2\n", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("name = a\ngamma = 2\n# x\ngame = dojo\n\n\n\n\ngamma = 2\n", R_STAGE_ERR_DUPLICATE_KEY);
     T_CONTAINS(m, "stages/x.stage:9: duplicate key 'gamma' (first on line 2)");
     /* a duplicate is refused even when both values agree or the first was a default */
-    m = parse_bad("name = a\nname = a\n", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("name = a\nname = a\n", R_STAGE_ERR_DUPLICATE_KEY);
     T_CONTAINS(m, "stages/x.stage:2: duplicate key 'name' (first on line 1)");
 
     static const char nul[] = "name = a\ngame = d\0ojo\n";
@@ -283,73 +283,75 @@ static void t_syntax_errors(void)
 
 static void t_missing_required(void)
 {
-    const char *m = parse_bad("name = a\n", R_STAGE_ERR_SYNTAX);
+    const char *m = parse_bad("name = a\n", R_STAGE_ERR_MISSING_KEY);
     T_CONTAINS(m, "stages/x.stage: missing required key 'game'");
-    m = parse_bad("# nothing\ngame = dojo\n", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("# nothing\ngame = dojo\n", R_STAGE_ERR_MISSING_KEY);
     T_CONTAINS(m, "stages/x.stage: missing required key 'name'");
-    m = parse_bad("", R_STAGE_ERR_SYNTAX);
+    m = parse_bad("", R_STAGE_ERR_MISSING_KEY);
     T_CONTAINS(m, "stages/x.stage: missing required key 'name'");
 }
 
 static void t_value_errors(void)
 {
+    enum { VAL = R_STAGE_ERR_VALUE, RNG = R_STAGE_ERR_RANGE };
     static const struct {
         const char *line, *want;
+        int code;
     } cases[] = {
-        {"sun_intensity = abc", "sun_intensity: expected a number in 0..65504, got 'abc'"},
-        {"sun_intensity =", "sun_intensity: expected a number in 0..65504, got ''"},
-        {"gamma = 2.2.2", "gamma: expected a number in 0.1..10, got '2.2.2'"},
-        {"gamma = 2 2", "gamma: expected a number in 0.1..10, got '2 2'"},
-        {"exposure = 0.0009", "exposure: expected a number in 0.001..1000, got '0.0009'"},
-        {"environment_rotate = -361", "environment_rotate: expected a number in -360..360, got '-361'"},
-        {"sun_size = 0.04", "sun_size: expected a number in 0.05..20, got '0.04'"},
-        {"key_area = 0.5", "key_area: expected a number in 1..90, got '0.5'"},
-        {"saturation = -0.1", "saturation: expected a number in 0..10, got '-0.1'"},
-        {"name = Dojo", "name: expected 1 to 31 characters of a-z 0-9 _ -, got 'Dojo'"},
-        {"name = a b", "name: expected 1 to 31 characters"},
-        {"name = abcdefghijklmnopqrstuvwxyz012345", "name: expected 1 to 31 characters"},
-        {"game = arena", "game: expected a game stage (dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry), got 'arena'"},
-        {"game = Dojo", "game: expected a game stage (dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry), got 'Dojo'"},
-        {"sky_zenith = 0.1 0.2", "sky_zenith: expected 3 numbers (r g b), got 2: '0.1 0.2'"},
-        {"sky_horizon = 0.1 0.2 0.3 0.4", "sky_horizon: expected 3 numbers (r g b), got 4"},
-        {"ground = 0.1 x 0.3", "ground: g: expected a number in 0..65504, got 'x'"},
-        {"ring_color = 0.5 0.5 1.01", "ring_color: b: expected a number in 0..1, got '1.01'"},
-        {"sun_direction = 0 0 0", "sun_direction: expected a direction x y z that is not all zero, got '0 0 0'"},
-        {"sun_direction = 1e-50 0 0", "sun_direction: expected a direction x y z that is not all zero"},
-        {"sun_direction = 1 2", "sun_direction: expected 3 numbers (x y z), got 2"},
-        {"sun_direction = 1 nan 2", "sun_direction: y: expected a number in -65504..65504, got 'nan'"},
-        {"sun = maybe", "sun: expected yes or no (or true/false, on/off, 1/0), got 'maybe'"},
-        {"shadows = YES", "shadows: expected yes or no"},
-        {"flare =", "flare: expected yes or no (or true/false, on/off, 1/0), got ''"},
-        {"hdr_format = rgba8", "hdr_format: expected rgba16f or r11g11b10f, got 'rgba8'"},
-        {"key_light = 1 1 1 1 1 1 1", "key_light: expected 8 numbers (x y z r g b intensity size_deg), got 7"},
-        {"key_light = 1 1 1 1 1 1 1 1 1", "key_light: expected 8 numbers (x y z r g b intensity size_deg), got 9"},
-        {"key_light = 1 1 1 1 1 1 1 91", "key_light: size_deg: expected a number in 0.5..90, got '91'"},
-        {"counter_light = 1 1 1 1 1 1 1 0.4", "counter_light: size_deg: expected a number in 0.5..90, got '0.4'"},
-        {"counter_light = 1 1 1 1 -1 1 1 1", "counter_light: g: expected a number in 0..65504, got '-1'"},
-        {"key_light = 1 1 1 1 1 1 65505 1", "key_light: intensity: expected a number in 0..65504, got '65505'"},
-        {"key_light = 0 0 0 1 1 1 1 1", "key_light: expected a direction x y z that is not all zero"},
-        {"environment = sky.png", "environment: expected 'procedural' or an .hdr or .exr file, got 'sky.png'"},
-        {"environment = .hdr", "environment: expected 'procedural' or an .hdr or .exr file"},
-        {"environment = Procedural", "environment: expected 'procedural' or an .hdr or .exr file"},
-        {"holes = maybe", "holes: expected yes or no (or true/false, on/off, 1/0), got 'maybe'"},
-        {"afterimage = blur", "afterimage: expected view, world or off, got 'blur'"},
-        {"afterimage = View", "afterimage: expected view, world or off, got 'View'"},
-        {"afterimage_stretch = 9", "afterimage_stretch: expected a number in 1..8, got '9'"},
-        {"buildings = 49", "buildings: expected a whole number in 0..48, got '49'"},
-        {"buildings = 2.5", "buildings: expected a whole number in 0..48, got '2.5'"},
-        {"buildings = +7", "buildings: expected a whole number in 0..48, got '+7'"},
-        {"buildings = -1", "buildings: expected a whole number in 0..48, got '-1'"},
-        {"buildings_seed = 99999999999999999999", "buildings_seed: expected a whole number in 0..16777216, got '99999999999999999999'"},
-        {"afterimage_speed = -1", "afterimage_speed: expected a number in 0..1000, got '-1'"},
-        {"water = perhaps", "water: expected yes or no"},
+        {"sun_intensity = abc", "sun_intensity: expected a number in 0..65504, got 'abc'", VAL},
+        {"sun_intensity =", "sun_intensity: expected a number in 0..65504, got ''", VAL},
+        {"gamma = 2.2.2", "gamma: expected a number in 0.1..10, got '2.2.2'", VAL},
+        {"gamma = 2 2", "gamma: expected a number in 0.1..10, got '2 2'", VAL},
+        {"exposure = 0.0009", "exposure: expected a number in 0.001..1000, got '0.0009'", RNG},
+        {"environment_rotate = -361", "environment_rotate: expected a number in -360..360, got '-361'", RNG},
+        {"sun_size = 0.04", "sun_size: expected a number in 0.05..20, got '0.04'", RNG},
+        {"key_area = 0.5", "key_area: expected a number in 1..90, got '0.5'", RNG},
+        {"saturation = -0.1", "saturation: expected a number in 0..10, got '-0.1'", RNG},
+        {"name = Dojo", "name: expected 1 to 31 characters of a-z 0-9 _ -, got 'Dojo'", VAL},
+        {"name = a b", "name: expected 1 to 31 characters", VAL},
+        {"name = abcdefghijklmnopqrstuvwxyz012345", "name: expected 1 to 31 characters", VAL},
+        {"game = arena", "game: expected a game stage (dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry), got 'arena'", VAL},
+        {"game = Dojo", "game: expected a game stage (dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry), got 'Dojo'", VAL},
+        {"sky_zenith = 0.1 0.2", "sky_zenith: expected 3 numbers (r g b), got 2: '0.1 0.2'", VAL},
+        {"sky_horizon = 0.1 0.2 0.3 0.4", "sky_horizon: expected 3 numbers (r g b), got 4", VAL},
+        {"ground = 0.1 x 0.3", "ground: g: expected a number in 0..65504, got 'x'", VAL},
+        {"ring_color = 0.5 0.5 1.01", "ring_color: b: expected a number in 0..1, got '1.01'", RNG},
+        {"sun_direction = 0 0 0", "sun_direction: expected a direction x y z that is not all zero, got '0 0 0'", VAL},
+        {"sun_direction = 1e-50 0 0", "sun_direction: expected a direction x y z that is not all zero", VAL},
+        {"sun_direction = 1 2", "sun_direction: expected 3 numbers (x y z), got 2", VAL},
+        {"sun_direction = 1 nan 2", "sun_direction: y: expected a number in -65504..65504, got 'nan'", VAL},
+        {"sun = maybe", "sun: expected yes or no (or true/false, on/off, 1/0), got 'maybe'", VAL},
+        {"shadows = YES", "shadows: expected yes or no", VAL},
+        {"flare =", "flare: expected yes or no (or true/false, on/off, 1/0), got ''", VAL},
+        {"hdr_format = rgba8", "hdr_format: expected rgba16f or r11g11b10f, got 'rgba8'", VAL},
+        {"key_light = 1 1 1 1 1 1 1", "key_light: expected 8 numbers (x y z r g b intensity size_deg), got 7", VAL},
+        {"key_light = 1 1 1 1 1 1 1 1 1", "key_light: expected 8 numbers (x y z r g b intensity size_deg), got 9", VAL},
+        {"key_light = 1 1 1 1 1 1 1 91", "key_light: size_deg: expected a number in 0.5..90, got '91'", RNG},
+        {"counter_light = 1 1 1 1 1 1 1 0.4", "counter_light: size_deg: expected a number in 0.5..90, got '0.4'", RNG},
+        {"counter_light = 1 1 1 1 -1 1 1 1", "counter_light: g: expected a number in 0..65504, got '-1'", RNG},
+        {"key_light = 1 1 1 1 1 1 65505 1", "key_light: intensity: expected a number in 0..65504, got '65505'", RNG},
+        {"key_light = 0 0 0 1 1 1 1 1", "key_light: expected a direction x y z that is not all zero", VAL},
+        {"environment = sky.png", "environment: expected 'procedural' or an .hdr or .exr file, got 'sky.png'", VAL},
+        {"environment = .hdr", "environment: expected 'procedural' or an .hdr or .exr file", VAL},
+        {"environment = Procedural", "environment: expected 'procedural' or an .hdr or .exr file", VAL},
+        {"holes = maybe", "holes: expected yes or no (or true/false, on/off, 1/0), got 'maybe'", VAL},
+        {"afterimage = blur", "afterimage: expected view, world or off, got 'blur'", VAL},
+        {"afterimage = View", "afterimage: expected view, world or off, got 'View'", VAL},
+        {"afterimage_stretch = 9", "afterimage_stretch: expected a number in 1..8, got '9'", RNG},
+        {"buildings = 49", "buildings: expected a whole number in 0..48, got '49'", RNG},
+        {"buildings = 2.5", "buildings: expected a whole number in 0..48, got '2.5'", VAL},
+        {"buildings = +7", "buildings: expected a whole number in 0..48, got '+7'", VAL},
+        {"buildings = -1", "buildings: expected a whole number in 0..48, got '-1'", VAL},
+        {"buildings_seed = 99999999999999999999", "buildings_seed: expected a whole number in 0..16777216, got '99999999999999999999'", RNG},
+        {"afterimage_speed = -1", "afterimage_speed: expected a number in 0..1000, got '-1'", RNG},
+        {"water = perhaps", "water: expected yes or no", VAL},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char text[256], want[256];
         /* the error comes before the check for required keys */
         snprintf(text, sizeof text, "# comment\n\n  # another\n\n%s\nname = a\ngame = dojo\n", cases[i].line);
         snprintf(want, sizeof want, "stages/x.stage:5: %s", cases[i].want);
-        T_CONTAINS(parse_bad(text, R_STAGE_ERR_VALUE), want);
+        T_CONTAINS(parse_bad(text, cases[i].code), want);
     }
     /* a value in a message is cut and stripped of control bytes */
     char text[400] = "name = ";
@@ -379,19 +381,24 @@ static void t_bounds(void)
         T_ASSERTF(parse(&st, "b.stage", text, &e), "%s: %s", ok[i], e.msg);
     }
     static const char *const refused[] = {
-        "sun_intensity = 65504.1", "sun_intensity = -0.0001", "sun_intensity = nan", "sun_intensity = inf",
-        "sun_intensity = -inf", "sun_intensity = infinity", "sun_intensity = 1e400", "sun_intensity = NAN",
-        "environment_scale = 65504.01", "sky_zenith = 0 65504.1 0", "bloom_threshold = 1e39",
-        "environment_rotate = 360.001", "exposure = 1000.5", "gamma = 10.0001", "sun_size = 20.01",
-        "key_area = 90.01", "bloom = 10.5", "ring_color = 0 0 1.0000001", "sun_direction = 65505 0 0",
-        "key_light = 1 1 1 65504.1 0 0 1 1", "key_light = inf 1 1 1 1 1 1 1", "gamma = 2f", "gamma = 0x",
+        "sun_intensity = 65504.1", "sun_intensity = -0.0001", "environment_scale = 65504.01",
+        "sky_zenith = 0 65504.1 0", "bloom_threshold = 1e39", "environment_rotate = 360.001", "exposure = 1000.5",
+        "gamma = 10.0001", "sun_size = 20.01", "key_area = 90.01", "bloom = 10.5", "ring_color = 0 0 1.0000001",
+        "sun_direction = 65505 0 0", "key_light = 1 1 1 65504.1 0 0 1 1",
+        "sun_intensity = nan", "sun_intensity = inf", "sun_intensity = -inf", "sun_intensity = infinity",
+        "sun_intensity = 1e400", "sun_intensity = NAN", "key_light = inf 1 1 1 1 1 1 1", "gamma = 2f", "gamma = 0x",
         "gamma = 2,5", "gamma = 1e", "gamma = .",
     };
+    /* the first of them are numbers out of range; from here on, not numbers at all */
+    static const char *const first_not_a_number = "sun_intensity = nan";
+    int code = R_STAGE_ERR_RANGE;
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++) {
         char text[256], want[64];
         snprintf(text, sizeof text, "name = a\ngame = dojo\n%s\n", refused[i]);
         snprintf(want, sizeof want, "stages/x.stage:3: %.*s:", (int)strcspn(refused[i], " "), refused[i]);
-        T_CONTAINS(parse_bad(text, R_STAGE_ERR_VALUE), want);
+        if (!strcmp(refused[i], first_not_a_number))
+            code = R_STAGE_ERR_VALUE;
+        T_CONTAINS(parse_bad(text, code), want);
     }
 }
 
@@ -586,8 +593,9 @@ static void check_result(bool ok, const r_stage *st, const rs_err *e, int it)
 {
     if (!ok) {
         T_ASSERTF(!strncmp(e->msg, "fuzz/x.stage:", 13), "iteration %d: message '%s'", it, e->msg);
-        T_ASSERTF(e->code == R_STAGE_ERR_SYNTAX || e->code == R_STAGE_ERR_VALUE, "iteration %d: code %d", it,
-                  e->code);
+        T_ASSERTF(RS_ERR_MODULE(e->code) == RS_ERR_MOD_R_STAGE && e->code != R_STAGE_ERR_FILE &&
+                      e->code != R_STAGE_ERR_GAME,
+                  "iteration %d: %s", it, r_stage_error_text(e->code));
         T_ASSERT(!strchr(e->msg, '\n'));
         return;
     }
@@ -751,12 +759,13 @@ static void t_for_game(void)
     r_stage st;
     rs_err e = {0};
     T_ASSERT(!r_stage_for_game(&st, G_STAGES, &e));
-    T_EQ(e.code, R_STAGE_ERR_VALUE);
+    T_EQ(e.code, R_STAGE_ERR_GAME);
     T_CONTAINS(e.msg, "does not exist (expected 0..");
     char want[64];
     snprintf(want, sizeof want, "game stage %d does not exist (expected 0..%d)", G_STAGES, G_STAGES - 1);
     T_CONTAINS(e.msg, want);
     T_ASSERT(!r_stage_for_game(&st, -1, &e));
+    T_EQ(e.code, R_STAGE_ERR_GAME);
 
     /* a data directory whose harbour file dresses the wrong stage, and no dojo file */
     const char *d = t_tmpdir();
@@ -767,7 +776,7 @@ static void t_for_game(void)
     setenv("RINGSIDE_DATA", d, 1);
     rs_data_reset();
     T_ASSERT(!r_stage_for_game(&st, 1, &e));
-    T_EQ(e.code, R_STAGE_ERR_VALUE);
+    T_EQ(e.code, R_STAGE_ERR_GAME);
     T_CONTAINS(e.msg, "stages/harbor.stage: game is 'dojo', but this file dresses game stage 'harbor'");
     T_ASSERT(!r_stage_for_game(&st, 0, &e));
     T_EQ(e.code, R_STAGE_ERR_FILE);
@@ -801,7 +810,7 @@ static void t_load(void)
     t_write(d, "bad.stage", "name = ok\ngame = temple\n\ngamma = 0\n");
     snprintf(p, sizeof p, "%s/bad.stage", d);
     T_ASSERT(!r_stage_load(&st, p, &e));
-    T_EQ(e.code, R_STAGE_ERR_VALUE);
+    T_EQ(e.code, R_STAGE_ERR_RANGE);
     snprintf(want, sizeof want, "%s:4: gamma: expected a number in 0.1..10, got '0'", p);
     T_CONTAINS(e.msg, want);
 
@@ -816,7 +825,22 @@ static void t_load(void)
     T_CONTAINS(e.msg, "big.stage: larger than the limit of 65536 bytes");
 }
 
-T_MAIN({"defaults", t_defaults}, {"every_key", t_every_key}, {"layout", t_layout},
+/* Every id has a text, and no two share one. */
+static void t_error_ids_have_texts(void)
+{
+    T_EQ(RS_ERR_MODULE(R_STAGE_ERR_BASE + 1), RS_ERR_MOD_R_STAGE);
+    T_EQ(RS_ERR_MODULE(R_STAGE_ERR_END - 1), RS_ERR_MOD_R_STAGE);
+    T_ASSERT(!strcmp(rs_err_module_name(R_STAGE_ERR_RANGE), "stage"));
+    for (int a = R_STAGE_ERR_BASE + 1; a < R_STAGE_ERR_END; a++) {
+        const char *t = r_stage_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = R_STAGE_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, r_stage_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(r_stage_error_text(R_STAGE_ERR_END), "?"));
+}
+
+T_MAIN({"error_ids_have_texts", t_error_ids_have_texts}, {"defaults", t_defaults}, {"every_key", t_every_key}, {"layout", t_layout},
        {"syntax_errors", t_syntax_errors}, {"missing_required", t_missing_required},
        {"value_errors", t_value_errors}, {"bounds", t_bounds}, {"directions_normalised", t_directions_normalised},
        {"environment_path", t_environment_path}, {"round_trip", t_round_trip},

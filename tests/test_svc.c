@@ -693,8 +693,9 @@ static void put_crc(uint8_t *buf, size_t n)
         buf[n - 4 + (size_t)k] = (uint8_t)(c >> (8 * k));
 }
 
-/* frames_total (> 0) when accepted; 0 when refused, which must be with code
- * and a message holding want (want NULL: must be accepted). */
+/* frames_total (> 0) when accepted; 0 when refused, which must be with the
+ * SVC error id code (or, for a code below SVC_ERR_BASE, any id that answers
+ * that HTTP status) and a message holding want (want NULL: must be accepted). */
 static int64_t upload(const svc_config *cfg, const uint8_t *data, size_t len, int code, const char *want)
 {
     svc_job j;
@@ -704,7 +705,9 @@ static int64_t upload(const svc_config *cfg, const uint8_t *data, size_t len, in
         T_ASSERT(j.frames_total > 0);
         return j.frames_total;
     }
-    T_ASSERTF(want && e.code == code, "%zu bytes: code %d, want %d: %s", len, e.code, code, e.msg);
+    bool as_wanted = code > SVC_ERR_BASE ? e.code == code : svc_http_status(e.code) == (unsigned)code;
+    T_ASSERTF(want && as_wanted, "%zu bytes: %s (%u), want %s: %s", len, svc_error_text(e.code),
+              svc_http_status(e.code), code > SVC_ERR_BASE ? svc_error_text(code) : "that status", e.msg);
     T_CONTAINS(e.msg, want);
     return 0;
 }
@@ -713,19 +716,19 @@ static void t_upload_refusals(void)
 {
     svc_config cfg;
     svc_config_defaults(&cfg);
-    T_EQ(upload(&cfg, (const uint8_t *)"", 0, 400, "empty upload"), 0);
-    T_EQ(upload(&cfg, (const uint8_t *)"hello world", 11, 400, "clip.rsr: not a ringside replay"), 0);
+    T_EQ(upload(&cfg, (const uint8_t *)"", 0, SVC_ERR_EMPTY, "empty upload"), 0);
+    T_EQ(upload(&cfg, (const uint8_t *)"hello world", 11, SVC_ERR_REPLAY, "clip.rsr: not a ringside replay"), 0);
     SET_OK(&cfg, "max_upload", "1K");
     uint8_t *junk = calloc(1, 1025);
     T_ASSERT(junk);
-    T_EQ(upload(&cfg, junk, 1025, 413, "clip.rsr: 1025 bytes is over the upload limit of 1024 bytes"), 0);
-    T_EQ(upload(&cfg, junk, 1024, 400, "clip.rsr: not a ringside replay"), 0); /* at the limit: parsed */
+    T_EQ(upload(&cfg, junk, 1025, SVC_ERR_TOO_LARGE, "clip.rsr: 1025 bytes is over the upload limit of 1024 bytes"), 0);
+    T_EQ(upload(&cfg, junk, 1024, SVC_ERR_REPLAY, "clip.rsr: not a ringside replay"), 0); /* at the limit: parsed */
     free(junk);
     size_t n;
     uint8_t *buf = make_replay(120, &n);
     memset(buf + 20, 0, 8); /* a replay of no ticks: nothing to render */
     put_crc(buf, n);
-    T_EQ(upload(&cfg, buf, n, 400, "clip.rsr: tick count 0"), 0);
+    T_EQ(upload(&cfg, buf, n, SVC_ERR_REPLAY, "clip.rsr: tick count 0"), 0);
     free(buf);
 }
 
@@ -740,7 +743,7 @@ static void t_upload_valid(void)
     cfg.max_seconds = 17;
     T_EQ(upload(&cfg, buf, n, 0, NULL), 1000);
     cfg.max_seconds = 16;
-    upload(&cfg, buf, n, 400, "clip.rsr: the replay lasts 17 s; this service renders at most 16 s (max_seconds)");
+    upload(&cfg, buf, n, SVC_ERR_TOO_LONG, "clip.rsr: the replay lasts 17 s; this service renders at most 16 s (max_seconds)");
     svc_config_defaults(&cfg);
     free(buf);
     char path[1024];
@@ -766,7 +769,7 @@ static void t_upload_truncations(void)
         uint8_t *cut = malloc(k);
         T_ASSERT(cut);
         memcpy(cut, buf, k);
-        T_ASSERTF(upload(&cfg, cut, k, 400, "clip.rsr") == 0, "the first %zu of %zu bytes were accepted", k, n);
+        T_ASSERTF(upload(&cfg, cut, k, SVC_ERR_REPLAY, "clip.rsr") == 0, "the first %zu of %zu bytes were accepted", k, n);
         free(cut);
     }
     free(buf);
@@ -795,6 +798,45 @@ static void t_upload_corruptions(void)
     free(buf);
 }
 
+/* Every id has a text, and no two share one. */
+static void t_error_ids_have_texts(void)
+{
+    T_EQ(RS_ERR_MODULE(SVC_ERR_BASE + 1), RS_ERR_MOD_SVC);
+    T_EQ(RS_ERR_MODULE(SVC_ERR_END - 1), RS_ERR_MOD_SVC);
+    for (int a = SVC_ERR_BASE + 1; a < SVC_ERR_END; a++) {
+        const char *t = svc_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = SVC_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, svc_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(svc_error_text(SVC_ERR_END), "?"));
+}
+
+/* The statuses clients have always seen; every id has a row (an id added
+ * without one would answer 500). */
+static void t_http_status_table(void)
+{
+    static const struct {
+        int id;
+        unsigned status;
+    } want[] = {
+        {SVC_ERR_EMPTY, 400},    {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
+        {SVC_ERR_BAD_BODY, 400}, {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
+        {SVC_ERR_GONE, 410},     {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
+        {SVC_ERR_NOMEM, 500},
+    };
+    T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+        T_ASSERTF(svc_http_status(want[i].id) == want[i].status, "%s: %u, want %u", svc_error_text(want[i].id),
+                  svc_http_status(want[i].id), want[i].status);
+    /* the queue store failing is always "the queue is unavailable" */
+    for (int a = SVC_STORE_ERR_BASE + 1; a < SVC_STORE_ERR_END; a++)
+        T_EQ(svc_http_status(a), 503);
+    /* a code from no list the service knows is a server error, never a client's */
+    T_EQ(svc_http_status(1), 500);
+    T_EQ(svc_http_status(RP_ERR_FIELD), 500);
+}
+
 T_MAIN({"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
        {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
        {"config_load_errors", t_config_load_errors}, {"config_finish", t_config_finish},
@@ -803,4 +845,5 @@ T_MAIN({"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"c
        {"json_str_random", t_json_str_random}, {"json_job", t_json_job}, {"json_buf_growth", t_json_buf_growth},
        {"range_cases", t_range_cases}, {"range_random", t_range_random}, {"upload_refusals", t_upload_refusals},
        {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
-       {"upload_corruptions", t_upload_corruptions})
+       {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
+       {"http_status_table", t_http_status_table})

@@ -712,11 +712,13 @@ BOTH(open_race)
 
 /* --- what each backend refuses, and how it says so --- */
 
-static void expect_open_fail(const char *spec, const char *want)
+static void expect_open_fail(const char *spec, int code, const char *want)
 {
     rs_err e = {0};
     svc_store *s = svc_store_open(spec, &e);
     T_ASSERTF(!s, "%s opened", spec);
+    T_ASSERTF(e.code == code, "%s: %s, want %s (%s)", spec, svc_store_error_text(e.code), svc_store_error_text(code),
+              e.msg);
     T_CONTAINS(e.msg, want);
 }
 
@@ -724,18 +726,18 @@ static void t_sqlite_bad_files(void)
 {
     const char *d = t_tmpdir();
     char p[600];
-    expect_open_fail("queue.txt", "expected sqlite:PATH, a path ending in .db, or postgres://");
-    expect_open_fail("sqlite:", "the database path is missing");
+    expect_open_fail("queue.txt", SVC_STORE_ERR_SPEC, "expected sqlite:PATH, a path ending in .db, or postgres://");
+    expect_open_fail("sqlite:", SVC_STORE_ERR_SPEC, "the database path is missing");
     sqlite_spec();
     snprintf(p, sizeof p, "sqlite:%s/no/such/dir/q.db", d);
-    expect_open_fail(p, "/no/such/dir/q.db");
+    expect_open_fail(p, SVC_STORE_ERR_OPEN, "/no/such/dir/q.db");
     /* a file that is not a database at all */
     char text[4096];
     memset(text, 'x', sizeof text - 1);
     text[sizeof text - 1] = 0;
     t_write(d, "notes.db", text);
     snprintf(p, sizeof p, "%s/notes.db", d);
-    expect_open_fail(p, "notes.db");
+    expect_open_fail(p, SVC_STORE_ERR_OPEN, "notes.db");
 #if defined(RS_HAVE_SQLITE)
     /* another program's database with its own jobs table */
     snprintf(p, sizeof p, "%s/other.db", d);
@@ -743,7 +745,7 @@ static void t_sqlite_bad_files(void)
     T_ASSERT(sqlite3_open(p, &db) == SQLITE_OK);
     T_ASSERT(sqlite3_exec(db, "CREATE TABLE jobs (title TEXT, salary INTEGER)", NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(db);
-    expect_open_fail(p, "other.db");
+    expect_open_fail(p, SVC_STORE_ERR_SCHEMA, "other.db");
 #endif
 }
 
@@ -772,17 +774,19 @@ static void t_pg_unreachable(void)
         snprintf(uri, sizeof uri, forms[i], port);
         rs_err e = {0};
         T_ASSERT(!svc_store_open(uri, &e));
+        T_EQ(e.code, SVC_STORE_ERR_OPEN);
         T_CONTAINS(e.msg, where);
         T_ASSERTF(!strstr(e.msg, "s3cret-pw"), "password in '%s'", e.msg);
     }
     /* libpq quotes a malformed URI whole */
     rs_err e = {0};
     T_ASSERT(!svc_store_open("postgresql://ringside:s3cret-pw@[::1/ringside", &e));
+    T_EQ(e.code, SVC_STORE_ERR_OPEN);
     T_ASSERT(e.msg[0]);
     T_ASSERTF(!strstr(e.msg, "s3cret-pw"), "password in '%s'", e.msg);
 #else
     snprintf(uri, sizeof uri, "postgresql://ringside:s3cret-pw@127.0.0.1:%d/ringside", port);
-    expect_open_fail(uri, "built without libpq (install libpq-dev and rebuild)");
+    expect_open_fail(uri, SVC_STORE_ERR_NOT_BUILT, "built without libpq (install libpq-dev and rebuild)");
     rs_err e = {0};
     svc_store_open(uri, &e);
     T_ASSERT(!strstr(e.msg, "s3cret-pw"));
@@ -794,7 +798,21 @@ static void t_pg_foreign_table(void)
 {
     const char *spec = pg_spec();
     pg_admin("CREATE TABLE " PG_SCHEMA ".jobs (title TEXT, salary INTEGER)");
-    expect_open_fail(spec, "table jobs is not a ringside queue");
+    expect_open_fail(spec, SVC_STORE_ERR_SCHEMA, "table jobs is not a ringside queue");
+}
+
+/* Every id has a text, and no two share one. */
+static void t_error_ids_have_texts(void)
+{
+    T_EQ(RS_ERR_MODULE(SVC_STORE_ERR_BASE + 1), RS_ERR_MOD_SVC_STORE);
+    T_EQ(RS_ERR_MODULE(SVC_STORE_ERR_END - 1), RS_ERR_MOD_SVC_STORE);
+    for (int a = SVC_STORE_ERR_BASE + 1; a < SVC_STORE_ERR_END; a++) {
+        const char *t = svc_store_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = SVC_STORE_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, svc_store_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(svc_store_error_text(SVC_STORE_ERR_END), "?"));
 }
 
 /* The server drops our connection (restart, failover): the next call
@@ -828,4 +846,4 @@ T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), 
        CASES(dead_letter), CASES(give_back), CASES(reap), CASES(list_paging), CASES(counts), CASES(persistence),
        CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), {"sqlite_bad_files", t_sqlite_bad_files},
        {"pg_unreachable", t_pg_unreachable}, {"pg_foreign_table", t_pg_foreign_table},
-       {"pg_reconnect", t_pg_reconnect})
+       {"pg_reconnect", t_pg_reconnect}, {"error_ids_have_texts", t_error_ids_have_texts})

@@ -25,6 +25,24 @@ static void t_err_one_line(void)
     T_ASSERT(!rs_fail(NULL, 1, "no crash without an err"));
 }
 
+/* Module blocks: a code names its list; *_error_text bodies share one lookup. */
+static void t_err_modules(void)
+{
+    T_ASSERT(!strcmp(rs_err_module_name(3), "local"));
+    T_ASSERT(!strcmp(rs_err_module_name(RS_ERR_BASE(RS_ERR_MOD_RP) + 1), "replay"));
+    T_ASSERT(!strcmp(rs_err_module_name(RS_ERR_BASE(RS_ERR_MOD_SVC) + 255), "service"));
+    T_ASSERT(!strcmp(rs_err_module_name(RS_ERR_BASE(RS_ERR_MOD_COUNT)), "?"));
+    T_ASSERT(!strcmp(rs_err_module_name(-1), "?"));
+    static const char *const texts[] = {"first", "second"};
+    int base = RS_ERR_BASE(RS_ERR_MOD_CAP);
+    T_ASSERT(!strcmp(rs_err_text_of(0, RS_ERR_MOD_CAP, texts, 2), "ok"));
+    T_ASSERT(!strcmp(rs_err_text_of(base, RS_ERR_MOD_CAP, texts, 2), "?"));
+    T_ASSERT(!strcmp(rs_err_text_of(base + 1, RS_ERR_MOD_CAP, texts, 2), "first"));
+    T_ASSERT(!strcmp(rs_err_text_of(base + 2, RS_ERR_MOD_CAP, texts, 2), "second"));
+    T_ASSERT(!strcmp(rs_err_text_of(base + 3, RS_ERR_MOD_CAP, texts, 2), "?"));
+    T_ASSERT(!strcmp(rs_err_text_of(base + 1, RS_ERR_MOD_MV, texts, 2), "?")); /* another module's code */
+}
+
 static void t_read_file_limits(void)
 {
     const char *d = t_tmpdir();
@@ -300,7 +318,8 @@ static void t_oiio_errors(void)
     T_ASSERT(!strcmp(rs_oiio_error_text(RS_OIIO_ERR_COUNT), "unknown OpenImageIO error"));
 }
 
-T_MAIN({"err_one_line", t_err_one_line}, {"read_file_limits", t_read_file_limits},
+T_MAIN({"err_one_line", t_err_one_line}, {"err_modules", t_err_modules},
+       {"read_file_limits", t_read_file_limits},
        {"png_roundtrip", t_png_roundtrip}, {"png_failure_leaves_nothing", t_png_failure_leaves_nothing},
        {"png_disk_full", t_png_disk_full},
        {"pnm_roundtrip", t_pnm_roundtrip}, {"pnm_bad_input", t_pnm_bad_input},

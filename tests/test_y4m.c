@@ -43,7 +43,7 @@ static void refuse(const char *text, int code, const char *needle)
     mv_info i;
     rs_err e;
     T_ASSERTF(!parse_n(text, strlen(text), &i, &e), "\"%s\" accepted", text);
-    T_ASSERTF(e.code == code, "\"%s\": code %d, want %d (%s)", text, e.code, code, e.msg);
+    T_ASSERTF(e.code == code, "\"%s\": %s, want %s (%s)", text, mv_error_text(e.code), mv_error_text(code), e.msg);
     T_ASSERTF(strstr(e.msg, needle), "\"%s\": expected \"%s\" in \"%s\"", text, needle, e.msg);
 }
 
@@ -181,7 +181,7 @@ static void open_fails(const char *path, int code, const char *needle)
     rs_err e = {0};
     mv_src *s = mv_y4m_open(path, &e);
     T_ASSERTF(!s, "%s opened", path);
-    T_ASSERTF(e.code == code, "%s: code %d, want %d (%s)", path, e.code, code, e.msg);
+    T_ASSERTF(e.code == code, "%s: %s, want %s (%s)", path, mv_error_text(e.code), mv_error_text(code), e.msg);
     T_CONTAINS(e.msg, path);
     T_CONTAINS(e.msg, needle);
 }
@@ -207,7 +207,7 @@ static void read_fails(mv_src *s, int code, const char *needle)
     rs_err e = {0};
     int64_t before = s->index;
     T_EQ(s->read(s, dst, &e), -1);
-    T_ASSERTF(e.code == code, "code %d, want %d (%s)", e.code, code, e.msg);
+    T_ASSERTF(e.code == code, "%s, want %s (%s)", mv_error_text(e.code), mv_error_text(code), e.msg);
     T_CONTAINS(e.msg, s->path);
     T_CONTAINS(e.msg, needle);
     T_EQ(s->index, before);
@@ -838,7 +838,22 @@ static void t_fuzz_files(void)
     out_done();
 }
 
-T_MAIN({"header_420jpeg", t_header_420jpeg}, {"header_colorspaces", t_header_colorspaces},
+/* Every id of the movie list has a text, and no two share one. */
+static void t_error_ids_have_texts(void)
+{
+    T_EQ(RS_ERR_MODULE(MV_ERR_BASE + 1), RS_ERR_MOD_MV);
+    T_EQ(RS_ERR_MODULE(MV_ERR_END - 1), RS_ERR_MOD_MV);
+    T_ASSERT(!strcmp(rs_err_module_name(MV_ERR_FORMAT), "movie"));
+    for (int a = MV_ERR_BASE + 1; a < MV_ERR_END; a++) {
+        const char *t = mv_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = MV_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, mv_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(mv_error_text(MV_ERR_END), "?"));
+}
+
+T_MAIN({"error_ids_have_texts", t_error_ids_have_texts}, {"header_420jpeg", t_header_420jpeg}, {"header_colorspaces", t_header_colorspaces},
        {"header_defaults", t_header_defaults}, {"header_rate_aspect", t_header_rate_aspect},
        {"header_range", t_header_range}, {"header_matrix", t_header_matrix},
        {"header_matrix_guess", t_header_matrix_guess}, {"header_ignores_unknown", t_header_ignores_unknown},

@@ -97,6 +97,16 @@ typedef struct ctx {
     rs_err *err;
 } ctx;
 
+const char *r_stage_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        R_STAGE_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_R_STAGE, text, (int)(sizeof text / sizeof text[0]));
+}
+
 static bool bad(const ctx *c, int code, const char *fmt, ...) RS_PRINTF(3, 4);
 static bool bad(const ctx *c, int code, const char *fmt, ...)
 {
@@ -173,9 +183,10 @@ static bool number(const ctx *c, const char *key, const char *part, const char *
 {
     char *end;
     double v = n ? strtod(tok, &end) : NAN;
-    if (!n || end != tok + n || !isfinite(v) || v < lo || v > hi)
-        return bad(c, R_STAGE_ERR_VALUE, "%s: %s%sexpected a number in %g..%g, got '%s'", key, part ? part : "",
-                   part ? ": " : "", lo, hi, quote(tok, n).s);
+    bool is_num = n && end == tok + n && isfinite(v);
+    if (!is_num || v < lo || v > hi)
+        return bad(c, is_num ? R_STAGE_ERR_RANGE : R_STAGE_ERR_VALUE, "%s: %s%sexpected a number in %g..%g, got '%s'",
+                   key, part ? part : "", part ? ": " : "", lo, hi, quote(tok, n).s);
     *out = (float)v;
     return true;
 }
@@ -293,7 +304,7 @@ static bool set(r_stage *st, const row *r, const char *v, const ctx *c)
         size_t nd = strspn(v, "0123456789");
         long x = nd && nd <= 9 && !v[nd] ? strtol(v, NULL, 10) : -1;
         if (x < 0 || x < (long)r->lo || x > (long)r->hi)
-            return bad(c, R_STAGE_ERR_VALUE, "%s: expected a whole number in %ld..%ld, got '%s'", r->key, (long)r->lo,
+            return bad(c, nd && !v[nd] ? R_STAGE_ERR_RANGE : R_STAGE_ERR_VALUE, "%s: expected a whole number in %ld..%ld, got '%s'", r->key, (long)r->lo,
                        (long)r->hi, Q(v));
         *(int *)field = (int)x;
         return true;
@@ -398,8 +409,8 @@ static bool unknown_key(const char *key, const ctx *c)
         }
     }
     if (best)
-        return bad(c, R_STAGE_ERR_SYNTAX, "unknown key '%s' (did you mean '%s'?)", Q(key), best);
-    return bad(c, R_STAGE_ERR_SYNTAX, "unknown key '%s' (keys are listed in docs/stages.md)", Q(key));
+        return bad(c, R_STAGE_ERR_UNKNOWN_KEY, "unknown key '%s' (did you mean '%s'?)", Q(key), best);
+    return bad(c, R_STAGE_ERR_UNKNOWN_KEY, "unknown key '%s' (keys are listed in docs/stages.md)", Q(key));
 }
 
 /* One line, NUL-terminated, without its '\n'.  seen[i] is the line where
@@ -425,7 +436,7 @@ static bool parse_line(r_stage *st, char *s, int seen[NROWS], const ctx *c)
     if (i == NROWS)
         return unknown_key(key, c);
     if (seen[i])
-        return bad(c, R_STAGE_ERR_SYNTAX, "duplicate key '%s' (first on line %d)", key, seen[i]);
+        return bad(c, R_STAGE_ERR_DUPLICATE_KEY, "duplicate key '%s' (first on line %d)", key, seen[i]);
     seen[i] = c->line;
     return set(st, &rows[i], val, c);
 }
@@ -463,7 +474,7 @@ bool r_stage_parse(r_stage *st, const char *path, const char *text, size_t len, 
     }
     for (size_t i = 0; ok && i < NROWS; i++)
         if (!rows[i].def && !seen[i])
-            ok = rs_fail(err, R_STAGE_ERR_SYNTAX, "%s: missing required key '%s' (every stage file sets name and game)",
+            ok = rs_fail(err, R_STAGE_ERR_MISSING_KEY, "%s: missing required key '%s' (every stage file sets name and game)",
                          path, rows[i].key);
     free(buf);
     return ok;
@@ -486,7 +497,7 @@ bool r_stage_load(r_stage *st, const char *path, rs_err *err)
 bool r_stage_for_game(r_stage *st, int game_index, rs_err *err)
 {
     if (game_index < 0 || game_index >= G_STAGES)
-        return rs_fail(err, R_STAGE_ERR_VALUE, "game stage %d does not exist (expected 0..%d)", game_index,
+        return rs_fail(err, R_STAGE_ERR_GAME, "game stage %d does not exist (expected 0..%d)", game_index,
                        G_STAGES - 1);
     const char *root = rs_data_dir(err);
     if (!root) {
@@ -500,7 +511,7 @@ bool r_stage_for_game(r_stage *st, int game_index, rs_err *err)
     if (!r_stage_load(st, path, err))
         return false;
     if (st->game_index != game_index)
-        return rs_fail(err, R_STAGE_ERR_VALUE,
+        return rs_fail(err, R_STAGE_ERR_GAME,
                        "%s: game is '%s', but this file dresses game stage '%s' (expected game = %s)", path, st->game,
                        g_stages[game_index].name, g_stages[game_index].name);
     return true;

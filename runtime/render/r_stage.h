@@ -17,7 +17,26 @@
 #define R_STAGE_MAX_BUILDINGS 48
 #define R_HALF_MAX 65504.0f /* largest finite fp16: the bound of every HDR value */
 
-enum { R_STAGE_ERR_FILE = 1, R_STAGE_ERR_SYNTAX, R_STAGE_ERR_VALUE };
+/* Error ids (rs_err.h).  Every message still reads "FILE:LINE: ...". */
+#define R_STAGE_ERRORS(X)                                                                          \
+    X(FILE, "cannot read the stage file (missing, too large, no data directory, out of memory)")  \
+    X(SYNTAX, "a line is not 'key = value', or holds a NUL byte")                                  \
+    X(UNKNOWN_KEY, "unknown key")                                                                   \
+    X(DUPLICATE_KEY, "a key is set twice")                                                          \
+    X(MISSING_KEY, "a required key (name, game) is missing")                                       \
+    X(VALUE, "a value of the wrong form (not a number, not one of the words allowed)")             \
+    X(RANGE, "a number outside the range of its key")                                              \
+    X(GAME, "no such game stage, or the file dresses another one")
+
+typedef enum r_stage_error {
+    R_STAGE_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_R_STAGE),
+#define X(id, text) R_STAGE_ERR_##id,
+    R_STAGE_ERRORS(X)
+#undef X
+        R_STAGE_ERR_END
+} r_stage_error;
+
+const char *r_stage_error_text(int code);
 
 typedef enum r_hdr_format { R_HDR_RGBA16F, R_HDR_R11G11B10F } r_hdr_format;
 

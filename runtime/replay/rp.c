@@ -9,6 +9,24 @@
 #include "../util/rs_file.h"
 #include "../util/rs_img.h" /* rs_crc32 */
 
+const char *rp_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        RP_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_RP, text, (int)(sizeof text / sizeof text[0]));
+}
+
+/* An error of a helper from another module (rs_file) as one of ours. */
+static bool recode(rs_err *err, int code)
+{
+    if (err)
+        err->code = code;
+    return false;
+}
+
 /* ---------- little-endian writer ---------- */
 typedef struct wbuf {
     uint8_t *p;
@@ -101,12 +119,12 @@ bool rp_encode(const rp_replay *rp, uint8_t **out, size_t *len, rs_err *err)
     wb_u(&w, rp->final_hash, 8);
     if (w.oom || in_oom) {
         free(w.p);
-        return rs_fail(err, RP_ERR_IO, "out of memory encoding a replay of %llu ticks", (unsigned long long)rp->ticks);
+        return rs_fail(err, RP_ERR_NOMEM, "out of memory encoding a replay of %llu ticks", (unsigned long long)rp->ticks);
     }
     wb_u(&w, rs_crc32(0, w.p, w.n), 4);
     if (w.oom) {
         free(w.p);
-        return rs_fail(err, RP_ERR_IO, "out of memory encoding a replay");
+        return rs_fail(err, RP_ERR_NOMEM, "out of memory encoding a replay");
     }
     *out = w.p;
     *len = w.n;
@@ -124,7 +142,7 @@ typedef struct rbuf {
 static bool need(rbuf *r, size_t n, const char *what)
 {
     if (r->n - r->o < n)
-        return rs_fail(r->err, RP_ERR_FORMAT, "%s: truncated at byte %zu: expected %s (%zu bytes), file has %zu",
+        return rs_fail(r->err, RP_ERR_TRUNCATED, "%s: truncated at byte %zu: expected %s (%zu bytes), file has %zu",
                        r->name, r->o, what, n, r->n - r->o);
     return true;
 }
@@ -147,7 +165,7 @@ static bool rd_varint(rbuf *r, size_t end, uint64_t *v)
     size_t start = r->o;
     for (int shift = 0; shift < 35; shift += 7) {
         if (r->o >= end)
-            return rs_fail(r->err, RP_ERR_FORMAT, "%s: truncated run length at byte %zu (input section ends at %zu)",
+            return rs_fail(r->err, RP_ERR_TRUNCATED, "%s: truncated run length at byte %zu (input section ends at %zu)",
                            r->name, start, end);
         uint8_t b = r->p[r->o++];
         x |= (uint64_t)(b & 0x7f) << shift;
@@ -156,10 +174,10 @@ static bool rd_varint(rbuf *r, size_t end, uint64_t *v)
             return true;
         }
     }
-    return rs_fail(r->err, RP_ERR_FORMAT, "%s: run length at byte %zu is longer than 5 bytes", r->name, start);
+    return rs_fail(r->err, RP_ERR_FIELD, "%s: run length at byte %zu is longer than 5 bytes", r->name, start);
 }
 
-#define BAD(...) rs_fail(err, RP_ERR_FORMAT, __VA_ARGS__)
+#define BAD(...) rs_fail(err, RP_ERR_FIELD, __VA_ARGS__)
 
 bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, rs_err *err)
 {
@@ -167,10 +185,10 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
     rbuf r = {buf, len, 0, name, err};
     uint64_t v;
     if (len > RP_MAX_FILE)
-        return rs_fail(err, RP_ERR_FORMAT, "%s: %zu bytes is larger than the %u-byte limit for replays", name, len,
+        return rs_fail(err, RP_ERR_TOO_BIG, "%s: %zu bytes is larger than the %u-byte limit for replays", name, len,
                        RP_MAX_FILE);
     if (len < 4 || memcmp(buf, RP_MAGIC, 4) != 0)
-        return BAD("%s: not a ringside replay: expected \"RSRP\" at byte 0", name);
+        return rs_fail(err, RP_ERR_MAGIC, "%s: not a ringside replay: expected \"RSRP\" at byte 0", name);
     if (!rd_u(&r, 4, &v, "magic") || !rd_u(&r, 2, &v, "format version"))
         return false;
     if (v != RP_VERSION)
@@ -179,7 +197,7 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
     rp->version = (int)v;
     /* the checksum covers everything, so check it before trusting any field */
     if (len < RP_HEADER_BYTES + 4 + 4 + 8 + 4)
-        return BAD("%s: truncated: %zu bytes, a replay has at least %d", name, len, RP_HEADER_BYTES + 20);
+        return rs_fail(err, RP_ERR_TRUNCATED, "%s: truncated: %zu bytes, a replay has at least %d", name, len, RP_HEADER_BYTES + 20);
     uint32_t stored = (uint32_t)buf[len - 4] | (uint32_t)buf[len - 3] << 8 | (uint32_t)buf[len - 2] << 16 |
                       (uint32_t)buf[len - 1] << 24;
     uint32_t crc = rs_crc32(0, buf, len - 4);
@@ -248,7 +266,7 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
     size_t in_end = r.o + (size_t)v;
     rp->inputs = malloc((size_t)rp->ticks * 2);
     if (!rp->inputs)
-        return rs_fail(err, RP_ERR_IO, "%s: out of memory for %llu ticks", name, (unsigned long long)rp->ticks);
+        return rs_fail(err, RP_ERR_NOMEM, "%s: out of memory for %llu ticks", name, (unsigned long long)rp->ticks);
     uint64_t t = 0;
     while (r.o < in_end) {
         size_t at = r.o;
@@ -261,7 +279,7 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
             goto fail;
         }
         if (in_end - r.o < 2) {
-            BAD("%s: truncated input run at byte %zu: expected two input bytes", name, r.o);
+            rs_fail(err, RP_ERR_TRUNCATED, "%s: truncated input run at byte %zu: expected two input bytes", name, r.o);
             goto fail;
         }
         g_input a = r.p[r.o], b = r.p[r.o + 1];
@@ -298,7 +316,7 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
     rp->ncheck = (size_t)v;
     rp->checkpoints = malloc(rp->ncheck ? rp->ncheck * 8 : 1);
     if (!rp->checkpoints) {
-        rs_fail(err, RP_ERR_IO, "%s: out of memory", name);
+        rs_fail(err, RP_ERR_NOMEM, "%s: out of memory", name);
         goto fail;
     }
     for (size_t k = 0; k < rp->ncheck; k++)
@@ -328,7 +346,7 @@ bool rp_read(const char *path, rp_replay *rp, rs_err *err)
     size_t n;
     uint8_t *buf = (uint8_t *)rs_read_file(path, RP_MAX_FILE, &n, err);
     if (!buf)
-        return false;
+        return recode(err, err && err->code == RS_FILE_ERR_TOO_BIG ? RP_ERR_TOO_BIG : RP_ERR_OPEN);
     bool ok = rp_decode(buf, n, path, rp, err);
     free(buf);
     return ok;
@@ -352,7 +370,7 @@ bool rp_write(const char *path, const rp_replay *rp, rs_err *err)
     bool written = rs_write_part(path, buf, n, err);
     free(buf);
     if (!written)
-        return false;
+        return recode(err, RP_ERR_WRITE);
     char part[PATH_MAX + 8];
     rs_part_path(path, part, sizeof part);
     /* read back what is on disk: it must decode to exactly what we recorded */
@@ -360,15 +378,15 @@ bool rp_write(const char *path, const rp_replay *rp, rs_err *err)
     if (!rp_read(part, &back, err)) {
         unlink(part);
         rs_err_prefix(err, "%s: read-back failed", path);
-        return false;
+        return recode(err, RP_ERR_WRITE);
     }
     bool eq = same(rp, &back);
     rp_free(&back);
     if (!eq) {
         unlink(part);
-        return rs_fail(err, RP_ERR_IO, "%s: read-back differs from what was recorded", path);
+        return rs_fail(err, RP_ERR_WRITE, "%s: read-back differs from what was recorded", path);
     }
-    return rs_commit_file(path, err);
+    return rs_commit_file(path, err) || recode(err, RP_ERR_WRITE);
 }
 
 /* ---------- recording ---------- */
@@ -392,14 +410,14 @@ bool rp_rec_tick(rp_recorder *r, const g_input in[2], const g_state *after, rs_e
         return false;
     if (rp->ticks >= RP_MAX_TICKS) {
         r->failed = true;
-        return rs_fail(err, RP_ERR_ARG, "replay longer than %llu ticks", (unsigned long long)RP_MAX_TICKS);
+        return rs_fail(err, RP_ERR_RECORD, "replay longer than %llu ticks", (unsigned long long)RP_MAX_TICKS);
     }
     if (rp->ticks == r->cap_ticks) {
         size_t cap = r->cap_ticks ? r->cap_ticks * 2 : 4096;
         g_input *ni = realloc(rp->inputs, cap * 2);
         if (!ni) {
             r->failed = true;
-            return rs_fail(err, RP_ERR_IO, "out of memory recording tick %llu", (unsigned long long)rp->ticks);
+            return rs_fail(err, RP_ERR_NOMEM, "out of memory recording tick %llu", (unsigned long long)rp->ticks);
         }
         rp->inputs = ni;
         r->cap_ticks = cap;
@@ -415,7 +433,7 @@ bool rp_rec_tick(rp_recorder *r, const g_input in[2], const g_state *after, rs_e
             uint64_t *nc = realloc(rp->checkpoints, cap * 8);
             if (!nc) {
                 r->failed = true;
-                return rs_fail(err, RP_ERR_IO, "out of memory recording checkpoints");
+                return rs_fail(err, RP_ERR_NOMEM, "out of memory recording checkpoints");
             }
             rp->checkpoints = nc;
             r->cap_check = cap;
@@ -434,7 +452,7 @@ bool rp_rec_tick(rp_recorder *r, const g_input in[2], const g_state *after, rs_e
 bool rp_rec_save(rp_recorder *r, const char *path, rs_err *err)
 {
     if (r->rp.ticks == 0)
-        return rs_fail(err, RP_ERR_ARG, "%s: nothing recorded (0 ticks)", path);
+        return rs_fail(err, RP_ERR_RECORD, "%s: nothing recorded (0 ticks)", path);
     return rp_write(path, &r->rp, err);
 }
 
@@ -461,7 +479,7 @@ bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t, uin
         if (hashes || at_check || last) {
             uint64_t h = g_hash(&st);
             if (hashes && fprintf(hashes, "%llu %016llx\n", (unsigned long long)(t + 1), (unsigned long long)h) < 0)
-                return rs_fail(err, RP_ERR_IO, "writing the hash list failed at tick %llu",
+                return rs_fail(err, RP_ERR_WRITE, "writing the hash list failed at tick %llu",
                                (unsigned long long)(t + 1));
             uint64_t want = at_check ? rp->checkpoints[next] : rp->final_hash;
             if ((at_check || last) && h != want) {

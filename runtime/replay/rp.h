@@ -23,7 +23,30 @@
 #define RP_MAX_TICKS (7ull * 24 * 3600 * G_HZ) /* a week of play */
 #define RP_DEFAULT_INTERVAL 60
 
-enum { RP_ERR_IO = 1, RP_ERR_FORMAT, RP_ERR_VERSION, RP_ERR_CHECKSUM, RP_ERR_DESYNC, RP_ERR_ARG };
+/* Error ids (rs_err.h): what a caller or a test can tell apart. */
+#define RP_ERRORS(X)                                                                   \
+    X(OPEN, "cannot open or read the replay file")                                     \
+    X(TOO_BIG, "larger than the size limit for replays")                               \
+    X(MAGIC, "not a ringside replay (no RSRP magic)")                                  \
+    X(VERSION, "format version not supported by this build")                          \
+    X(TRUNCATED, "the file ends before a field it needs")                              \
+    X(CHECKSUM, "checksum mismatch: the file is damaged or truncated")                 \
+    X(FIELD, "a header field or input run is out of range or inconsistent")            \
+    X(NOMEM, "out of memory")                                                          \
+    X(WRITE, "writing the replay (or a hash list) failed, or its read-back differs")   \
+    X(RECORD, "nothing to save, or a recording longer than the tick limit")            \
+    X(DESYNC, "the inputs no longer reproduce the recorded state hashes")
+
+typedef enum rp_error {
+    RP_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_RP),
+#define X(id, text) RP_ERR_##id,
+    RP_ERRORS(X)
+#undef X
+        RP_ERR_END
+} rp_error;
+
+const char *rp_error_text(int code);
+
 enum { RP_HUMAN = 0, RP_CPU = 1 };
 
 typedef struct rp_replay {

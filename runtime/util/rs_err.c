@@ -45,3 +45,21 @@ void rs_err_clear(rs_err *e)
         e->msg[0] = 0;
     }
 }
+
+const char *rs_err_module_name(int code)
+{
+    static const char *const names[] = {
+#define X(id, name) name,
+        RS_ERR_MODULES(X)
+#undef X
+    };
+    return code >= 0 && RS_ERR_MODULE(code) < RS_ERR_MOD_COUNT ? names[RS_ERR_MODULE(code)] : "?";
+}
+
+const char *rs_err_text_of(int code, rs_err_module mod, const char *const texts[], int n)
+{
+    if (code == 0)
+        return "ok";
+    int k = code - RS_ERR_BASE(mod) - 1;
+    return k >= 0 && k < n ? texts[k] : "?";
+}
