@@ -136,20 +136,26 @@ struct r_game {
 /* stencil bits: the scene pass marks the fighters' pixels */
 #define R_STENCIL_FIGHTER 0x80
 
-/* helpers of r_game.c */
+/* the GL layer (r_gl.c) */
 GLint r_loc(GLuint p, const char *name);
 void r_upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *ibo);
 void r_free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo);
 GLuint r_tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const void *px, GLenum filter, GLenum wrap);
 GLuint r_fbo_for(GLuint color, int level, GLuint depth); /* depth: a GL_DEPTH24_STENCIL8 texture or 0 */
+GLuint r_cube_tex(int n, float *const face[6], int levels); /* RGB16F faces; mipmapped when levels > 1 */
 void r_bind_tex(GLuint p, const char *name, int unit, GLenum target, GLuint t);
 void r_bind_ibl(r_game *r, GLuint p); /* units 8..13 */
 void r_fullscreen(r_game *r);      /* one triangle: cap_fullscreen.vert */
 int r_half(int v, int k);          /* v >> k, at least 1 */
-bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run this frame (so far) */
-void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
 void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
+
+/* per-frame set-up (r_frame.c) */
+void r_frame_setup(r_game *r, frame *f); /* f->prev, cur, alpha, w, h, out_fbo set: the rest */
+bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run this frame (so far) */
+
+/* the scene (r_scene.c) */
+void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
 void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
 /* The P_STAGE program's uniforms for this frame (lighting, shadows, fog,
  * LSPSM); material as scene.frag's u_material. */
@@ -160,5 +166,17 @@ void r_begin_opaque(r_game *r);
 /* The ring mesh (build_ring): its box's +y face, the destructible ring
  * top, is the 6 indices from here; the ground's box follows the ring's. */
 #define R_RING_TOP_FIRST 30
+bool r_build_lens(r_mesh_data *m); /* the visor's mesh */
+
+/* The core passes, each in the file of its responsibility; r_game.c's
+ * build_graph puts them in order with the effects' phases between. */
+#define R_SHADOW_NPASS 6
+#define R_POST_NPASS 5
+extern const r_pass r_shadow_passes[R_SHADOW_NPASS]; /* r_shadow.c */
+extern const r_pass r_scene_pass, r_sky_pass, r_lens_pass; /* r_scene.c */
+extern const r_pass r_post_passes[R_POST_NPASS];     /* r_post.c: bloom, sun visibility, flare, tone map */
+extern const r_pass r_hud_pass;                      /* r_hud.c */
+void r_update_lut(r_game *r);                        /* r_post.c: the tone curve for the stage's gamma */
+GLuint r_hud_font(void);                             /* r_hud.c: the font texture */
 
 #endif
