@@ -1,5 +1,5 @@
-/* The fog map (techniques A8): runtime/render/r_fx_fog_sim.c (the mist,
- * pure C) and r_fx_fog.c with shaders/fog_*.glsl (the map and the scene's
+/* The fog map (techniques A8): runtime/fx/fx_fog_sim.c (the mist,
+ * pure C) and fx_fog.c with shaders/fog_*.glsl (the map and the scene's
  * height fog), on llvmpipe.
  *
  * The GL cases draw the dojo demo's state with the mistvale look
@@ -13,8 +13,8 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
-#include "../runtime/render/r_fx.h"
-#include "../runtime/render/r_fx_fog_sim.h"
+#include "../runtime/fx/fx_fog.h"
+#include "../runtime/fx/fx_fog_sim.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"

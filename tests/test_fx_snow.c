@@ -1,4 +1,4 @@
-/* runtime/render/r_fx_snow: the snow effect (techniques A7) — its
+/* runtime/fx/fx_snow: the snow effect (techniques A7) — its
  * procedural textures, the displacement map's footprints (lowered where a
  * bone dips in, never below the trampled minimum, restored by a reset),
  * that it shows, and that it keeps the HDR buffer finite. */
@@ -11,8 +11,8 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
+#include "../runtime/fx/fx_snow_tex.h"
 #include "../runtime/render/r_fx.h"
-#include "../runtime/render/r_fx_snow_tex.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_graph.h"
 #include "../runtime/render/r_stage.h"

@@ -1,4 +1,4 @@
-/* runtime/render/r_fx_water*: the water effect (techniques A6).
+/* runtime/fx/fx_water*: the water effect (techniques A6).
  *
  *   - the CPU automaton stays bounded for a million forced steps at the
  *     default Courant number, and blows up above the cap when the cap is
@@ -18,7 +18,7 @@
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
-#include "../runtime/render/r_fx_water_sim.h"
+#include "../runtime/fx/fx_water_sim.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "t.h"

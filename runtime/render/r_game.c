@@ -14,10 +14,8 @@
 #include "r_tone.h"
 #include "r_local.h"
 
-static const char *const res_names[] = {"env",    "shadow map",  "silhouette",  "depth",       "shadow mask",
-                                        "hdr",    "bloom",       "sun visibility", "output",   "flare",
-                                        "fog map", "water",      "water reflection", "under water", "snow",
-                                        "snow light", "lspsm map"};
+static const char *const core_res_names[R_RES_CORE] = {"env", "shadow map", "silhouette", "depth", "shadow mask",
+                                                       "hdr", "bloom", "sun visibility", "output", "flare"};
 
 /* ---- the look: stage, environment, IBL ---- */
 
@@ -215,7 +213,28 @@ static bool build_programs(r_game *r, rs_err *err)
 
 static bool build_graph(r_game *r, rs_err *err)
 {
-    r_graph_init(&r->graph, RES_PERSISTENT, res_names, (int)(sizeof res_names / sizeof res_names[0]));
+    /* the effects' resources: named and made persistent by their modules */
+    uint32_t persistent = RES_PERSISTENT, fx_reads = 0;
+    memcpy(r->res_names, core_res_names, sizeof core_res_names);
+    for (int m = 0; m < r_fx_nmodules; m++) {
+        const r_fx_module *mod = r_fx_modules[m];
+        for (int k = 0; k < R_FX_MAX_RES && mod->res[k].bit; k++) {
+            int b = 0;
+            while (b < 32 && mod->res[k].bit != 1u << b)
+                b++;
+            if (b < R_RES_FX_FIRST || b >= 32 || r->res_names[b])
+                return rs_fail(err, 1, "effect '%s': resource '%s' is not one free bit from %d up", mod->name,
+                               mod->res[k].name, R_RES_FX_FIRST);
+            r->res_names[b] = mod->res[k].name;
+            if (mod->res[k].persistent)
+                persistent |= mod->res[k].bit;
+        }
+        fx_reads |= mod->scene_reads;
+    }
+    if (r_fx_units() > R_FX_UNIT_END - R_FX_UNIT_FIRST)
+        return rs_fail(err, 1, "the effects' bind hooks want %d texture units; there are %d", r_fx_units(),
+                       R_FX_UNIT_END - R_FX_UNIT_FIRST);
+    r_graph_init(&r->graph, persistent, r->res_names, 32);
     /* NULL: the stage effects' passes of that phase (r_fx.h) */
     const r_pass *const order[] = {
         &r_shadow_passes[0], &r_shadow_passes[1], &r_shadow_passes[2], &r_shadow_passes[3],
@@ -226,10 +245,8 @@ static bool build_graph(r_game *r, rs_err *err)
     for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
         if (order[i]) {
             r_pass p = *order[i];
-            if (p.run == r_scene_pass.run)
-                p.may_read |= RES_FOGMAP | RES_LSPSM;
-            else if (p.run == r_sky_pass.run || p.run == r_lens_pass.run)
-                p.may_read |= RES_FOGMAP;
+            if (p.run == r_scene_pass.run || p.run == r_sky_pass.run || p.run == r_lens_pass.run)
+                p.may_read |= fx_reads; /* what the modules bind into the scene's programs */
             if (!r_graph_add(&r->graph, &p, err))
                 return false;
             continue;
@@ -406,6 +423,49 @@ void r_game_destroy(r_game *r)
 }
 
 /* ---- the frame ---- */
+/* a known state whatever the caller left: every pass sets what it needs on top */
+static void known_state(void)
+{
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.Disable(GL_BLEND);
+    gl.BlendEquation(GL_FUNC_ADD);
+    gl.Disable(GL_STENCIL_TEST);
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_CULL_FACE);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gl.DepthMask(GL_TRUE);
+}
+
+/* What r_game_draw leaves bound. */
+static void leave_state(GLint out)
+{
+    gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)out);
+    gl.BindVertexArray(0);
+    gl.UseProgram(0);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.DepthMask(GL_TRUE);
+    gl.Enable(GL_DEPTH_TEST);
+}
+
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h)
+{
+    rs_err err = {0};
+    if (w <= 0 || h <= 0 || !r_game_prepare(r, cur->stage, &err) ||
+        (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) || r_fx_needs_frame(r))
+        return r_game_draw(r, prev, cur, 1.0f, w, h); /* which reports the error, or draws */
+    GLint out = 0;
+    gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &out);
+    known_state();
+    frame *f = &r->f;
+    memset(f, 0, sizeof *f);
+    f->prev = prev, f->cur = cur, f->alpha = 1.0f, f->w = w, f->h = h, f->out_fbo = out;
+    r_frame_setup(r, f); /* steps and reset, as a drawn frame counts them */
+    r_fx_advance(r);
+    leave_state(out);
+    RGL_CHECK("r_game_advance");
+    return true;
+}
+
 bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h)
 {
     GLint out = 0;
@@ -428,27 +488,14 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
         return false;
     }
     r_update_lut(r);
-    /* a known state whatever the caller left: every pass sets what it needs on top */
-    gl.Disable(GL_SCISSOR_TEST);
-    gl.Disable(GL_BLEND);
-    gl.BlendEquation(GL_FUNC_ADD);
-    gl.Disable(GL_STENCIL_TEST);
-    gl.Disable(GL_POLYGON_OFFSET_FILL);
-    gl.Disable(GL_CULL_FACE);
-    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    gl.DepthMask(GL_TRUE);
+    known_state();
     frame *f = &r->f;
     memset(f, 0, sizeof *f);
     f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = w, f->h = h, f->out_fbo = out;
     r_frame_setup(r, f);
     r->mask_final = 0;
     r_graph_run(&r->graph, r);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)out);
-    gl.BindVertexArray(0);
-    gl.UseProgram(0);
-    gl.ActiveTexture(GL_TEXTURE0);
-    gl.DepthMask(GL_TRUE);
-    gl.Enable(GL_DEPTH_TEST);
+    leave_state(out);
     RGL_CHECK("r_game_draw");
     return true;
 }

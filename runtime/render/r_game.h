@@ -50,6 +50,13 @@ const r_stage *r_game_stage(const r_game *r);
  * clears to black) when the stage could not be loaded: r_game_error. */
 bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h);
 const char *r_game_error(const r_game *r);
+/* Moves the stage effects' history (r_fx.h) on by the one game tick cur
+ * without drawing it: ticks 0..A-1 advanced and tick A drawn give the same
+ * frame A as ticks 0..A drawn (prev, w, h as r_game_draw would get them;
+ * each tick in turn).  Where an effect's history needs the frame itself
+ * (LSPSM's auto-focus), the frame is drawn into the bound framebuffer at
+ * alpha 1.  Returns false as r_game_draw does. */
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h);
 
 /* --passes: time every pass; per_frame prints one line per frame to out. */
 void r_game_passes(r_game *r, bool per_frame, FILE *out);

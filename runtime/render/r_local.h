@@ -1,6 +1,6 @@
-/* The game renderer's insides, shared by r_game.c and the stage-effect
- * modules (r_fx_*.c, r_fx.h).  Not an API: include only from
- * runtime/render. */
+/* The game renderer's insides, shared by the render core's files and the
+ * stage-effect modules (runtime/fx/, contract in r_fx.h).  Not an API:
+ * include only from runtime/render and runtime/fx. */
 #ifndef R_LOCAL_H
 #define R_LOCAL_H
 
@@ -34,16 +34,10 @@ enum {
     RES_SUNVIS = 1u << 7,
     RES_OUT = 1u << 8,
     RES_FLARE = 1u << 9,
-    /* stage effects */
-    RES_FOGMAP = 1u << 10,
-    RES_WATER = 1u << 11,       /* the wave simulation: persistent, steps each tick */
-    RES_WATER_REFL = 1u << 12,
-    RES_WATER_UNDER = 1u << 13,
-    RES_SNOW = 1u << 14,        /* the displacement map: persistent */
-    RES_SNOW_LIGHT = 1u << 15,
-    RES_LSPSM = 1u << 16,       /* the large-world shadow map */
 };
-#define RES_PERSISTENT (RES_ENV | RES_WATER | RES_SNOW)
+#define R_RES_CORE 10      /* the core's resources: bits 0..9 */
+#define R_RES_FX_FIRST 10  /* from here up, the stage effects' (r_fx.h) */
+#define RES_PERSISTENT RES_ENV
 
 typedef struct hud_vertex {
     float x, y, u, v, r, g, b, a;
@@ -119,19 +113,23 @@ struct r_game {
     int pass_ids[R_GRAPH_MAX];
     bool per_frame;
     FILE *passes_out;
-    /* stage effects: each module keeps its own state (r_fx.h) */
-    struct r_fx_water *water;
-    struct r_fx_snow *snow;
-    struct r_fx_fog *fog;
-    struct r_fx_afterimage *afterimage;
-    struct r_fx_lspsm *lspsm;
-    struct r_fx_holes *holes;
+    const char *res_names[32]; /* the graph's resources: the core's, then the effects' */
+    /* stage effects: each module's state, by its index in r_fx_modules (r_fx.h) */
+    void *fx_state[R_FX_MAX_MODULES];
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
     bool have_last;
     frame f;
     char error[768];
 };
 
+
+/* the core's side of the effect contract (r_fx.c) */
+int r_fx_units(void);                          /* texture units the modules' bind hooks take */
+void r_fx_bind(r_game *r, GLuint p, int what); /* every module's bind, units from R_FX_UNIT_FIRST */
+bool r_fx_scene_cleared(r_game *r);            /* an effect cleared the HDR target this frame */
+bool r_fx_draw_ring(r_game *r);                /* an effect drew the ring its own way */
+bool r_fx_needs_frame(r_game *r);              /* some history needs the frame drawn */
+void r_fx_advance(r_game *r);                  /* every module's history, one tick */
 
 /* stencil bits: the scene pass marks the fighters' pixels */
 #define R_STENCIL_FIGHTER 0x80

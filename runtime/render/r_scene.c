@@ -47,9 +47,8 @@ static void run_scene(void *u)
     gl.CullFace(GL_BACK);
     gl.Disable(GL_BLEND);
     bool prepass = r_ran(f, r, "z_prepass");
-    /* the holes pass (techniques D, steps 1-3) cleared and drew already */
-    bool holes = r_ran(f, r, "holes");
-    if (!holes)
+    /* an effect may have cleared and drawn already (the holes' stencil volumes) */
+    if (!r_fx_scene_cleared(r))
         gl.Clear(GL_COLOR_BUFFER_BIT | (prepass ? 0 : GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT));
 
     /* fighters: over their own z-prepass depth when it ran */
@@ -61,8 +60,7 @@ static void run_scene(void *u)
     r_bind_tex(p, "u_spec_map", 1, GL_TEXTURE_2D, r->spec_tex);
     r_bind_tex(p, "u_mask", 2, GL_TEXTURE_2D, r->mask_tex[r->mask_final]);
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
-    r_fx_fog_bind(r, p, 6);
-    r_fx_lspsm_bind(r, p, 4);
+    r_fx_bind(r, p, R_FX_BIND_SCENE);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     /* stencil bit R_STENCIL_FIGHTER marks the fighters' pixels: copies
      * drawn later (afterimages) stay behind the models, as if drawn first */
@@ -79,19 +77,9 @@ static void run_scene(void *u)
     gl.DepthFunc(GL_LESS);
     r_stage_uniforms(r, p, r->stage.buildings > 0 ? 1 : 0);
     gl.BindVertexArray(r->ring_vao);
-    if (!holes) {
+    /* an effect may draw the ring in its own order (the holes: r_fx.h) */
+    if (!r_fx_draw_ring(r))
         gl.DrawElements(GL_TRIANGLES, r->ring_count, GL_UNSIGNED_INT, NULL);
-        return;
-    }
-    /* with holes (techniques D, steps 5 and 6): the indestructible parts,
-     * then the ring top's colour only where its own depth is still there
-     * (the holes pass put the craters' depth in the rest) */
-    gl.DrawElements(GL_TRIANGLES, R_RING_TOP_FIRST, GL_UNSIGNED_INT, NULL);
-    gl.DrawElements(GL_TRIANGLES, r->ring_count - R_RING_TOP_FIRST - 6, GL_UNSIGNED_INT,
-                    (const void *)((R_RING_TOP_FIRST + 6) * sizeof(unsigned)));
-    gl.DepthFunc(GL_EQUAL);
-    gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, (const void *)(R_RING_TOP_FIRST * sizeof(unsigned)));
-    gl.DepthFunc(GL_LESS);
 }
 
 void r_begin_opaque(r_game *r)
@@ -113,8 +101,7 @@ void r_stage_uniforms(r_game *r, GLuint p, int material)
     r_bind_ibl(r, p);
     r_bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
     gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "mask_filter") && r_ran(f, r, "silhouette_mips"));
-    r_fx_fog_bind(r, p, 6);
-    r_fx_lspsm_bind(r, p, 4);
+    r_fx_bind(r, p, R_FX_BIND_SCENE);
     gl.Uniform1i(r_loc(p, "u_material"), material);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
@@ -149,7 +136,7 @@ static void run_sky(void *u)
                  fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
     gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
-    r_fx_fog_bind(r, p, 6);
+    r_fx_bind(r, p, R_FX_BIND_SKY);
     r_fullscreen(r);
     gl.DepthMask(GL_TRUE);
 }
@@ -170,7 +157,7 @@ static void run_lens(void *u)
     gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     r_camera_uniforms(r, p);
     r_bind_ibl(r, p);
-    r_fx_fog_bind(r, p, 6);
+    r_fx_bind(r, p, R_FX_BIND_LENS);
     gl.Uniform1f(r_loc(p, "u_lens_alpha"), LENS_ALPHA);
     gl.BindVertexArray(r->lens_vao);
     for (int i = 0; i < 2; i++) {
