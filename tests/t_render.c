@@ -51,7 +51,7 @@ void t_fb_free(t_fb *f)
 r_game *t_game_new(bool mask)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
+    r_game *r = r_game_create_opts(&(r_game_opts){.cache_dir = "", .quiet = true, .mask = mask}, &e);
     T_ASSERTF(r, "%s", e.msg);
     return r;
 }

@@ -239,7 +239,7 @@ enum { W = 320, H = 180 };
 static r_game *game_new(const r_stage *st)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true}, &e);
+    r_game *r = r_game_create_opts(&(r_game_opts){.cache_dir = "", .quiet = true}, &e);
     T_ASSERTF(r, "%s", e.msg);
     if (st)
         T_ASSERTF(r_game_set_stage(r, st, &e), "%s", e.msg);

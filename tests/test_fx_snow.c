@@ -96,7 +96,7 @@ static void t_color_textures(void)
 static r_game *game_new(void)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true}, &e);
+    r_game *r = r_game_create_opts(&(r_game_opts){.cache_dir = "", .quiet = true}, &e);
     T_ASSERTF(r, "%s", e.msg);
     T_ASSERTF(r_game_prepare(r, snowfield(), &e), "%s", e.msg);
     T_ASSERTF(r_game_stage(r)->snow, "stages/snowfield.stage has no snow");

@@ -114,7 +114,7 @@ static int shallows_index(void)
 static r_game *game_new(void)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .no_hud = true}, &e);
+    r_game *r = r_game_create_opts(&(r_game_opts){.cache_dir = "", .quiet = true, .no_hud = true}, &e);
     T_ASSERTF(r, "%s", e.msg);
     T_ASSERTF(r_game_prepare(r, shallows_index(), &e), "%s", e.msg);
     T_ASSERT(r_game_stage(r)->water);

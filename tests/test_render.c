@@ -31,7 +31,7 @@ enum { W = 320, H = 180 };
 
 static r_game *game_new(const r_game_opts *o)
 {
-    r_game_opts d = {.hdr_format = -1, .cache_dir = "", .quiet = true};
+    r_game_opts d = {.cache_dir = "", .quiet = true};
     if (o) {
         d = *o;
         d.cache_dir = "";
@@ -237,7 +237,7 @@ static void t_hud_shows_health_and_intro(void)
     int gold2 = gold_in_band(px);
     T_ASSERTF(gold2 < gold / 4, "announcement still shown during the fight (%d)", gold2);
     /* --no-hud leaves it out */
-    picture("temple", 30, &(r_game_opts){.hdr_format = -1, .no_hud = true}, px);
+    picture("temple", 30, &(r_game_opts){.no_hud = true}, px);
     bar = px + ((size_t)(H * 45 / 1000) * W + W / 4) * 4;
     T_ASSERTF(!(bar[0] > 200 && bar[1] > 150 && bar[2] < 80), "health bar drawn with no_hud");
     plat_destroy(p);
@@ -250,7 +250,7 @@ static void t_stage_file_keeps_the_matchs_ring(void)
     plat *p = t_context("egl");
     g_state prev, cur;
     t_state_at("dojo", 900, &prev, &cur);
-    r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/temple.stage"});
+    r_game *r = game_new(&(r_game_opts){.stage_file = RS_SOURCE_DIR "/stages/temple.stage"});
     t_fb f;
     t_fb_make(&f, W, H);
     draw(r, &f, &prev, &cur, NULL);
@@ -367,7 +367,7 @@ static void t_sunless_stage_skips_its_passes(void)
         T_ASSERTF(pass_ran(r, all[i]), "dojo: '%s' did not run", all[i]);
     r_game_destroy(r);
     /* sunless: no sun, no bloom, no shadows (stages/sunless.stage) */
-    r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
+    r = game_new(&(r_game_opts){.stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     const char *skipped[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter",
@@ -410,7 +410,7 @@ static void t_mask_output_alpha(void)
     g_state prev, cur;
     t_state_at("temple", 900, &prev, &cur);
     static uint8_t px[W * H * 4];
-    r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .mask = true});
+    r_game *r = game_new(&(r_game_opts){.mask = true});
     t_fb f;
     t_fb_make(&f, W, H);
     draw(r, &f, &prev, &cur, px);
@@ -696,7 +696,7 @@ static void t_packed_float_hdr(void)
     plat *p = t_context("egl");
     static uint8_t a[W * H * 4], b[W * H * 4];
     picture("temple", 900, NULL, a);
-    picture("temple", 900, &(r_game_opts){.hdr_format = R_HDR_R11G11B10F}, b);
+    picture("temple", 900, &(r_game_opts){.hdr_format = R_GAME_HDR_R11G11B10F}, b);
     double se = 0;
     for (int i = 0; i < W * H * 4; i += 4)
         for (int c = 0; c < 3; c++)

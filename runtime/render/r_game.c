@@ -56,7 +56,9 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
 {
     free_look(r);
     r->stage = *st;
-    r->hdr_format = r->opts.hdr_format >= 0 ? (r_hdr_format)r->opts.hdr_format : st->hdr_format;
+    r->hdr_format = r->opts.hdr_format == R_GAME_HDR_R11G11B10F ? R_HDR_R11G11B10F
+                    : r->opts.hdr_format == R_GAME_HDR_RGBA16F  ? R_HDR_RGBA16F
+                                                                : st->hdr_format;
     if (r->opts.mask && r->hdr_format != R_HDR_RGBA16F)
         return rs_fail(err, 1, "--mask needs an alpha channel: the r11g11b10f HDR format has none (use rgba16f)");
     r_ibl_params ip;
@@ -275,8 +277,6 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     }
     if (o)
         r->opts = *o;
-    else
-        r->opts.hdr_format = -1;
     if (r->opts.stage_file) {
         snprintf(r->stage_file, sizeof r->stage_file, "%s", r->opts.stage_file);
         r->opts.stage_file = r->stage_file;

@@ -24,11 +24,21 @@
 
 typedef struct r_game r_game;
 
+/* r_game_opts.hdr_format: zero is the stage's own (r_stage.hdr_format). */
+typedef enum r_game_hdr { R_GAME_HDR_STAGE, R_GAME_HDR_RGBA16F, R_GAME_HDR_R11G11B10F } r_game_hdr;
+
+/* An r_hdr_format (cli_hdr_format's) as an r_game_hdr. */
+static inline r_game_hdr r_game_hdr_of(int fmt)
+{
+    return fmt == R_HDR_R11G11B10F ? R_GAME_HDR_R11G11B10F : R_GAME_HDR_RGBA16F;
+}
+
+/* Zero is the default for every field. */
 typedef struct r_game_opts {
     const char *stage_file; /* NULL: <data>/stages/<game stage>.stage */
     bool mask;              /* output alpha = the fighters' mask (and no HUD) */
     bool no_hud;
-    int hdr_format;         /* -1: the stage's; else an r_hdr_format */
+    r_game_hdr hdr_format;  /* 0 (R_GAME_HDR_STAGE): the stage's */
     const char *cache_dir;  /* NULL: r_ibl_cache_dir(); "" = no cache */
     int lut_size;           /* 0: R_TONE_LUT_DEFAULT */
     bool quiet;             /* no note when prefiltering takes a while */
