@@ -31,7 +31,7 @@ static void frame_at(const char *demo, uint64_t a, bool advance, frame_px *out)
     for (uint64_t t = 0; t <= a; t++) {
         t_state_at(demo, t, &prev, &cur);
         if (t == a || !advance) {
-            t_draw(r, &fb, &prev, &cur, W, H);
+            t_draw_read(r, &fb, &prev, &cur, W, H, t == a ? out->rgba : NULL, false);
             continue;
         }
         rgl_error_reset();
@@ -41,10 +41,6 @@ static void frame_at(const char *demo, uint64_t a, bool advance, frame_px *out)
         T_EQ(rgl_error_count(), 0);
         T_EQ(gl.GetError(), GL_NO_ERROR);
     }
-    gl.BindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.ReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, out->rgba);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     out->hdr = t_read(r, "hdr", 4, W, H);
     r_game_destroy(r);
     t_fb_free(&fb);
