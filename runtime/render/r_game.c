@@ -217,6 +217,8 @@ static bool build_graph(r_game *r, rs_err *err)
 {
     /* the effects' resources: named and made persistent by their modules */
     uint32_t persistent = RES_PERSISTENT, fx_reads = 0;
+    if (r_fx_nmodules > R_FX_MAX_MODULES)
+        return rs_fail(err, 1, "%d stage effects; r_game keeps state for %d", r_fx_nmodules, R_FX_MAX_MODULES);
     memcpy(r->res_names, core_res_names, sizeof core_res_names);
     for (int m = 0; m < r_fx_nmodules; m++) {
         const r_fx_module *mod = r_fx_modules[m];

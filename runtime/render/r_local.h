@@ -155,8 +155,8 @@ bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run thi
 /* the scene (r_scene.c) */
 void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
 void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
-/* The P_STAGE program's uniforms for this frame (lighting, shadows, fog,
- * LSPSM); material as scene.frag's u_material. */
+/* The P_STAGE program's uniforms for this frame (lighting, shadows, the
+ * effects' maps through r_fx_bind); material as scene.frag's u_material. */
 void r_stage_uniforms(r_game *r, GLuint p, int material);
 /* Opaque drawing into the HDR target: its FBO and the frame's viewport,
  * depth test (less) and writes, back faces culled, no blending. */
