@@ -79,27 +79,31 @@ static void t_every_module_declares_its_history(void)
 /* The ticks: long enough for contacts, splats and a stirred mist. */
 static void t_fog_history(void)
 {
-    t_context("egl");
+    plat *p = t_context("egl");
     same_frame("mistvale", 45, "fog");
+    plat_destroy(p);
 }
 
 static void t_snow_history(void)
 {
-    t_context("egl");
+    plat *p = t_context("egl");
     same_frame("snowfield", 45, "snow");
+    plat_destroy(p);
 }
 
 static void t_water_history(void)
 {
-    t_context("egl");
+    plat *p = t_context("egl");
     same_frame("shallows", 45, "water");
+    plat_destroy(p);
 }
 
 /* LSPSM's focus needs the drawn frame: r_game_advance draws it there. */
 static void t_lspsm_history(void)
 {
-    t_context("egl");
+    plat *p = t_context("egl");
     same_frame("plaza", 6, "lspsm");
+    plat_destroy(p);
 }
 
 T_MAIN({"every_module_declares_its_history", t_every_module_declares_its_history},
