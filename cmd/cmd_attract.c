@@ -543,7 +543,7 @@ int cmd_attract(int argc, char **argv)
         status = cli_plat_status(&a->err);
         goto done;
     }
-    if (!(a->r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .quiet = true}, &a->err)))
+    if (!(a->r = r_game_create_opts(&(r_game_opts){.quiet = true}, &a->err)))
         goto done;
     if (a->headless && !r_target_create(&a->target, a->w, a->h, &a->err))
         goto done;

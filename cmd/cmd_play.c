@@ -174,7 +174,7 @@ int cmd_play(int argc, char **argv)
     uint64_t seed = (uint64_t)time(NULL);
     const char *record = NULL, *replay = NULL, *shot = NULL;
     bool headless = false, quiet = false;
-    r_game_opts go = {.hdr_format = -1};
+    r_game_opts go = {0};
     int passes = 0;
     plat_desc pd = {.title = "ringside"};
     rp_replay watch = {0};
@@ -203,12 +203,15 @@ int cmd_play(int argc, char **argv)
                 goto done;
             }
             break;
-        case 'X':
-            if (!cli_hdr_format(optarg, &go.hdr_format)) {
+        case 'X': {
+            int fmt;
+            if (!cli_hdr_format(optarg, &fmt)) {
                 status = RS_EXIT_USAGE;
                 goto done;
             }
+            go.hdr_format = r_game_hdr_of(fmt);
             break;
+        }
         case 'q': quiet = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:

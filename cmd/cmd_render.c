@@ -106,7 +106,7 @@ int cmd_render(int argc, char **argv)
     const char *out = NULL, *hashes = NULL, *backend = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
-    r_game_opts go = {.hdr_format = -1};
+    r_game_opts go = {0};
     int passes = 0; /* 1 summary, 2 per frame */
     long first = 0, end = -1; /* --ticks; end -1: the whole replay */
     long progress_fd = -1;
@@ -158,10 +158,13 @@ int cmd_render(int argc, char **argv)
             break;
         case 'M': go.mask = true; break;
         case 'U': go.no_hud = true; break;
-        case 'X':
-            if (!cli_hdr_format(optarg, &go.hdr_format))
+        case 'X': {
+            int fmt;
+            if (!cli_hdr_format(optarg, &fmt))
                 return RS_EXIT_USAGE;
+            go.hdr_format = r_game_hdr_of(fmt);
             break;
+        }
         case 'K': {
             char *colon = strchr(optarg, ':'), a[32];
             if (!colon || (size_t)(colon - optarg) >= sizeof a) {

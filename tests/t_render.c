@@ -8,6 +8,7 @@
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_img.h"
 #include "t.h"
 
 void t_state_at(const char *demo, uint64_t tick, g_state *prev, g_state *cur)
@@ -48,19 +49,41 @@ void t_fb_free(t_fb *f)
     gl.DeleteRenderbuffers(2, f->rb);
 }
 
-r_game *t_game_new(bool mask)
+r_game *t_game_opts(const r_game_opts *o)
 {
+    r_game_opts d = {0};
+    if (o)
+        d = *o;
+    d.cache_dir = "";
+    d.quiet = true;
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
+    r_game *r = r_game_create_opts(&d, &e);
     T_ASSERTF(r, "%s", e.msg);
     return r;
 }
 
+r_game *t_game_new(bool mask)
+{
+    return t_game_opts(&(r_game_opts){.mask = mask});
+}
+
 void t_draw(r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h)
+{
+    t_draw_read(r, f, prev, cur, w, h, NULL, false);
+}
+
+void t_draw_read(r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h, uint8_t *px,
+                 bool top_down)
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
     T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, w, h), "%s", r_game_error(r));
+    if (px) {
+        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+        gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        if (top_down)
+            rs_flip_rows(px, w, h, 4);
+    }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     T_EQ(rgl_error_count(), 0);
     T_EQ(gl.GetError(), GL_NO_ERROR);

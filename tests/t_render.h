@@ -23,8 +23,16 @@ void t_fb_free(t_fb *f);
 /* A game renderer for tests (no IBL cache, quiet; mask: HDR alpha = the
  * fighters' mask).  Fails the test when it cannot be made. */
 struct r_game *t_game_new(bool mask);
+/* The same with these options (NULL: all default); cache_dir and quiet are
+ * the tests' whatever o says. */
+struct r_game_opts;
+struct r_game *t_game_opts(const struct r_game_opts *o);
 /* One w x h frame into f, failing the test on any GL or pass-graph error. */
 void t_draw(struct r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h);
+/* The same, then f's RGBA8 pixels into px (w * h * 4; NULL: none), the
+ * top row first when top_down, else as GL reads them (bottom row first). */
+void t_draw_read(struct r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h, uint8_t *px,
+                 bool top_down);
 /* Did the pass run in the frame drawn last (fails the test on a bad name)? */
 bool t_pass_ran(struct r_game *r, const char *name);
 /* r_game_read_buffer into a new w x h x channels array (free() it). */

@@ -18,33 +18,6 @@
 
 enum { W = 320, H = 180 };
 
-static r_game *game_new(bool mask)
-{
-    rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .mask = mask}, &e);
-    T_ASSERTF(r, "%s", e.msg);
-    return r;
-}
-
-static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur)
-{
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
-}
-
-static bool pass_ran(r_game *r, const char *name)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, name);
-    T_ASSERTF(i >= 0, "no pass '%s'", name);
-    return (g->last_ran >> i) & 1;
-}
-
 static void load_stage(r_stage *st, const char *name)
 {
     char path[1024];
@@ -85,19 +58,19 @@ static void t_effects_run_only_where_asked(void)
     for (size_t s = 0; s < sizeof stages / sizeof stages[0]; s++) {
         r_stage st;
         load_stage(&st, stages[s]);
-        r_game *r = game_new(false);
+        r_game *r = t_game_new(false);
         rs_err e = {0};
         T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
         g_state prev, cur;
         /* holes are game state: the quarry demo's own match has them */
         t_state_at(st.holes ? "quarry" : "dojo", st.holes ? 3000 : 400, &prev, &cur);
         for (int k = 0; k < 10; k++) { /* ticks 400..409: fast limbs among them */
-            draw(r, &f, &prev, &cur);
+            t_draw(r, &f, &prev, &cur, W, H);
             for (int m = 0; m < r_fx_nmodules; m++) {
                 const r_fx_module *mod = r_fx_modules[m];
                 for (int ph = 0; ph < R_FX_PHASES; ph++)
                     for (int i = 0; i < mod->npass[ph]; i++) {
-                        bool ran = pass_ran(r, mod->pass[ph][i].name);
+                        bool ran = t_pass_ran(r, mod->pass[ph][i].name);
                         T_ASSERTF(!ran || wants(&st, mod->name), "stage %s ran pass '%s' of effect %s it does not use",
                                   stages[s], mod->pass[ph][i].name, mod->name);
                         ran_somewhere[m] |= ran;
@@ -130,7 +103,7 @@ static float *hdr_frame(r_game *r, t_fb *f, r_afterimage mode, const g_state *pr
     st.afterimage = mode;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, f, prev, cur);
+    t_draw(r, f, prev, cur, W, H);
     float *px = malloc((size_t)W * H * 4 * sizeof *px);
     T_ASSERT(px);
     int w = 0, h = 0;
@@ -148,13 +121,13 @@ static void t_afterimage_trails_fast_limbs_only(void)
     t_fb_make(&f, W, H);
     g_state prev, cur;
     t_state_at("dojo", 408, &prev, &cur);
-    r_game *r = game_new(true); /* mask mode: HDR alpha = the fighters' mask */
+    r_game *r = t_game_new(true); /* mask mode: HDR alpha = the fighters' mask */
     float *off = hdr_frame(r, &f, R_AFTERIMAGE_OFF, &prev, &cur);
-    T_ASSERT(!pass_ran(r, "afterimage"));
+    T_ASSERT(!t_pass_ran(r, "afterimage"));
     float *on = hdr_frame(r, &f, R_AFTERIMAGE_VIEW, &prev, &cur);
-    T_ASSERT(pass_ran(r, "afterimage"));
+    T_ASSERT(t_pass_ran(r, "afterimage"));
     float *world = hdr_frame(r, &f, R_AFTERIMAGE_WORLD, &prev, &cur);
-    T_ASSERT(pass_ran(r, "afterimage"));
+    T_ASSERT(t_pass_ran(r, "afterimage"));
     int changed = 0, over_fighter = 0, alpha_changed = 0, changed_world = 0, bad = 0;
     for (size_t i = 0; i < (size_t)W * H; i++) {
         const float *a = off + 4 * i, *b = on + 4 * i, *c = world + 4 * i;
@@ -182,7 +155,7 @@ static void t_afterimage_trails_fast_limbs_only(void)
 
     /* the same tick drawn again: nothing moved since, no pass */
     float *still = hdr_frame(r, &f, R_AFTERIMAGE_VIEW, &cur, &cur);
-    T_ASSERT(!pass_ran(r, "afterimage"));
+    T_ASSERT(!t_pass_ran(r, "afterimage"));
     free(still);
     /* a threshold above every limb's speed: no pass */
     r_stage st;
@@ -190,8 +163,8 @@ static void t_afterimage_trails_fast_limbs_only(void)
     st.afterimage_speed = 1000;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur);
-    T_ASSERT(!pass_ran(r, "afterimage"));
+    t_draw(r, &f, &prev, &cur, W, H);
+    T_ASSERT(!t_pass_ran(r, "afterimage"));
     r_game_destroy(r);
     t_fb_free(&f);
     plat_destroy(p);
@@ -206,7 +179,7 @@ static void t_afterimage_extremes(void)
     t_fb_make(&f, W, H);
     g_state prev, cur;
     t_state_at("dojo", 408, &prev, &cur);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     r_stage st;
     load_stage(&st, "dojo");
     st.afterimage_stretch = 8, st.afterimage_speed = 0;
@@ -215,8 +188,8 @@ static void t_afterimage_extremes(void)
     /* a teleport: the previous tick's state has the fighters 3 m away */
     g_state far = prev;
     far.f[0].x += FX(3.0), far.f[1].x -= FX(3.0);
-    draw(r, &f, &far, &cur);
-    T_ASSERT(pass_ran(r, "afterimage"));
+    t_draw(r, &f, &far, &cur, W, H);
+    T_ASSERT(t_pass_ran(r, "afterimage"));
     float *px = malloc((size_t)W * H * 4 * sizeof *px);
     T_ASSERT(px && r_game_read_buffer(r, "hdr", px, NULL, NULL));
     int bad = 0;
@@ -240,18 +213,18 @@ static void t_stage_switch_leaves_nothing_behind(void)
     g_state prev, cur;
     t_state_at("dojo", 408, &prev, &cur);
     static const char *const order[] = {"mistvale", "shallows", "snowfield", "mistvale", "dojo"};
-    r_game *shared = game_new(false);
+    r_game *shared = t_game_new(false);
     for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
         r_stage st;
         load_stage(&st, order[i]);
         rs_err e = {0};
         T_ASSERTF(r_game_set_stage(shared, &st, &e), "%s", e.msg);
-        draw(shared, &f, &prev, &cur);
+        t_draw(shared, &f, &prev, &cur, W, H);
         float *a = malloc((size_t)W * H * 4 * sizeof *a), *b = malloc((size_t)W * H * 4 * sizeof *b);
         T_ASSERT(a && b && r_game_read_buffer(shared, "hdr", a, NULL, NULL));
-        r_game *fresh = game_new(false);
+        r_game *fresh = t_game_new(false);
         T_ASSERTF(r_game_set_stage(fresh, &st, &e), "%s", e.msg);
-        draw(fresh, &f, &prev, &cur);
+        t_draw(fresh, &f, &prev, &cur, W, H);
         T_ASSERT(r_game_read_buffer(fresh, "hdr", b, NULL, NULL));
         int differ = 0;
         for (size_t k = 0; k < (size_t)W * H * 4; k++)
@@ -271,7 +244,7 @@ static void t_empty_frame_is_refused(void)
     plat *p = t_context("egl");
     g_state prev, cur;
     t_state_at("shallows", 300, &prev, &cur);
-    r_game *r = game_new(false);
+    r_game *r = t_game_new(false);
     T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 0, 0));
     T_CONTAINS(r_game_error(r), "cannot draw a 0x0 frame");
     T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 64, -1));

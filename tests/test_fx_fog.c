@@ -1,5 +1,5 @@
-/* The fog map (techniques A8): runtime/render/r_fx_fog_sim.c (the mist,
- * pure C) and r_fx_fog.c with shaders/fog_*.glsl (the map and the scene's
+/* The fog map (techniques A8): runtime/fx/fx_fog_sim.c (the mist,
+ * pure C) and fx_fog.c with shaders/fog_*.glsl (the map and the scene's
  * height fog), on llvmpipe.
  *
  * The GL cases draw the dojo demo's state with the mistvale look
@@ -13,8 +13,8 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
-#include "../runtime/render/r_fx.h"
-#include "../runtime/render/r_fx_fog_sim.h"
+#include "../runtime/fx/fx_fog.h"
+#include "../runtime/fx/fx_fog_sim.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"
@@ -239,8 +239,7 @@ enum { W = 320, H = 180 };
 static r_game *game_new(const r_stage *st)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true}, &e);
-    T_ASSERTF(r, "%s", e.msg);
+    r_game *r = t_game_new(false);
     if (st)
         T_ASSERTF(r_game_set_stage(r, st, &e), "%s", e.msg);
     return r;
@@ -253,31 +252,6 @@ static r_stage mistvale(void)
     T_ASSERTF(r_stage_load(&st, RS_SOURCE_DIR "/stages/mistvale.stage", &e), "%s", e.msg);
     T_ASSERT(st.fog);
     return st;
-}
-
-static bool pass_ran(r_game *r, const char *name)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, name);
-    T_ASSERTF(i >= 0, "no pass '%s'", name);
-    return (g->last_ran >> i) & 1;
-}
-
-/* One frame into f (px: RGBA8 top row first, may be NULL); no GL errors. */
-static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
-{
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    if (px) {
-        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-        gl.ReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
-        rs_flip_rows(px, W, H, 4);
-    }
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
 }
 
 static float *read_map(r_game *r, int *n, float *half)
@@ -333,7 +307,7 @@ static void place(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, c
     s->n = n;
     for (int i = 0; i < n; i++)
         s->p[i] = (r_fog_particle){xz[i][0], xz[i][1], 1.0f, 5.0f, 10.0f};
-    draw(r, f, prev, cur, NULL);
+    t_draw_read(r, f, prev, cur, W, H, NULL, true);
 }
 
 /* The map is the particles' sprites: the right height where each is,
@@ -347,8 +321,8 @@ static void t_map_is_where_particles_are(void)
     r_game *r = game_new(&st);
     t_fb f;
     t_fb_make(&f, W, H);
-    draw(r, &f, &prev, &cur, NULL);
-    T_ASSERT(pass_ran(r, "fog_map"));
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
+    T_ASSERT(t_pass_ran(r, "fog_map"));
     int n;
     float h;
     float *m = read_map(r, &n, &h);
@@ -431,9 +405,9 @@ static void t_map_follows_the_game(void)
         prev = cur;
         for (uint64_t t = 0; t < to; t++) {
             if (t >= from) {
-                draw(r, &f, &prev, &cur, NULL);
+                t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
                 if (run == 1 && t % 7 == 0) /* drawn again: steps 0 */
-                    draw(r, &f, &prev, &cur, NULL);
+                    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
                 stirred += run == 0 ? r_fx_fog_sim(r)->stirred : 0;
             }
             prev = cur;
@@ -476,7 +450,7 @@ static void t_fog_varies_at_equal_height(void)
     t_fb f;
     t_fb_make(&f, W, H);
     r_game *r = game_new(&st);
-    draw(r, &f, &prev, &cur, NULL);
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
     r_vec3 eye;
     r_mat4 vp = r_game_camera(&cur, W, H, &eye);
     float mid = eye.x, cut = mid - 1.2f;
@@ -500,8 +474,8 @@ static void t_fog_varies_at_equal_height(void)
     st.fog = false;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, NULL);
-    T_ASSERT(!pass_ran(r, "fog_map"));
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
+    T_ASSERT(!t_pass_ran(r, "fog_map"));
     T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
     /* the floor 1 m in front of the fight plane, 1.8 m to either side;
      * the clear one's whole view ray is over x >= mid: no mist at all */
@@ -535,14 +509,14 @@ static void t_fog_is_visible(void)
     t_fb f;
     t_fb_make(&f, W, H);
     r_game *r = game_new(&st);
-    draw(r, &f, &prev, &cur, a);
-    T_ASSERT(pass_ran(r, "fog_map"));
+    t_draw_read(r, &f, &prev, &cur, W, H, a, true);
+    T_ASSERT(t_pass_ran(r, "fog_map"));
     T_ASSERT(r_game_read_buffer(r, "hdr", ha, &w, &h));
     st.fog = false;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, b);
-    T_ASSERT(!pass_ran(r, "fog_map"));
+    t_draw_read(r, &f, &prev, &cur, W, H, b, true);
+    T_ASSERT(!t_pass_ran(r, "fog_map"));
     T_ASSERT(r_game_read_buffer(r, "hdr", hb, &w, &h));
     dump_frame("mistvale_fog", a);
     dump_frame("mistvale_nofog", b);
@@ -587,8 +561,8 @@ static void t_fog_off_keeps_the_golden_image(void)
     t_fb f;
     t_fb_make(&f, W, H);
     r_game *r = game_new(NULL);
-    draw(r, &f, &prev, &cur, px);
-    T_ASSERT(!pass_ran(r, "fog_map"));
+    t_draw_read(r, &f, &prev, &cur, W, H, px, true);
+    T_ASSERT(!t_pass_ran(r, "fog_map"));
     rs_image g;
     rs_err e = {0};
     T_ASSERTF(rs_pnm_read(RS_SOURCE_DIR "/tests/golden/render_dojo_1200.ppm", &g, &e), "%s", e.msg);
@@ -656,8 +630,8 @@ static void t_fp16_extremes(void)
         if (cases[k].key >= 0)
             st.key.intensity = st.counter.intensity = cases[k].key;
         T_ASSERTF(r_game_set_stage(r, &st, &e), "%s: %s", cases[k].what, e.msg);
-        draw(r, &f, &prev, &cur, NULL);
-        T_ASSERT(pass_ran(r, "fog_map"));
+        t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
+        T_ASSERT(t_pass_ran(r, "fog_map"));
         check_finite(r, cases[k].what);
         if (cases[k].sky == 0) { /* no light anywhere: the fog has none to scatter either */
             static float hdr[W * H * 4];
@@ -673,11 +647,11 @@ static void t_fp16_extremes(void)
     g_state far = cur;
     far.tick = cur.tick + 1;
     far.f[0].x = FX(30000);
-    draw(r, &f, &cur, &far, NULL);
+    t_draw_read(r, &f, &cur, &far, W, H, NULL, true);
     check_finite(r, "teleport");
     g_state back = cur;
     back.tick = far.tick + 1;
-    draw(r, &f, &far, &back, NULL);
+    t_draw_read(r, &f, &far, &back, W, H, NULL, true);
     check_finite(r, "teleport back");
     /* every particle on one spot */
     static float xz[3000][2];
@@ -686,7 +660,7 @@ static void t_fp16_extremes(void)
     /* a corrupted mist: weights and places no simulation makes */
     r_fog_sim *s = r_fx_fog_sim(r);
     s->p[0].weight = INFINITY, s->p[1].weight = NAN, s->p[2].weight = 1e30f, s->p[3].x = NAN, s->p[4].z = -INFINITY;
-    draw(r, &f, &cur, &back, NULL);
+    t_draw_read(r, &f, &cur, &back, W, H, NULL, true);
     check_finite(r, "corrupted particles");
     r_game_destroy(r);
     t_fb_free(&f);

@@ -1,4 +1,4 @@
-/* Destruction holes on GL (runtime/render/r_fx_holes.c, techniques D): the
+/* Destruction holes on GL (runtime/fx/fx_holes.c, techniques D): the
  * craters change the picture only inside their rims, force their depth
  * into the depth buffer (deeper than the ring top), never cover a fighter
  * (the fighters are drawn after them: the mask is unchanged), 30 holes
@@ -12,7 +12,7 @@
 
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
-#include "../runtime/render/r_fx.h"
+#include "../runtime/fx/fx_holes.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "t.h"

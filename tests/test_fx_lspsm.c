@@ -1,4 +1,4 @@
-/* LSPSM shadows in a large world (runtime/render/r_fx_lspsm.c, techniques
+/* LSPSM shadows in a large world (runtime/fx/fx_lspsm.c, techniques
  * C) on GL: the buildings' shadows show; culling drops casters without
  * changing the map; the auto-focus reads exactly the 20x16 pattern of the
  * depth buffer and uses it the next frame; the fighters do not shadow
@@ -13,7 +13,7 @@
 
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
-#include "../runtime/render/r_fx.h"
+#include "../runtime/fx/fx_lspsm.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_lspsm.h"
 #include "../runtime/render/r_stage.h"

@@ -1,4 +1,4 @@
-/* runtime/render/r_fx_snow: the snow effect (techniques A7) — its
+/* runtime/fx/fx_snow: the snow effect (techniques A7) — its
  * procedural textures, the displacement map's footprints (lowered where a
  * bone dips in, never below the trampled minimum, restored by a reset),
  * that it shows, and that it keeps the HDR buffer finite. */
@@ -11,8 +11,8 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
+#include "../runtime/fx/fx_snow_tex.h"
 #include "../runtime/render/r_fx.h"
-#include "../runtime/render/r_fx_snow_tex.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_graph.h"
 #include "../runtime/render/r_stage.h"
@@ -96,30 +96,10 @@ static void t_color_textures(void)
 static r_game *game_new(void)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true}, &e);
-    T_ASSERTF(r, "%s", e.msg);
+    r_game *r = t_game_new(false);
     T_ASSERTF(r_game_prepare(r, snowfield(), &e), "%s", e.msg);
     T_ASSERTF(r_game_stage(r)->snow, "stages/snowfield.stage has no snow");
     return r;
-}
-
-static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur)
-{
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
-}
-
-static bool pass_ran(r_game *r, const char *name)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, name);
-    T_ASSERTF(i >= 0, "no pass '%s'", name);
-    return (g->last_ran >> i) & 1;
 }
 
 typedef struct maps {
@@ -172,8 +152,8 @@ static void t_contacts_lower_the_map(void)
     t_fb_make(&f, W, H);
     g_state st;
     g_init(&st, snowfield(), 1); /* both fighters standing, feet on the ring */
-    draw(r, &f, &st, &st);
-    T_ASSERT(pass_ran(r, "snow_map") && pass_ran(r, "snow_light") && pass_ran(r, "snow_surface"));
+    t_draw(r, &f, &st, &st, W, H);
+    T_ASSERT(t_pass_ran(r, "snow_map") && t_pass_ran(r, "snow_light") && t_pass_ran(r, "snow_surface"));
     static maps m;
     read_maps(r, &m);
     check_bounds(&m, "first frame");
@@ -231,7 +211,7 @@ static void t_never_below_trampled_and_reset(void)
     t_fb_make(&f, W, H);
     g_state st;
     g_init(&st, snowfield(), 1);
-    draw(r, &f, &st, &st);
+    t_draw(r, &f, &st, &st, W, H);
     static maps before, m;
     read_maps(r, &before);
     /* thousands of stamps of a bone sunk deep under the boards, same place */
@@ -259,15 +239,15 @@ static void t_never_below_trampled_and_reset(void)
     T_ASSERTF(hi - lo > 0.002f, "a flat print: %g..%g", lo, hi);
 
     /* the same tick drawn again: no step, the map is kept */
-    draw(r, &f, &st, &st);
-    T_ASSERT(!pass_ran(r, "snow_map") && pass_ran(r, "snow_surface"));
+    t_draw(r, &f, &st, &st, W, H);
+    T_ASSERT(!t_pass_ran(r, "snow_map") && t_pass_ran(r, "snow_surface"));
     read_maps(r, &m);
     T_ASSERT(m.map[t] == m.tr[t]);
     /* a seek (more than R_FX_MAX_GAP ticks) restarts from untouched snow */
     g_state later = st;
     later.tick += R_FX_MAX_GAP + 5;
-    draw(r, &f, &later, &later);
-    T_ASSERT(pass_ran(r, "snow_map"));
+    t_draw(r, &f, &later, &later, W, H);
+    T_ASSERT(t_pass_ran(r, "snow_map"));
     static maps after;
     read_maps(r, &after);
     T_ASSERTF(after.map[t] == after.un[t], "after the reset: %g, untouched %g", after.map[t], after.un[t]);
@@ -312,9 +292,9 @@ static void t_footprints_where_fighters_walked(void)
                 foot_y[t][2 * i + k] = fx_to_float(b->ay) - fx_to_float(b->r);
             }
         }
-        draw(every, &f, &prev, &cur);
+        t_draw(every, &f, &prev, &cur, W, H);
         if (t % 2 == 1)
-            draw(other, &f, &prev, &cur);
+            t_draw(other, &f, &prev, &cur, W, H);
     }
     static maps m, m60;
     read_maps(every, &m60);
@@ -368,16 +348,16 @@ static void t_snow_is_visible(void)
     g_state st;
     g_init(&st, snowfield(), 1);
     static float with[W * H * 4], without[W * H * 4];
-    draw(r, &f, &st, &st);
+    t_draw(r, &f, &st, &st, W, H);
     read_hdr(r, with);
     const char *passes[] = {"snow_map", "snow_light", "snow_light_blur", "snow_surface"};
     r_stage bare = *r_game_stage(r);
     bare.snow = false;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &bare, &e), "%s", e.msg);
-    draw(r, &f, &st, &st);
+    t_draw(r, &f, &st, &st, W, H);
     for (size_t k = 0; k < sizeof passes / sizeof passes[0]; k++)
-        T_ASSERTF(!pass_ran(r, passes[k]), "'%s' ran without snow", passes[k]);
+        T_ASSERTF(!t_pass_ran(r, passes[k]), "'%s' ran without snow", passes[k]);
     read_hdr(r, without);
     /* the ring top fills the bottom rows at the start of a round: snow
      * there is brighter than the boards (albedo 0.9 against 0.4) */
@@ -443,7 +423,7 @@ static void t_fp16_extremes(void)
                 st2.sun_color[c] = st2.key.color[c] = c == 2 ? 1.0f : 0.0f;
         rs_err e = {0};
         T_ASSERTF(r_game_set_stage(r, &st2, &e), "%s: %s", cases[k].what, e.msg);
-        draw(r, &f, &st, &st);
+        t_draw(r, &f, &st, &st, W, H);
         read_hdr(r, hdr);
         for (int i = 0; i < W * H * 4; i++)
             T_ASSERTF(isfinite(hdr[i]) && fabsf(hdr[i]) <= R_HALF_MAX, "%s: hdr[%d] = %g", cases[k].what, i, hdr[i]);

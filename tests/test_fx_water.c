@@ -1,4 +1,4 @@
-/* runtime/render/r_fx_water*: the water effect (techniques A6).
+/* runtime/fx/fx_water*: the water effect (techniques A6).
  *
  *   - the CPU automaton stays bounded for a million forced steps at the
  *     default Courant number, and blows up above the cap when the cap is
@@ -18,7 +18,7 @@
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
-#include "../runtime/render/r_fx_water_sim.h"
+#include "../runtime/fx/fx_water_sim.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_stage.h"
 #include "t.h"
@@ -114,34 +114,10 @@ static int shallows_index(void)
 static r_game *game_new(void)
 {
     rs_err e = {0};
-    r_game *r = r_game_create_opts(&(r_game_opts){.hdr_format = -1, .cache_dir = "", .quiet = true, .no_hud = true}, &e);
-    T_ASSERTF(r, "%s", e.msg);
+    r_game *r = t_game_opts(&(r_game_opts){.no_hud = true});
     T_ASSERTF(r_game_prepare(r, shallows_index(), &e), "%s", e.msg);
     T_ASSERT(r_game_stage(r)->water);
     return r;
-}
-
-static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
-{
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    if (px) {
-        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-        gl.ReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
-    }
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
-}
-
-static bool ran(r_game *r, const char *pass)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, pass);
-    T_ASSERTF(i >= 0, "no pass %s", pass);
-    return (g->last_ran >> i) & 1;
 }
 
 static float grid_absmax(const float *g)
@@ -235,8 +211,8 @@ static void t_shallows_waves_and_picture(void)
     float still = 0;
     for (int t = 0; t < 40; t++) {
         match_tick(&m);
-        draw(r, &f, &m.prev, &m.cur, NULL);
-        T_ASSERT(ran(r, "water_sim") && ran(r, "water_reflect") && ran(r, "water_under") && ran(r, "water_surface"));
+        t_draw_read(r, &f, &m.prev, &m.cur, W, H, NULL, false);
+        T_ASSERT(t_pass_ran(r, "water_sim") && t_pass_ran(r, "water_reflect") && t_pass_ran(r, "water_under") && t_pass_ran(r, "water_surface"));
     }
     T_ASSERT(r_fx_water_read(r, g));
     still = grid_absmax(g);
@@ -246,11 +222,11 @@ static void t_shallows_waves_and_picture(void)
         match_tick(&m);
         if (m.cur.tick < 300)
             continue;
-        draw(r, &f, &m.prev, &m.cur, NULL);
+        t_draw_read(r, &f, &m.prev, &m.cur, W, H, NULL, false);
         if (r_fx_water_last_splats(r) > most_splats)
             most_splats = r_fx_water_last_splats(r);
     }
-    draw(r, &f, &m.prev, &m.cur, wet);
+    t_draw_read(r, &f, &m.prev, &m.cur, W, H, wet, false);
     T_ASSERT(r_fx_water_read(r, g));
     float moving = grid_absmax(g);
     fprintf(stderr, "    max |h|: standing (40 ticks of intro) %.2g m, fighting (120 ticks) %.4f m, up to %d splats a tick\n",
@@ -265,8 +241,8 @@ static void t_shallows_waves_and_picture(void)
     st.water = false;
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &m.prev, &m.cur, dry);
-    T_ASSERT(!ran(r, "water_sim") && !ran(r, "water_reflect") && !ran(r, "water_under") && !ran(r, "water_surface"));
+    t_draw_read(r, &f, &m.prev, &m.cur, W, H, dry, false);
+    T_ASSERT(!t_pass_ran(r, "water_sim") && !t_pass_ran(r, "water_reflect") && !t_pass_ran(r, "water_under") && !t_pass_ran(r, "water_surface"));
     /* the ring's top face in front of the fighters: the lower quarter of the picture */
     int differ = 0, n = 0;
     for (int y = 2; y < H / 4; y++)
@@ -346,11 +322,11 @@ static void t_no_nan_or_inf(void)
                     g[i] = (i / 2 + i / (2 * R_WATER_N)) & 1 ? v : -v; /* a checkerboard of both signs */
                 }
                 T_ASSERT(r_fx_water_write(r, g));
-                draw(r, &f, &m.cur, &m.cur, NULL); /* the same tick again: the surface reads the raw state */
+                t_draw_read(r, &f, &m.cur, &m.cur, W, H, NULL, false); /* the same tick again: the surface reads the raw state */
                 check_finite(r, cases[k].what, false);
             }
             match_tick(&m);
-            draw(r, &f, &m.prev, &m.cur, NULL);
+            t_draw_read(r, &f, &m.prev, &m.cur, W, H, NULL, false);
             check_finite(r, cases[k].what, true);
         }
     }

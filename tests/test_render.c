@@ -29,37 +29,6 @@
 
 enum { W = 320, H = 180 };
 
-static r_game *game_new(const r_game_opts *o)
-{
-    r_game_opts d = {.hdr_format = -1, .cache_dir = "", .quiet = true};
-    if (o) {
-        d = *o;
-        d.cache_dir = "";
-        d.quiet = true;
-    }
-    rs_err e = {0};
-    r_game *r = r_game_create_opts(&d, &e);
-    T_ASSERTF(r, "%s", e.msg);
-    return r;
-}
-
-/* Draws one frame into f and reads it back top-down (px may be NULL). */
-static void draw(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, uint8_t *px)
-{
-    rgl_error_reset();
-    gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, W, H), "%s", r_game_error(r));
-    if (px) {
-        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-        gl.ReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
-        rs_flip_rows(px, W, H, 4);
-    }
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    T_EQ(rgl_error_count(), 0);
-    T_EQ(gl.GetError(), GL_NO_ERROR);
-    T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "pass graph: %s", r_graph_error(r_game_graph(r)));
-}
-
 /* One picture of a demo with its stage file, the way render makes it:
  * the frames of the `history` ticks before it are drawn first, so the
  * stage effects' simulations (docs/effects.md) have that much past. */
@@ -73,15 +42,15 @@ static void picture_after(const char *demo, uint64_t tick, uint64_t history, con
     rp_replay rp;
     rs_err e = {0};
     T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
-    r_game *r = game_new(o);
+    r_game *r = t_game_opts(o);
     t_fb f;
     t_fb_make(&f, W, H);
     for (uint64_t t = first; t < tick; t++) {
-        draw(r, &f, &prev, &cur, NULL);
+        t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
         prev = cur;
         g_step(&cur, &rp.inputs[2 * t], NULL);
     }
-    draw(r, &f, &prev, &cur, px);
+    t_draw_read(r, &f, &prev, &cur, W, H, px, true);
     rp_free(&rp);
     t_fb_free(&f);
     r_game_destroy(r);
@@ -191,10 +160,10 @@ static void t_fighters_where_the_camera_says(void)
     g_state prev, cur;
     t_state_at("temple", 900, &prev, &cur); /* midday: both fighters in full light */
     static uint8_t px[W * H * 4];
-    r_game *r = game_new(NULL);
+    r_game *r = t_game_opts(NULL);
     t_fb f;
     t_fb_make(&f, W, H);
-    draw(r, &f, &prev, &cur, px);
+    t_draw_read(r, &f, &prev, &cur, W, H, px, true);
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
         g_capsule c[G_BONES];
@@ -237,7 +206,7 @@ static void t_hud_shows_health_and_intro(void)
     int gold2 = gold_in_band(px);
     T_ASSERTF(gold2 < gold / 4, "announcement still shown during the fight (%d)", gold2);
     /* --no-hud leaves it out */
-    picture("temple", 30, &(r_game_opts){.hdr_format = -1, .no_hud = true}, px);
+    picture("temple", 30, &(r_game_opts){.no_hud = true}, px);
     bar = px + ((size_t)(H * 45 / 1000) * W + W / 4) * 4;
     T_ASSERTF(!(bar[0] > 200 && bar[1] > 150 && bar[2] < 80), "health bar drawn with no_hud");
     plat_destroy(p);
@@ -250,10 +219,10 @@ static void t_stage_file_keeps_the_matchs_ring(void)
     plat *p = t_context("egl");
     g_state prev, cur;
     t_state_at("dojo", 900, &prev, &cur);
-    r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/temple.stage"});
+    r_game *r = t_game_opts(&(r_game_opts){.stage_file = RS_SOURCE_DIR "/stages/temple.stage"});
     t_fb f;
     t_fb_make(&f, W, H);
-    draw(r, &f, &prev, &cur, NULL);
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
     T_ASSERT(!strcmp(r_game_stage(r)->name, "temple"));
     T_EQ(r_game_ring_stage(r), cur.stage);
     T_ASSERT(cur.stage != r_game_stage(r)->game_index);
@@ -268,11 +237,11 @@ static void t_drawing_leaves_state_alone(void)
     g_state prev, cur;
     t_state_at("dojo", 900, &prev, &cur);
     uint64_t h0 = g_hash(&prev), h1 = g_hash(&cur);
-    r_game *r = game_new(NULL);
+    r_game *r = t_game_opts(NULL);
     t_fb f;
     t_fb_make(&f, W, H);
     static uint8_t clean[W * H * 4], messy[W * H * 4];
-    draw(r, &f, &prev, &cur, clean);
+    t_draw_read(r, &f, &prev, &cur, W, H, clean, true);
     T_EQ(g_hash(&prev), h0);
     T_EQ(g_hash(&cur), h1);
     /* a caller's leftover state changes nothing in the picture ... */
@@ -305,14 +274,6 @@ static void t_drawing_leaves_state_alone(void)
 }
 
 /* ---- the pass graph on real stages ---- */
-
-static bool pass_ran(r_game *r, const char *name)
-{
-    r_graph *g = r_game_graph(r);
-    int i = r_graph_find(g, name);
-    T_ASSERTF(i >= 0, "no pass '%s'", name);
-    return (g->last_ran >> i) & 1;
-}
 
 /* Counts the draw calls and framebuffer binds a frame makes. */
 static int n_draws, n_binds;
@@ -356,7 +317,7 @@ static void t_sunless_stage_skips_its_passes(void)
     t_fb f;
     t_fb_make(&f, W, H);
     /* dojo: the sun is on screen, everything runs */
-    r_game *r = game_new(NULL);
+    r_game *r = t_game_opts(NULL);
     int d_all, b_all, d_less, b_less;
     /* the second frame: the first also creates the screen targets */
     counted_frame(r, &f, &prev, &cur, &d_all, &b_all);
@@ -364,19 +325,19 @@ static void t_sunless_stage_skips_its_passes(void)
     const char *all[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter", "scene",
                          "sky", "lens", "bloom_bright", "bloom_blur", "sun_visibility", "flare", "tonemap", "hud"};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
-        T_ASSERTF(pass_ran(r, all[i]), "dojo: '%s' did not run", all[i]);
+        T_ASSERTF(t_pass_ran(r, all[i]), "dojo: '%s' did not run", all[i]);
     r_game_destroy(r);
     /* sunless: no sun, no bloom, no shadows (stages/sunless.stage) */
-    r = game_new(&(r_game_opts){.hdr_format = -1, .stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
+    r = t_game_opts(&(r_game_opts){.stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     const char *skipped[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter",
                              "bloom_bright", "bloom_blur", "sun_visibility", "flare"};
     for (size_t i = 0; i < sizeof skipped / sizeof skipped[0]; i++)
-        T_ASSERTF(!pass_ran(r, skipped[i]), "sunless: '%s' ran", skipped[i]);
+        T_ASSERTF(!t_pass_ran(r, skipped[i]), "sunless: '%s' ran", skipped[i]);
     const char *kept[] = {"scene", "sky", "lens", "tonemap", "hud"};
     for (size_t i = 0; i < sizeof kept / sizeof kept[0]; i++)
-        T_ASSERTF(pass_ran(r, kept[i]), "sunless: '%s' did not run", kept[i]);
+        T_ASSERTF(t_pass_ran(r, kept[i]), "sunless: '%s' did not run", kept[i]);
     T_ASSERTF(!r_graph_error(r_game_graph(r))[0], "%s", r_graph_error(r_game_graph(r)));
     T_EQ(r_game_ring_stage(r), cur.stage); /* sunless dresses the dojo: the dojo's ring */
     /* a skipped pass costs nothing: far fewer draws and binds */
@@ -410,10 +371,10 @@ static void t_mask_output_alpha(void)
     g_state prev, cur;
     t_state_at("temple", 900, &prev, &cur);
     static uint8_t px[W * H * 4];
-    r_game *r = game_new(&(r_game_opts){.hdr_format = -1, .mask = true});
+    r_game *r = t_game_opts(&(r_game_opts){.mask = true});
     t_fb f;
     t_fb_make(&f, W, H);
-    draw(r, &f, &prev, &cur, px);
+    t_draw_read(r, &f, &prev, &cur, W, H, px, true);
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
         g_capsule c[G_BONES];
@@ -473,23 +434,23 @@ static void t_low_alpha_lens_shows_the_sun(void)
     t_state_at("temple", 900, &prev, &cur);
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(NULL);
+    r_game *r = t_game_opts(NULL);
     r_stage st;
     lens_stage(&st, true);
     rs_err e = {0};
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
     static float with[W * H * 4], without[W * H * 4];
     int w, h;
-    draw(r, &f, &prev, &cur, NULL);
-    T_ASSERT(pass_ran(r, "lens"));
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
+    T_ASSERT(t_pass_ran(r, "lens"));
     T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h) && w == W && h == H);
     r_graph *g = r_game_graph(r);
     int lens = r_graph_find(g, "lens");
     bool (*was)(void *) = g->pass[lens].needed;
     g->pass[lens].needed = never;
-    draw(r, &f, &prev, &cur, NULL);
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
     g->pass[lens].needed = was;
-    T_ASSERT(!pass_ran(r, "lens"));
+    T_ASSERT(!t_pass_ran(r, "lens"));
     T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
     float most = 0;
     int changed = 0, where = 0;
@@ -512,7 +473,7 @@ static void t_low_alpha_lens_shows_the_sun(void)
     /* no sun: nothing there (the reflection came from the sun) */
     lens_stage(&st, false);
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, NULL);
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
     T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
     float mx = 0;
     for (int k = 0; k < W * H; k++)
@@ -533,21 +494,21 @@ static void floor_shadow_check(const r_stage *st_in, const float L[3], float max
     t_state_at("temple", 900, &prev, &cur);
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(NULL);
+    r_game *r = t_game_opts(NULL);
     rs_err e = {0};
     r_stage st = *st_in;
     static float with[W * H * 4], without[W * H * 4];
     int w, h;
     st.shadows = true;
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, NULL);
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
     T_ASSERT(r_game_read_buffer(r, "hdr", with, &w, &h));
     if (mask)
         T_ASSERT(r_game_read_buffer(r, "mask", mask, &w, &h));
     st.shadows = false;
     T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
-    draw(r, &f, &prev, &cur, NULL);
-    T_ASSERT(!pass_ran(r, "silhouette") && !pass_ran(r, "shadow_mask"));
+    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
+    T_ASSERT(!t_pass_ran(r, "silhouette") && !t_pass_ran(r, "shadow_mask"));
     T_ASSERT(r_game_read_buffer(r, "hdr", without, &w, &h));
     r_mat4 vp = r_game_camera(&cur, W, H, NULL);
     for (int i = 0; i < 2; i++) {
@@ -639,7 +600,7 @@ static void t_stress_no_nan_or_inf(void)
     t_state_at("dojo", 1200, &prev, &cur); /* the sun on screen */
     t_fb f;
     t_fb_make(&f, W, H);
-    r_game *r = game_new(NULL);
+    r_game *r = t_game_opts(NULL);
     rs_err e = {0};
     T_ASSERTF(r_game_prepare(r, cur.stage, &e), "%s", e.msg);
     const r_stage base = *r_game_stage(r);
@@ -672,7 +633,7 @@ static void t_stress_no_nan_or_inf(void)
         st.gamma = cases[k].gamma, st.saturation = cases[k].sat, st.exposure = cases[k].exposure;
         st.bloom = cases[k].bloom;
         T_ASSERTF(r_game_set_stage(r, &st, &e), "%s: %s", cases[k].what, e.msg);
-        draw(r, &f, &prev, &cur, px);
+        t_draw_read(r, &f, &prev, &cur, W, H, px, true);
         check_finite(r, cases[k].what);
         if (cases[k].expect >= 0) {
             /* the middle band (no HUD): the picture must be what the light says */
@@ -696,7 +657,7 @@ static void t_packed_float_hdr(void)
     plat *p = t_context("egl");
     static uint8_t a[W * H * 4], b[W * H * 4];
     picture("temple", 900, NULL, a);
-    picture("temple", 900, &(r_game_opts){.hdr_format = R_HDR_R11G11B10F}, b);
+    picture("temple", 900, &(r_game_opts){.hdr_format = R_GAME_HDR_R11G11B10F}, b);
     double se = 0;
     for (int i = 0; i < W * H * 4; i += 4)
         for (int c = 0; c < 3; c++)

@@ -1,4 +1,6 @@
-/* Stage effects: the module list and what the modules share (r_fx.h). */
+/* Stage effects: what the core does with the modules (r_fx.h): their
+ * states, texture units, scene hooks and history; and what the modules
+ * share (contacts).  The module table is runtime/fx/fx_table.c. */
 #include "r_fx.h"
 
 #include <math.h>
@@ -6,19 +8,79 @@
 #include <string.h>
 
 #include "../game/g_game.h"
+#include "r_local.h"
 
-extern const r_fx_module r_fx_water_module, r_fx_snow_module, r_fx_fog_module, r_fx_afterimage_module,
-    r_fx_lspsm_module, r_fx_holes_module;
+static int index_of(const r_fx_module *m)
+{
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i] == m)
+            return i;
+    return -1;
+}
 
-const r_fx_module *const r_fx_modules[] = {
-    &r_fx_fog_module,   /* first: the fog map is read by every later scene draw */
-    &r_fx_lspsm_module, /* the shadow map, read by every later scene draw */
-    &r_fx_holes_module, /* before the other surfaces: it clears the frame (steps 1-3 of D) */
-    &r_fx_water_module,
-    &r_fx_snow_module,
-    &r_fx_afterimage_module,
-};
-const int r_fx_nmodules = (int)(sizeof r_fx_modules / sizeof r_fx_modules[0]);
+void *r_fx_state(const r_game *r, const r_fx_module *m)
+{
+    int i = index_of(m);
+    return i >= 0 ? r->fx_state[i] : NULL;
+}
+
+void r_fx_set_state(r_game *r, const r_fx_module *m, void *state)
+{
+    int i = index_of(m);
+    if (i >= 0)
+        r->fx_state[i] = state;
+}
+
+int r_fx_units(void)
+{
+    int n = 0;
+    for (int i = 0; i < r_fx_nmodules; i++)
+        n += r_fx_modules[i]->bind ? r_fx_modules[i]->units : 0;
+    return n;
+}
+
+void r_fx_bind(r_game *r, GLuint p, int what)
+{
+    int unit = R_FX_UNIT_FIRST;
+    for (int i = 0; i < r_fx_nmodules; i++) {
+        const r_fx_module *m = r_fx_modules[i];
+        if (!m->bind)
+            continue;
+        m->bind(r, p, unit, what);
+        unit += m->units;
+    }
+}
+
+bool r_fx_scene_cleared(r_game *r)
+{
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->scene_cleared && r_fx_modules[i]->scene_cleared(r))
+            return true;
+    return false;
+}
+
+bool r_fx_draw_ring(r_game *r)
+{
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->draw_ring && r_fx_modules[i]->draw_ring(r))
+            return true;
+    return false;
+}
+
+bool r_fx_needs_frame(r_game *r)
+{
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->needs_frame && r_fx_modules[i]->needs_frame(r))
+            return true;
+    return false;
+}
+
+void r_fx_advance(r_game *r)
+{
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->advance)
+            r_fx_modules[i]->advance(r);
+}
 
 static int deeper_first(const void *a, const void *b)
 {

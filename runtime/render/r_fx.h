@@ -1,28 +1,69 @@
-/* Stage effects (issue 8; techniques A6-A8, B, C, D): each effect is a
- * module of passes that the renderer's pass graph runs only on stages (or
- * frames) that need them.
+/* The stage-effect contract (issue 8; techniques A6-A8, B, C, D; issue 17).
  *
- * A module (r_fx_<name>.c) keeps its state behind one pointer in r_game
- * (r_local.h) and gives the renderer:
+ * An effect is a module in runtime/fx/ (fx_<name>.c): one r_fx_module row
+ * in the table runtime/fx/fx_table.c lists.  The render core calls it only
+ * through this struct and never names an effect, its resources or its
+ * texture units; adding an effect is adding its file and one row.  An
+ * effect's own tests and bench hooks live in its own header in runtime/fx/
+ * (fx_fog.h, fx_lspsm.h, fx_holes.h, fx_snow_tex.h, fx_water_sim.h).
+ *
+ * State.  A module keeps its state behind one pointer that the core holds
+ * for it: r_fx_set_state at create, r_fx_state(r, &its_module) after.
+ *
+ * Lifecycle.
  *   create   at r_game_create: programs and fixed-size GL objects
- *   destroy  at r_game_destroy (also after a failed create)
+ *   destroy  at r_game_destroy (also after a failed create; the state
+ *            may then be NULL or half made)
  *   load     when the look changes (r->stage is the new stage)
- *   passes   by phase, added to the graph in this order:
- *     R_FX_PRE          after the shadow passes, before "scene"
- *                       (simulations, light-space and texture-space maps)
- *     R_FX_SURFACE      after "scene", before "sky": opaque surfaces
- *     R_FX_TRANSLUCENT  after "sky", before "lens"
+ *
+ * Passes, by phase; r_game.c's build_graph adds them in table order:
+ *   R_FX_PRE          after the shadow passes, before "scene"
+ *                     (simulations, light-space and texture-space maps)
+ *   R_FX_SURFACE      after "scene", before "sky": opaque surfaces
+ *   R_FX_TRANSLUCENT  after "sky", before "lens"
  * Passes get the r_game as their user pointer; the frame being drawn is
- * r->f.  Simulations step r->f.steps times (whole game ticks since the
+ * r->f (r_local.h).
+ *
+ * Resources.  Bits from R_RES_FX_FIRST up of the pass graph's mask belong
+ * to the effects (runtime/fx/fx_local.h gives them out); a module names
+ * those it writes in res[] (persistent ones survive from frame to frame),
+ * and scene_reads says which of them the scene, sky and lens programs may
+ * read through its bind hook.
+ *
+ * Binding into the scene.  Every program that draws the scene (the
+ * fighters and stage programs, the sky, the visors, and effect passes that
+ * use r_stage_uniforms) calls r_fx_bind, which calls each module's bind
+ * with `units` texture units of its own, handed out by the core from
+ * R_FX_UNIT_FIRST in table order.  A module binds its maps there (or 0
+ * with its "on" uniform off when its pass did not run this frame).
+ *
+ * Inside "scene".  scene_cleared says the effect already cleared the HDR
+ * target and drew into it this frame (the holes: stencil volumes before
+ * the fighters), so scene must not clear it; draw_ring draws the ring mesh
+ * in the effect's own order (scene has bound the stage program and the
+ * ring's VAO) and returns true, or returns false and scene draws it whole.
+ *
+ * History.  Simulations step r->f.steps times (whole game ticks since the
  * frame drawn last, 0 when a tick is drawn again) and restart when
  * r->f.reset is set, so a video of a replay (every tick drawn) is the same
- * on any machine.  A frame spanning several ticks knows only the last two
- * (docs/effects.md says what each effect does then). */
+ * on any machine.  What a module carries from one frame to the next is its
+ * history; `advance` moves it on by exactly one game tick without drawing
+ * (r_game_advance sets up r->f for that tick first), so that drawing ticks
+ * 0..A-1 and then A gives the same frame A as advancing 0..A-1 and drawing
+ * A.  `warmup` declares how much history frame A depends on:
+ *   0 (R_FX_STATELESS)  none: the frame is a function of the game states
+ *   N > 0               the last N ticks (older history has decayed)
+ *   R_FX_FROM_START     every tick since the last reset (tick 0, a seek, a
+ *                       new look)
+ * A module whose history cannot be advanced without the frame itself says
+ * so with needs_frame (true on this stage); r_game_advance then draws the
+ * frame instead, which advances every module the way a full render does.
+ * docs/effects.md ("The effect contract") lists each effect's history. */
 #ifndef R_FX_H
 #define R_FX_H
 
 #include <stdbool.h>
-#include <stdio.h>
+#include <stdint.h>
 
 #include "../game/g_skel.h"
 #include "../gl/rgl.h"
@@ -55,60 +96,61 @@ typedef struct r_fx_contact {
 
 enum { R_FX_PRE, R_FX_SURFACE, R_FX_TRANSLUCENT, R_FX_PHASES };
 
+/* What r_fx_bind is binding for (a module's bind may skip some). */
+enum { R_FX_BIND_SCENE, R_FX_BIND_SKY, R_FX_BIND_LENS };
+
+enum { R_FX_STATELESS = 0, R_FX_FROM_START = -1 };
+
+#define R_FX_MAX_RES 4     /* resources a module may own */
+#define R_FX_MAX_MODULES 16
+
+typedef struct r_fx_res {
+    uint32_t bit;      /* one bit from R_RES_FX_FIRST up */
+    const char *name;  /* for the graph's messages */
+    bool persistent;   /* valid without a writer this frame (carried history) */
+} r_fx_res;
+
 typedef struct r_fx_module {
     const char *name;
+    /* lifecycle; each may be NULL */
     bool (*create)(r_game *r, rs_err *err);
     void (*destroy)(r_game *r);
     bool (*load)(r_game *r, rs_err *err);
+    /* passes by phase */
     const r_pass *pass[R_FX_PHASES];
     int npass[R_FX_PHASES];
+    /* the resources it writes, and those the scene programs may read */
+    r_fx_res res[R_FX_MAX_RES];
+    uint32_t scene_reads;
+    /* binding into the scene: `units` texture units from `unit` on */
+    int units;
+    void (*bind)(r_game *r, GLuint prog, int unit, int what);
+    /* inside "scene" (NULL: nothing to do there) */
+    bool (*scene_cleared)(r_game *r);
+    bool (*draw_ring)(r_game *r);
+    /* history */
+    int warmup;                       /* R_FX_STATELESS, N ticks or R_FX_FROM_START */
+    void (*advance)(r_game *r);       /* one game tick, r->f set up; draws nothing on screen */
+    bool (*needs_frame)(r_game *r);   /* its history needs the drawn frame on this stage */
 } r_fx_module;
 
+/* The table (runtime/fx/fx_table.c), in the order the passes run. */
 extern const r_fx_module *const r_fx_modules[];
 extern const int r_fx_nmodules;
+
+/* A module's state pointer, kept by the core (NULL until set). */
+void *r_fx_state(const r_game *r, const r_fx_module *m);
+void r_fx_set_state(r_game *r, const r_fx_module *m, void *state);
+
+/* Texture units handed to the modules' bind hooks: from here up, below the
+ * IBL's units 8..13 (r_bind_ibl).  r_game_create checks they fit. */
+#define R_FX_UNIT_FIRST 3
+#define R_FX_UNIT_END 8
 
 /* Contacts of both fighters' capsules with the plane y = level (at most
  * max, deepest first when there are more).  caps/caps_prev as in
  * r_local.h's frame.  Returns the number written. */
 int r_fx_contacts(const r_fx_capsule caps[2][G_BONES], const r_fx_capsule prev[2][G_BONES], float level, r_fx_contact *out,
                   int max);
-
-/* Fog map (r_fx_fog.c): sets program p's fog uniforms (u_fog_on and the
- * map when the fog_map pass ran this frame).  Every program that draws the
- * scene calls it; its shaders include fog_common.glsl. */
-void r_fx_fog_bind(r_game *r, GLuint p, int unit);
-/* Its hooks for tests and bench accuracy: the mist simulation (NULL when
- * the module was not created), the map of the frame drawn last (size x
- * size floats, row = z, covering x, z in +-half metres; out NULL asks the
- * size only), and the "fog-map resolution vs time" table of bench
- * accuracy (needs a current GL context). */
-struct r_fog_sim *r_fx_fog_sim(r_game *r);
-bool r_fx_fog_read_map(r_game *r, float *out, int *size, float *half);
-bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err);
-
-/* LSPSM (r_fx_lspsm.c): sets program p's u_lspsm_* uniforms and its two
- * maps on units `unit` and `unit + 1` (u_lspsm_on = 0 whenever the map was
- * not drawn this frame).  Every program that draws the scene with
- * lspsm_common.glsl calls it. */
-void r_fx_lspsm_bind(r_game *r, GLuint p, int unit);
-/* What the last frame's lspsm_map did, for tests, bench and docs. */
-typedef struct r_fx_lspsm_stats {
-    int casters, casters_drawn;   /* buildings, and those that passed culling */
-    int city_triangles, proxy_triangles;
-    float range;                  /* the shadow range used (the focus), m */
-    float warp, gamma;            /* r_lspsm's warp strength and view-light angle */
-    float focus_farthest;         /* the farthest sample the focus found, m */
-    int focus_used;               /* samples that counted */
-} r_fx_lspsm_stats;
-bool r_fx_lspsm_stats_get(r_game *r, r_fx_lspsm_stats *out);
-/* Tests and bench: force the light direction (NULL: the stage's key),
- * switch caster culling off, or the warp (plain uniform shadow mapping). */
-void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform);
-/* Tests: "map" (1024x1024 depth floats), "flag" (1024x1024), "focus"
- * (20x16 depth samples of the frame drawn last), "shadow" (16 floats). */
-bool r_fx_lspsm_read(r_game *r, const char *what, float *out);
-
-/* Holes (r_fx_holes.c): how many the frame drawn last cut into the ring. */
-int r_fx_holes_drawn(r_game *r);
 
 #endif

@@ -24,11 +24,21 @@
 
 typedef struct r_game r_game;
 
+/* r_game_opts.hdr_format: zero is the stage's own (r_stage.hdr_format). */
+typedef enum r_game_hdr { R_GAME_HDR_STAGE, R_GAME_HDR_RGBA16F, R_GAME_HDR_R11G11B10F } r_game_hdr;
+
+/* An r_hdr_format (cli_hdr_format's) as an r_game_hdr. */
+static inline r_game_hdr r_game_hdr_of(int fmt)
+{
+    return fmt == R_HDR_R11G11B10F ? R_GAME_HDR_R11G11B10F : R_GAME_HDR_RGBA16F;
+}
+
+/* Zero is the default for every field. */
 typedef struct r_game_opts {
     const char *stage_file; /* NULL: <data>/stages/<game stage>.stage */
     bool mask;              /* output alpha = the fighters' mask (and no HUD) */
     bool no_hud;
-    int hdr_format;         /* -1: the stage's; else an r_hdr_format */
+    r_game_hdr hdr_format;  /* 0 (R_GAME_HDR_STAGE): the stage's */
     const char *cache_dir;  /* NULL: r_ibl_cache_dir(); "" = no cache */
     int lut_size;           /* 0: R_TONE_LUT_DEFAULT */
     bool quiet;             /* no note when prefiltering takes a while */
@@ -50,6 +60,13 @@ const r_stage *r_game_stage(const r_game *r);
  * clears to black) when the stage could not be loaded: r_game_error. */
 bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h);
 const char *r_game_error(const r_game *r);
+/* Moves the stage effects' history (r_fx.h) on by the one game tick cur
+ * without drawing it: ticks 0..A-1 advanced and tick A drawn give the same
+ * frame A as ticks 0..A drawn (prev, w, h as r_game_draw would get them;
+ * each tick in turn).  Where an effect's history needs the frame itself
+ * (LSPSM's auto-focus), the frame is drawn into the bound framebuffer at
+ * alpha 1.  Returns false as r_game_draw does. */
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h);
 
 /* --passes: time every pass; per_frame prints one line per frame to out. */
 void r_game_passes(r_game *r, bool per_frame, FILE *out);

@@ -1,6 +1,6 @@
-/* The game renderer's insides, shared by r_game.c and the stage-effect
- * modules (r_fx_*.c, r_fx.h).  Not an API: include only from
- * runtime/render. */
+/* The game renderer's insides, shared by the render core's files and the
+ * stage-effect modules (runtime/fx/, contract in r_fx.h).  Not an API:
+ * include only from runtime/render and runtime/fx. */
 #ifndef R_LOCAL_H
 #define R_LOCAL_H
 
@@ -34,16 +34,10 @@ enum {
     RES_SUNVIS = 1u << 7,
     RES_OUT = 1u << 8,
     RES_FLARE = 1u << 9,
-    /* stage effects */
-    RES_FOGMAP = 1u << 10,
-    RES_WATER = 1u << 11,       /* the wave simulation: persistent, steps each tick */
-    RES_WATER_REFL = 1u << 12,
-    RES_WATER_UNDER = 1u << 13,
-    RES_SNOW = 1u << 14,        /* the displacement map: persistent */
-    RES_SNOW_LIGHT = 1u << 15,
-    RES_LSPSM = 1u << 16,       /* the large-world shadow map */
 };
-#define RES_PERSISTENT (RES_ENV | RES_WATER | RES_SNOW)
+#define R_RES_CORE 10      /* the core's resources: bits 0..9 */
+#define R_RES_FX_FIRST 10  /* from here up, the stage effects' (r_fx.h) */
+#define RES_PERSISTENT RES_ENV
 
 typedef struct hud_vertex {
     float x, y, u, v, r, g, b, a;
@@ -119,13 +113,9 @@ struct r_game {
     int pass_ids[R_GRAPH_MAX];
     bool per_frame;
     FILE *passes_out;
-    /* stage effects: each module keeps its own state (r_fx.h) */
-    struct r_fx_water *water;
-    struct r_fx_snow *snow;
-    struct r_fx_fog *fog;
-    struct r_fx_afterimage *afterimage;
-    struct r_fx_lspsm *lspsm;
-    struct r_fx_holes *holes;
+    const char *res_names[32]; /* the graph's resources: the core's, then the effects' */
+    /* stage effects: each module's state, by its index in r_fx_modules (r_fx.h) */
+    void *fx_state[R_FX_MAX_MODULES];
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
     bool have_last;
     frame f;
@@ -133,26 +123,40 @@ struct r_game {
 };
 
 
+/* the core's side of the effect contract (r_fx.c) */
+int r_fx_units(void);                          /* texture units the modules' bind hooks take */
+void r_fx_bind(r_game *r, GLuint p, int what); /* every module's bind, units from R_FX_UNIT_FIRST */
+bool r_fx_scene_cleared(r_game *r);            /* an effect cleared the HDR target this frame */
+bool r_fx_draw_ring(r_game *r);                /* an effect drew the ring its own way */
+bool r_fx_needs_frame(r_game *r);              /* some history needs the frame drawn */
+void r_fx_advance(r_game *r);                  /* every module's history, one tick */
+
 /* stencil bits: the scene pass marks the fighters' pixels */
 #define R_STENCIL_FIGHTER 0x80
 
-/* helpers of r_game.c */
+/* the GL layer (r_gl.c) */
 GLint r_loc(GLuint p, const char *name);
 void r_upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *ibo);
 void r_free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo);
 GLuint r_tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const void *px, GLenum filter, GLenum wrap);
 GLuint r_fbo_for(GLuint color, int level, GLuint depth); /* depth: a GL_DEPTH24_STENCIL8 texture or 0 */
+GLuint r_cube_tex(int n, float *const face[6], int levels); /* RGB16F faces; mipmapped when levels > 1 */
 void r_bind_tex(GLuint p, const char *name, int unit, GLenum target, GLuint t);
 void r_bind_ibl(r_game *r, GLuint p); /* units 8..13 */
 void r_fullscreen(r_game *r);      /* one triangle: cap_fullscreen.vert */
 int r_half(int v, int k);          /* v >> k, at least 1 */
-bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run this frame (so far) */
-void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
 void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
+
+/* per-frame set-up (r_frame.c) */
+void r_frame_setup(r_game *r, frame *f); /* f->prev, cur, alpha, w, h, out_fbo set: the rest */
+bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run this frame (so far) */
+
+/* the scene (r_scene.c) */
+void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
 void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
-/* The P_STAGE program's uniforms for this frame (lighting, shadows, fog,
- * LSPSM); material as scene.frag's u_material. */
+/* The P_STAGE program's uniforms for this frame (lighting, shadows, the
+ * effects' maps through r_fx_bind); material as scene.frag's u_material. */
 void r_stage_uniforms(r_game *r, GLuint p, int material);
 /* Opaque drawing into the HDR target: its FBO and the frame's viewport,
  * depth test (less) and writes, back faces culled, no blending. */
@@ -160,5 +164,17 @@ void r_begin_opaque(r_game *r);
 /* The ring mesh (build_ring): its box's +y face, the destructible ring
  * top, is the 6 indices from here; the ground's box follows the ring's. */
 #define R_RING_TOP_FIRST 30
+bool r_build_lens(r_mesh_data *m); /* the visor's mesh */
+
+/* The core passes, each in the file of its responsibility; r_game.c's
+ * build_graph puts them in order with the effects' phases between. */
+#define R_SHADOW_NPASS 6
+#define R_POST_NPASS 5
+extern const r_pass r_shadow_passes[R_SHADOW_NPASS]; /* r_shadow.c */
+extern const r_pass r_scene_pass, r_sky_pass, r_lens_pass; /* r_scene.c */
+extern const r_pass r_post_passes[R_POST_NPASS];     /* r_post.c: bloom, sun visibility, flare, tone map */
+extern const r_pass r_hud_pass;                      /* r_hud.c */
+void r_update_lut(r_game *r);                        /* r_post.c: the tone curve for the stage's gamma */
+GLuint r_hud_font(void);                             /* r_hud.c: the font texture */
 
 #endif

@@ -1,6 +1,6 @@
 /* Fog map (techniques A8, issue 8): mist particles laid over the stage,
  * moved by a global wind plus the local wind that fast limbs stir up
- * (r_fx_fog_sim.c, once per game tick), are drawn each frame as soft
+ * (fx_fog_sim.c, once per game tick), are drawn each frame as soft
  * sprites into a top-down density map; the scene's vertex shaders read it
  * as height-fog density (shaders/fog_common.glsl), so the fog varies at
  * equal height, with none of the sorting or clipping troubles of layered
@@ -16,7 +16,7 @@
  *      size x size texels over x, z in +-half metres, normalised so that
  *      its mean is 1;
  *   3. optionally a blur.
- * r_fx_fog_bind then hands the map and the fog's light to the scene's
+ * fog_bind (its r_fx_module bind hook) then hands the map and the fog's light to the scene's
  * programs (scene.vert/.frag and lens.frag include fog_common.glsl). */
 #include <math.h>
 #include <stdlib.h>
@@ -24,9 +24,13 @@
 
 #include "../game/g_game.h"
 #include "../util/rs_progress.h"
-#include "r_fx_fog_sim.h"
-#include "r_local.h"
-#include "r_shader.h"
+#include "fx_fog.h"
+#include "fx_fog_sim.h"
+#include "fx_local.h"
+#include "../render/r_shader.h"
+
+extern const r_fx_module fx_fog_module;
+#define FOG(r) ((struct r_fx_fog *)r_fx_state((r), &fx_fog_module))
 
 /* What the fog looks like (A8 gives no numbers; these suit mistvale). */
 typedef struct fog_look {
@@ -153,7 +157,7 @@ static int draw_map(r_game *r, struct r_fx_fog *fg)
 static bool need_fog(void *u)
 {
     r_game *r = u;
-    return r->stage.fog && r->fog;
+    return r->stage.fog && FOG(r);
 }
 
 /* Both fighters' bone end points now and a tick ago (r->f.caps*). */
@@ -169,10 +173,11 @@ static int limb_points(const frame *f, float cur[][3], float prev[][3])
     return n;
 }
 
-static void run_fog_map(void *u)
+/* Step 1, the fog's history: once per frame drawn, or per tick advanced
+ * (fog_advance). */
+static void sim_follow(r_game *r)
 {
-    r_game *r = u;
-    struct r_fx_fog *fg = r->fog;
+    struct r_fx_fog *fg = FOG(r);
     const frame *f = &r->f;
     /* step 1: the mist follows the game's ticks, never the frame rate */
     float cur[4 * G_BONES][3], prev[4 * G_BONES][3];
@@ -185,7 +190,19 @@ static void run_fog_map(void *u)
             r_fog_sim_stir(&fg->sim, cur, prev, n);
             r_fog_sim_step(&fg->sim);
         }
-    draw_map(r, fg);
+}
+
+static void run_fog_map(void *u)
+{
+    r_game *r = u;
+    sim_follow(r);
+    draw_map(r, FOG(r));
+}
+
+static void fog_advance(r_game *r)
+{
+    if (need_fog(r))
+        sim_follow(r);
 }
 
 static const r_pass fog_passes[] = {
@@ -199,9 +216,12 @@ static float half_clamp(float v)
     return v > 0 ? (v < R_HALF_MAX ? v : R_HALF_MAX) : 0.0f; /* NaN fails v > 0 */
 }
 
-void r_fx_fog_bind(r_game *r, GLuint p, int unit)
+/* The scene's programs (fog_common.glsl): u_fog_on and the map when the
+ * fog_map pass ran this frame, and the fog's light. */
+static void fog_bind(r_game *r, GLuint p, int unit, int what)
 {
-    struct r_fx_fog *fg = r->fog;
+    (void)what;
+    struct r_fx_fog *fg = FOG(r);
     bool on = fg && r->stage.fog && r_ran(&r->f, r, "fog_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_fog_on"), on);
@@ -244,7 +264,7 @@ void r_fx_fog_bind(r_game *r, GLuint p, int unit)
 
 static void fog_destroy(r_game *r)
 {
-    struct r_fx_fog *fg = r->fog;
+    struct r_fx_fog *fg = FOG(r);
     if (!fg)
         return;
     free_map(fg);
@@ -257,7 +277,7 @@ static void fog_destroy(r_game *r)
     r_fog_sim_free(&fg->sim);
     free(fg->inst);
     free(fg);
-    r->fog = NULL;
+    r_fx_set_state(r, &fx_fog_module, NULL);
 }
 
 static bool fog_create(r_game *r, rs_err *err)
@@ -265,7 +285,7 @@ static bool fog_create(r_game *r, rs_err *err)
     struct r_fx_fog *fg = calloc(1, sizeof *fg);
     if (!fg)
         return rs_fail(err, 1, "fog: out of memory");
-    r->fog = fg;
+    r_fx_set_state(r, &fx_fog_module, fg);
     fg->look = default_look;
     if (!r_fog_sim_init(&fg->sim, NULL)) {
         fog_destroy(r);
@@ -298,19 +318,27 @@ static bool fog_create(r_game *r, rs_err *err)
     return true;
 }
 
-const r_fx_module r_fx_fog_module = {"fog", fog_create, fog_destroy, NULL,
-                                     {fog_passes}, {(int)(sizeof fog_passes / sizeof fog_passes[0])}};
+/* History: the mist particles, restarted (seeded by the tick) on a reset,
+ * then stirred and stepped once per tick: every tick since the reset
+ * counts.  fog_advance is the pass's step 1 without the map. */
+const r_fx_module fx_fog_module = {
+    .name = "fog", .create = fog_create, .destroy = fog_destroy,
+    .pass = {fog_passes}, .npass = {(int)(sizeof fog_passes / sizeof fog_passes[0])},
+    .res = {{RES_FOGMAP, "fog map", false}}, .scene_reads = RES_FOGMAP,
+    .units = 1, .bind = fog_bind,
+    .warmup = R_FX_FROM_START, .advance = fog_advance,
+};
 
 /* ---- tests and bench accuracy ---- */
 
 r_fog_sim *r_fx_fog_sim(r_game *r)
 {
-    return r->fog ? &r->fog->sim : NULL;
+    return FOG(r) ? &FOG(r)->sim : NULL;
 }
 
 bool r_fx_fog_read_map(r_game *r, float *out, int *size, float *half)
 {
-    struct r_fx_fog *fg = r->fog;
+    struct r_fx_fog *fg = FOG(r);
     if (!fg || !fg->tex)
         return false;
     if (size)
@@ -386,7 +414,7 @@ bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err)
             rs_fail(err, 1, "fog accuracy: out of memory");
         goto done;
     }
-    struct r_fx_fog *fg = r->fog;
+    struct r_fx_fog *fg = FOG(r);
     /* a mist that has drifted for 5 s, with a kick's worth of local wind:
      * a limb point sweeping through the middle at 6 m/s */
     r_fog_sim_reset(&fg->sim, 0);

@@ -1,5 +1,5 @@
-/* Snow's procedural textures (r_fx_snow_tex.h): value noise, no files. */
-#include "r_fx_snow_tex.h"
+/* Snow's procedural textures (fx_snow_tex.h): value noise, no files. */
+#include "fx_snow_tex.h"
 
 #include <math.h>
 #include <stddef.h>

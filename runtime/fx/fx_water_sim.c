@@ -1,7 +1,7 @@
-/* Water: the wave automaton on the CPU (r_fx_water_sim.h).  The formulas
+/* Water: the wave automaton on the CPU (fx_water_sim.h).  The formulas
  * here and in shaders/water_sim.frag, water_splat.frag must stay the same,
  * operation for operation (the build has no FMA contraction). */
-#include "r_fx_water_sim.h"
+#include "fx_water_sim.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -35,9 +35,12 @@
 #include <string.h>
 
 #include "../game/g_game.h"
-#include "r_fx_snow_tex.h"
-#include "r_local.h"
-#include "r_shader.h"
+#include "fx_snow_tex.h"
+#include "fx_local.h"
+#include "../render/r_shader.h"
+
+extern const r_fx_module fx_snow_module;
+#define SNOW(r) ((struct r_fx_snow *)r_fx_state((r), &fx_snow_module))
 
 #define SNOW_LIGHT 256              /* texture-space lighting texels per side */
 /* The surface grid: a vertex on every SNOW_COL_STRIDE-th map texel along
@@ -151,7 +154,7 @@ static bool build_grid(struct r_fx_snow *s)
 
 static void snow_destroy(r_game *r)
 {
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     if (!s)
         return;
     for (int i = 0; i < S_PROGS; i++)
@@ -165,7 +168,7 @@ static void snow_destroy(r_game *r)
     gl.DeleteBuffers(1, &s->grid_ibo);
     gl.DeleteVertexArrays(1, &s->grid_vao);
     free(s);
-    r->snow = NULL;
+    r_fx_set_state(r, &fx_snow_module, NULL);
 }
 
 static bool snow_create(r_game *r, rs_err *err)
@@ -173,7 +176,7 @@ static bool snow_create(r_game *r, rs_err *err)
     struct r_fx_snow *s = calloc(1, sizeof *s);
     if (!s)
         return rs_fail(err, 1, "out of memory for the snow");
-    r->snow = s;
+    r_fx_set_state(r, &fx_snow_module, s);
     char stamps[64];
     snprintf(stamps, sizeof stamps, "#define MAX_STAMPS %d\n", MAX_STAMPS);
     const struct {
@@ -243,7 +246,7 @@ static bool make_heights(struct r_fx_snow *s, float half, rs_err *err)
 static bool snow_load(r_game *r, rs_err *err)
 {
     /* the map itself restarts on the first frame (load_look resets the ticks) */
-    return !r->stage.snow || make_heights(r->snow, ring_half(r), err);
+    return !r->stage.snow || make_heights(SNOW(r), ring_half(r), err);
 }
 
 /* ---- snow_map: reset and footprints ---- */
@@ -268,7 +271,7 @@ static void add_contacts(struct r_fx_snow *s, const r_fx_capsule caps[2][G_BONES
 static bool need_map(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     if (!r->stage.snow || !s)
         return false;
     /* the contacts are found here so that a tick without any costs no pass */
@@ -282,7 +285,7 @@ static bool need_map(void *u)
 
 static void stamp(r_game *r, const r_fx_capsule *caps, int n)
 {
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     GLuint p = s->prog[S_STAMP];
     float a[MAX_STAMPS][4], b[MAX_STAMPS][3];
     gl.UseProgram(p);
@@ -321,7 +324,7 @@ static void map_target(struct r_fx_snow *s)
 static void run_map(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     bool reset = r->f.reset;
     if (s->half != ring_half(r)) { /* the ring changed size under the same look */
         if (!make_heights(s, ring_half(r), NULL))
@@ -344,13 +347,13 @@ static void run_map(void *u)
 static bool need_snow(void *u)
 {
     r_game *r = u;
-    return r->stage.snow && r->snow;
+    return r->stage.snow && SNOW(r);
 }
 
 static void run_light(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     GLuint p = s->prog[S_LIGHT];
     gl.BindFramebuffer(GL_FRAMEBUFFER, s->light_fbo);
     gl.Viewport(0, 0, SNOW_LIGHT, SNOW_LIGHT);
@@ -382,7 +385,7 @@ static void run_light(void *u)
 static void run_light_blur(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     r_blur_into(r, s->tmp_fbo, s->light_tex, 0, SNOW_LIGHT, SNOW_LIGHT, 1, 0);
     r_blur_into(r, s->light_fbo, s->tmp_tex, 0, SNOW_LIGHT, SNOW_LIGHT, 0, 1);
 }
@@ -392,7 +395,7 @@ static void run_light_blur(void *u)
 static void run_surface(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     frame *f = &r->f;
     GLuint p = s->prog[S_SURFACE];
     r_begin_opaque(r);
@@ -421,7 +424,7 @@ static void run_surface(void *u)
     gl.BindVertexArray(0);
 }
 
-/* ---- test hooks (r_fx_snow_tex.h) ---- */
+/* ---- test hooks (fx_snow_tex.h) ---- */
 
 int r_fx_snow_light_size(void)
 {
@@ -430,7 +433,7 @@ int r_fx_snow_light_size(void)
 
 bool r_fx_snow_read(r_game *r, const char *which, float *out)
 {
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     if (!s)
         return false;
     GLuint t = !strcmp(which, "map")         ? s->map_tex
@@ -449,7 +452,7 @@ bool r_fx_snow_read(r_game *r, const char *which, float *out)
 
 void r_fx_snow_stamp(r_game *r, const r_fx_capsule *caps, int n)
 {
-    struct r_fx_snow *s = r->snow;
+    struct r_fx_snow *s = SNOW(r);
     if (!s || !s->half || n <= 0)
         return;
     map_target(s);
@@ -469,6 +472,20 @@ static const r_pass surface[] = {
      RES_SIL},
 };
 
-const r_fx_module r_fx_snow_module = {
-    "snow", snow_create, snow_destroy, snow_load, {pre, surface, NULL}, {3, 1, 0},
+/* History: the displacement map (map_tex), reset to the untouched
+ * heights and then only ever lowered by the contacts of each tick: a
+ * footprint stays for the rest of the sequence, so every tick since the
+ * reset counts.  snow_advance is the snow_map pass (its need() finds the
+ * tick's contacts); the light maps are made from it each frame. */
+static void snow_advance(r_game *r)
+{
+    if (need_map(r))
+        run_map(r);
+}
+
+const r_fx_module fx_snow_module = {
+    .name = "snow", .create = snow_create, .destroy = snow_destroy, .load = snow_load,
+    .pass = {pre, surface, NULL}, .npass = {3, 1, 0},
+    .res = {{RES_SNOW, "snow", true}, {RES_SNOW_LIGHT, "snow light", false}},
+    .warmup = R_FX_FROM_START, .advance = snow_advance,
 };

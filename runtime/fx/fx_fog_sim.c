@@ -1,5 +1,5 @@
-/* The fog map's mist, CPU side (r_fx_fog_sim.h). */
-#include "r_fx_fog_sim.h"
+/* The fog map's mist, CPU side (fx_fog_sim.h). */
+#include "fx_fog_sim.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -24,9 +24,12 @@
 #include <string.h>
 
 #include "../game/g_game.h"
-#include "r_fx_water_sim.h"
-#include "r_local.h"
-#include "r_shader.h"
+#include "fx_water_sim.h"
+#include "fx_local.h"
+#include "../render/r_shader.h"
+
+extern const r_fx_module fx_water_module;
+#define WATER(r) ((struct r_fx_water *)r_fx_state((r), &fx_water_module))
 
 enum { W_SIM, W_SPLAT, W_NORMAL, W_MIRROR, W_UNDER, W_SURFACE, W_PROGS };
 
@@ -261,26 +264,28 @@ fail:
 
 static bool create(r_game *r, rs_err *err)
 {
-    if (!(r->water = calloc(1, sizeof *r->water)))
+    r_fx_water *w = calloc(1, sizeof *w);
+    if (!w)
         return rs_fail(err, 1, "out of memory");
-    r_water_params_fix(&r->water->prm);
+    r_fx_set_state(r, &fx_water_module, w);
+    r_water_params_fix(&w->prm);
     return true;
 }
 
 static void destroy(r_game *r)
 {
-    if (!r->water)
+    if (!WATER(r))
         return;
-    free_gl(r->water);
-    free(r->water);
-    r->water = NULL;
+    free_gl(WATER(r));
+    free(WATER(r));
+    r_fx_set_state(r, &fx_water_module, NULL);
 }
 
 /* Builds on the first stage with water; a later stage keeps what is built
  * but the screen-sized targets, which only a water stage needs. */
 static bool load(r_game *r, rs_err *err)
 {
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     if (w && !r->stage.water)
         free_targets(w);
     return !r->stage.water || !w || w->built || build(w, err);
@@ -289,7 +294,7 @@ static bool load(r_game *r, rs_err *err)
 static bool need_water(void *u)
 {
     r_game *r = u;
-    return r->stage.water && r->water && r->water->built;
+    return r->stage.water && WATER(r) && WATER(r)->built;
 }
 
 /* ---- the simulation ---- */
@@ -363,7 +368,7 @@ static float ring_half(const r_game *r)
 static void run_sim(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     frame *f = &r->f;
     if (f->reset)
         clear_state(w);
@@ -421,7 +426,7 @@ static void ensure_targets(r_fx_water *w, int sw, int sh)
 static void run_reflect(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     frame *f = &r->f;
     ensure_targets(w, f->w, f->h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->refl_fbo);
@@ -474,7 +479,7 @@ static void water_box(const r_game *r, float half, int box[4])
     const frame *f = &r->f;
     float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
     for (int k = 0; k < 8; k++) {
-        r_vec3 c = r_v3(k & 1 ? half : -half, k & 2 ? R_WATER_LEVEL + r->water->prm.h_max : 0.0f, k & 4 ? half : -half);
+        r_vec3 c = r_v3(k & 1 ? half : -half, k & 2 ? R_WATER_LEVEL + WATER(r)->prm.h_max : 0.0f, k & 4 ? half : -half);
         float x, y;
         if (!r_project(f->vp, c, f->w, f->h, &x, &y) || !isfinite(x) || !isfinite(y)) {
             box[0] = box[1] = 0, box[2] = f->w, box[3] = f->h;
@@ -491,7 +496,7 @@ static void water_box(const r_game *r, float half, int box[4])
 static void run_under(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     frame *f = &r->f;
     ensure_targets(w, f->w, f->h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->under_fbo);
@@ -528,7 +533,7 @@ static void run_under(void *u)
 static void run_surface(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     frame *f = &r->f;
     float half = ring_half(r);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
@@ -561,16 +566,16 @@ static void run_surface(void *u)
     RGL_CHECK("water_surface");
 }
 
-/* ---- for tests (r_fx_water_sim.h) ---- */
+/* ---- for tests (fx_water_sim.h) ---- */
 
 const r_water_params *r_fx_water_params(r_game *r)
 {
-    return r->water && r->water->built ? &r->water->prm : NULL;
+    return WATER(r) && WATER(r)->built ? &WATER(r)->prm : NULL;
 }
 
 bool r_fx_water_gpu_steps(r_game *r, const r_water_splat *s, int ns, int steps)
 {
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     if (!w || !w->built || ns < 0 || ns > MAX_SPLATS)
         return false;
     gpu_steps(r, w, s, ns, steps);
@@ -581,7 +586,7 @@ bool r_fx_water_gpu_steps(r_game *r, const r_water_splat *s, int ns, int steps)
 
 bool r_fx_water_read(r_game *r, float *grid)
 {
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     float *px = w && w->built ? malloc((size_t)R_WATER_N * R_WATER_N * 4 * sizeof *px) : NULL;
     if (!px)
         return false;
@@ -597,7 +602,7 @@ bool r_fx_water_read(r_game *r, float *grid)
 
 bool r_fx_water_write(r_game *r, const float *grid)
 {
-    r_fx_water *w = r->water;
+    r_fx_water *w = WATER(r);
     float *px = w && w->built ? calloc((size_t)R_WATER_N * R_WATER_N * 4, sizeof *px) : NULL;
     if (!px)
         return false;
@@ -612,7 +617,7 @@ bool r_fx_water_write(r_game *r, const float *grid)
 
 int r_fx_water_last_splats(r_game *r)
 {
-    return r->water ? r->water->nsplat : 0;
+    return WATER(r) ? WATER(r)->nsplat : 0;
 }
 
 /* ---- the module ---- */
@@ -627,6 +632,21 @@ static const r_pass surface[] = {
      need_water, run_surface, 0},
 };
 
-const r_fx_module r_fx_water_module = {
-    "water", create, destroy, load, {pre, surface, NULL}, {2, 2, 0},
+/* History: the wave automaton (heights now and a tick ago, sim_tex) and
+ * the normal map made from it: cleared on a reset, then one step per
+ * tick with that tick's splats.  The waves are damped but never exactly
+ * zero again, so every tick since the reset counts.  water_advance is the
+ * water_sim pass: it draws into the automaton's own targets only. */
+static void water_advance(r_game *r)
+{
+    if (need_water(r))
+        run_sim(r);
+}
+
+const r_fx_module fx_water_module = {
+    .name = "water", .create = create, .destroy = destroy, .load = load,
+    .pass = {pre, surface, NULL}, .npass = {2, 2, 0},
+    .res = {{RES_WATER, "water", true}, {RES_WATER_REFL, "water reflection", false},
+            {RES_WATER_UNDER, "under water", false}},
+    .warmup = R_FX_FROM_START, .advance = water_advance,
 };

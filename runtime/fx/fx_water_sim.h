@@ -1,6 +1,6 @@
 /* Water (techniques A6): the wave automaton's CPU reference and its
  * parameters.  Plain C, no GL: shaders/water_sim.frag and water_splat.*
- * run the same formulas on the GPU (r_fx_water.c), and
+ * run the same formulas on the GPU (fx_water.c), and
  * tests/test_fx_water.c holds the two to each other.
  *
  * The grid is n x n cells of two floats, interleaved like the RG channels
@@ -108,7 +108,7 @@ bool r_water_forced_run(const r_water_params *p, bool raw, int n, long steps, lo
  * per step (analytic) and the CPU time of a 256 x 256 step.  ~10 s. */
 void r_water_accuracy_rows(FILE *out);
 
-/* ---- the GPU side (r_fx_water.c), for tests ---- */
+/* ---- the GPU side (fx_water.c), for tests ---- */
 struct r_game;
 /* The parameters the water passes use (NULL before a water stage loaded). */
 const r_water_params *r_fx_water_params(struct r_game *r);

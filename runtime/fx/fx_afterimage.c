@@ -12,8 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "r_local.h"
-#include "r_shader.h"
+#include "fx_local.h"
+#include "../render/r_shader.h"
+
+extern const r_fx_module fx_afterimage_module;
+#define AFTERIMAGE(r) ((struct r_fx_afterimage *)r_fx_state((r), &fx_afterimage_module))
 
 #define OPACITY 0.6f /* the copy's alpha at rest; the speed fade scales it */
 
@@ -29,7 +32,7 @@ static bool create(r_game *r, rs_err *err)
     r_fx_afterimage *a = calloc(1, sizeof *a);
     if (!a)
         return rs_fail(err, 1, "out of memory");
-    r->afterimage = a;
+    r_fx_set_state(r, &fx_afterimage_module, a);
     a->prog = r_program(&(r_program_desc){.vs = "afterimage.vert", .fs = "afterimage.frag"}, err);
     if (!a->prog)
         return false;
@@ -56,12 +59,12 @@ static bool create(r_game *r, rs_err *err)
 
 static void destroy(r_game *r)
 {
-    r_fx_afterimage *a = r->afterimage;
+    r_fx_afterimage *a = AFTERIMAGE(r);
     if (!a)
         return;
     gl.DeleteProgram(a->prog);
     free(a);
-    r->afterimage = NULL;
+    r_fx_set_state(r, &fx_afterimage_module, NULL);
 }
 
 /* A point of a bone (t metres along its x axis) through matrix v. */
@@ -93,7 +96,7 @@ static float bone_speed(const float cur[16], const float prev[16], float len, co
 static bool needed(void *u)
 {
     r_game *r = u;
-    r_fx_afterimage *a = r->afterimage;
+    r_fx_afterimage *a = AFTERIMAGE(r);
     if (!a || r->stage.afterimage == R_AFTERIMAGE_OFF)
         return false;
     a->any_fast = false;
@@ -113,7 +116,7 @@ static bool needed(void *u)
 static void run(void *u)
 {
     r_game *r = u;
-    r_fx_afterimage *a = r->afterimage;
+    r_fx_afterimage *a = AFTERIMAGE(r);
     frame *f = &r->f;
     GLuint p = a->prog;
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
@@ -155,6 +158,12 @@ static const r_pass passes[] = {
     {"afterimage", RES_ENV | RES_DEPTH | RES_HDR, RES_HDR, needed, run, 0},
 };
 
-const r_fx_module r_fx_afterimage_module = {
-    "afterimage", create, destroy, NULL, {[R_FX_TRANSLUCENT] = passes}, {[R_FX_TRANSLUCENT] = 1},
+/* History: none of its own.  The previous matrices are those of the game
+ * state one tick before (r->f.bones_prev, view_prev: r_frame.c), which the
+ * caller hands r_game_draw as `prev`; a frame is a function of the two
+ * game states alone. */
+const r_fx_module fx_afterimage_module = {
+    .name = "afterimage", .create = create, .destroy = destroy,
+    .pass = {[R_FX_TRANSLUCENT] = passes}, .npass = {[R_FX_TRANSLUCENT] = 1},
+    .warmup = R_FX_STATELESS,
 };

@@ -29,7 +29,11 @@
 #include <string.h>
 
 #include "../game/g_game.h"
-#include "r_local.h"
+#include "fx_local.h"
+#include "fx_holes.h"
+
+extern const r_fx_module fx_holes_module;
+#define HOLES(r) ((struct r_fx_holes *)r_fx_state((r), &fx_holes_module))
 
 #define SPHERE_SEG 32
 #define SPHERE_RINGS 8
@@ -45,7 +49,7 @@ struct r_fx_holes {
 static bool need_holes(void *u)
 {
     r_game *r = u;
-    return r->holes && r->stage.holes && r->f.cur->nholes > 0;
+    return HOLES(r) && r->stage.holes && r->f.cur->nholes > 0;
 }
 
 static void model(const g_hole *h, float m[16])
@@ -73,7 +77,7 @@ static int nearer_first(const void *a, const void *b)
 static void run_holes(void *u)
 {
     r_game *r = u;
-    struct r_fx_holes *hs = r->holes;
+    struct r_fx_holes *hs = HOLES(r);
     frame *f = &r->f;
     const g_state *st = f->cur;
     bool prepass = r_ran(f, r, "z_prepass");
@@ -153,12 +157,12 @@ static const r_pass holes_passes[] = {
 
 static void holes_destroy(r_game *r)
 {
-    struct r_fx_holes *hs = r->holes;
+    struct r_fx_holes *hs = HOLES(r);
     if (!hs)
         return;
     r_free_mesh(&hs->vao, &hs->vbo, &hs->ibo);
     free(hs);
-    r->holes = NULL;
+    r_fx_set_state(r, &fx_holes_module, NULL);
 }
 
 static bool holes_create(r_game *r, rs_err *err)
@@ -166,7 +170,7 @@ static bool holes_create(r_game *r, rs_err *err)
     struct r_fx_holes *hs = calloc(1, sizeof *hs);
     if (!hs)
         return rs_fail(err, 1, "holes: out of memory");
-    r->holes = hs;
+    r_fx_set_state(r, &fx_holes_module, hs);
     /* the unit sphere (a capsule of length 0) on bone 0: u_bones[0] places it */
     r_mesh_data m = {0};
     if (!r_mesh_capsule(&m, 0.0f, 1.0f, 0, SPHERE_SEG, SPHERE_RINGS)) {
@@ -181,10 +185,38 @@ static bool holes_create(r_game *r, rs_err *err)
     return true;
 }
 
-const r_fx_module r_fx_holes_module = {"holes", holes_create, holes_destroy, NULL,
-                                       {holes_passes}, {(int)(sizeof holes_passes / sizeof holes_passes[0])}};
+/* Inside "scene": the holes pass cleared the HDR target and drew already */
+static bool holes_scene_cleared(r_game *r)
+{
+    return r_ran(&r->f, r, "holes");
+}
+
+/* Steps 5 and 6 (scene has bound the stage program and the ring's VAO):
+ * the indestructible parts, then the ring top's colour only where its own
+ * depth is still there (the holes pass put the craters' depth in the rest). */
+static bool holes_draw_ring(r_game *r)
+{
+    if (!r_ran(&r->f, r, "holes"))
+        return false;
+    gl.DrawElements(GL_TRIANGLES, R_RING_TOP_FIRST, GL_UNSIGNED_INT, NULL);
+    gl.DrawElements(GL_TRIANGLES, r->ring_count - R_RING_TOP_FIRST - 6, GL_UNSIGNED_INT,
+                    (const void *)((R_RING_TOP_FIRST + 6) * sizeof(unsigned)));
+    gl.DepthFunc(GL_EQUAL);
+    gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, (const void *)(R_RING_TOP_FIRST * sizeof(unsigned)));
+    gl.DepthFunc(GL_LESS);
+    return true;
+}
+
+/* History: none.  The craters are game state (g_holes.c); a frame draws
+ * those of the state it is given. */
+const r_fx_module fx_holes_module = {
+    .name = "holes", .create = holes_create, .destroy = holes_destroy,
+    .pass = {holes_passes}, .npass = {(int)(sizeof holes_passes / sizeof holes_passes[0])},
+    .scene_cleared = holes_scene_cleared, .draw_ring = holes_draw_ring,
+    .warmup = R_FX_STATELESS,
+};
 
 int r_fx_holes_drawn(r_game *r)
 {
-    return r->holes ? r->holes->drawn : 0;
+    return HOLES(r) ? HOLES(r)->drawn : 0;
 }

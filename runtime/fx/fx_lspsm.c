@@ -41,10 +41,14 @@
 #include <string.h>
 
 #include "../game/g_game.h"
-#include "r_city.h"
-#include "r_local.h"
-#include "r_lspsm.h"
-#include "r_shader.h"
+#include "../render/r_city.h"
+#include "../render/r_lspsm.h"
+#include "../render/r_shader.h"
+#include "fx_local.h"
+#include "fx_lspsm.h"
+
+extern const r_fx_module fx_lspsm_module;
+#define LSPSM(r) ((struct r_fx_lspsm *)r_fx_state((r), &fx_lspsm_module))
 
 #define KEEP 0.4f         /* a fighter in full shadow keeps 40 % of the key light */
 #define DEPTH_BIAS 0.0005f /* receivers, window depth units */
@@ -77,20 +81,20 @@ struct r_fx_lspsm {
 static bool need_map(void *u)
 {
     r_game *r = u;
-    return r->stage.lspsm && r->lspsm;
+    return r->stage.lspsm && LSPSM(r);
 }
 
 static bool need_buildings(void *u)
 {
     r_game *r = u;
-    return r->lspsm && r->lspsm->nb > 0;
+    return LSPSM(r) && LSPSM(r)->nb > 0;
 }
 
 /* The key light: the direction the other shadows use (frame.light_dir),
  * or a test's. */
 static r_vec3 to_light(const r_game *r)
 {
-    return r->lspsm->light_override ? r->lspsm->light : r->f.light_dir;
+    return LSPSM(r)->light_override ? LSPSM(r)->light : r->f.light_dir;
 }
 
 static void take_focus(struct r_fx_lspsm *ls, bool reset)
@@ -119,7 +123,7 @@ static void take_focus(struct r_fx_lspsm *ls, bool reset)
 static void run_map(void *u)
 {
     r_game *r = u;
-    struct r_fx_lspsm *ls = r->lspsm;
+    struct r_fx_lspsm *ls = LSPSM(r);
     frame *f = &r->f;
     take_focus(ls, f->reset);
     r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
@@ -170,7 +174,7 @@ static void run_map(void *u)
 static void run_buildings(void *u)
 {
     r_game *r = u;
-    struct r_fx_lspsm *ls = r->lspsm;
+    struct r_fx_lspsm *ls = LSPSM(r);
     GLuint p = r->prog[P_STAGE];
     r_begin_opaque(r);
     r_stage_uniforms(r, p, 2);
@@ -186,7 +190,7 @@ static void run_buildings(void *u)
 static void run_focus(void *u)
 {
     r_game *r = u;
-    struct r_fx_lspsm *ls = r->lspsm;
+    struct r_fx_lspsm *ls = LSPSM(r);
     frame *f = &r->f;
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->focus_fbo);
     gl.Viewport(0, 0, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H);
@@ -218,9 +222,14 @@ static const r_pass focus_passes[] = {
 
 /* ---- the receivers' side ---- */
 
-void r_fx_lspsm_bind(r_game *r, GLuint p, int unit)
+/* The scene's programs (lspsm_common.glsl): u_lspsm_* and the two maps on
+ * units `unit` and `unit + 1` (u_lspsm_on = 0 whenever the map was not
+ * drawn this frame).  The sky and the visors do not receive it. */
+static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
 {
-    struct r_fx_lspsm *ls = r->lspsm;
+    if (what != R_FX_BIND_SCENE)
+        return;
+    struct r_fx_lspsm *ls = LSPSM(r);
     bool on = ls && r->stage.lspsm && r_ran(&r->f, r, "lspsm_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
@@ -265,7 +274,7 @@ static void free_city(struct r_fx_lspsm *ls)
 
 static void lspsm_destroy(r_game *r)
 {
-    struct r_fx_lspsm *ls = r->lspsm;
+    struct r_fx_lspsm *ls = LSPSM(r);
     if (!ls)
         return;
     free_city(ls);
@@ -277,7 +286,7 @@ static void lspsm_destroy(r_game *r)
     gl.DeleteProgram(ls->prog_map);
     gl.DeleteProgram(ls->prog_focus);
     free(ls);
-    r->lspsm = NULL;
+    r_fx_set_state(r, &fx_lspsm_module, NULL);
 }
 
 static bool lspsm_create(r_game *r, rs_err *err)
@@ -285,7 +294,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
     struct r_fx_lspsm *ls = calloc(1, sizeof *ls);
     if (!ls)
         return rs_fail(err, 1, "lspsm: out of memory");
-    r->lspsm = ls;
+    r_fx_set_state(r, &fx_lspsm_module, ls);
     if (!(ls->prog_map = r_program(&(r_program_desc){.vs = "scene.vert", .fs = "light_depth.frag",
                                                      .defines = "#define LIGHT_VIEW 1\n#define LSPSM 1\n"},
                                    err)) ||
@@ -329,7 +338,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
 /* A new look: the buildings of its layout (their meshes), the focus afresh. */
 static bool lspsm_load(r_game *r, rs_err *err)
 {
-    struct r_fx_lspsm *ls = r->lspsm;
+    struct r_fx_lspsm *ls = LSPSM(r);
     free_city(ls);
     ls->pending = false;
     ls->focus.range = 0;
@@ -364,39 +373,55 @@ static bool lspsm_load(r_game *r, rs_err *err)
     return true;
 }
 
-const r_fx_module r_fx_lspsm_module = {
-    "lspsm", lspsm_create, lspsm_destroy, lspsm_load,
-    {map_passes, surface_passes, focus_passes},
-    {(int)(sizeof map_passes / sizeof map_passes[0]), (int)(sizeof surface_passes / sizeof surface_passes[0]),
-     (int)(sizeof focus_passes / sizeof focus_passes[0])},
+/* History: the auto-focus range, and the depth samples read back one
+ * frame late.  The range follows the farthest sample at once when it
+ * grows and shrinks at most 2 % a frame (R_LSPSM_SHRINK), so in general
+ * every frame since the reset counts; and the samples are the drawn
+ * frame's depth buffer (the ring, the craters, the buildings, the
+ * fighters), which only drawing the frame gives.  So there is no advance
+ * hook: needs_frame makes r_game_advance draw the frame on an LSPSM stage,
+ * which moves every module's history on exactly as a full render does. */
+static bool lspsm_needs_frame(r_game *r)
+{
+    return need_map(r);
+}
+
+const r_fx_module fx_lspsm_module = {
+    .name = "lspsm", .create = lspsm_create, .destroy = lspsm_destroy, .load = lspsm_load,
+    .pass = {map_passes, surface_passes, focus_passes},
+    .npass = {(int)(sizeof map_passes / sizeof map_passes[0]), (int)(sizeof surface_passes / sizeof surface_passes[0]),
+              (int)(sizeof focus_passes / sizeof focus_passes[0])},
+    .res = {{RES_LSPSM, "lspsm map", false}}, .scene_reads = RES_LSPSM,
+    .units = 2, .bind = lspsm_bind,
+    .warmup = R_FX_FROM_START, .needs_frame = lspsm_needs_frame,
 };
 
 /* ---- tests, bench and --passes ---- */
 
 bool r_fx_lspsm_stats_get(r_game *r, r_fx_lspsm_stats *out)
 {
-    if (!r->lspsm)
+    if (!LSPSM(r))
         return false;
-    *out = r->lspsm->stats;
-    out->focus_farthest = r->lspsm->focus.farthest;
-    out->focus_used = r->lspsm->focus.used;
+    *out = LSPSM(r)->stats;
+    out->focus_farthest = LSPSM(r)->focus.farthest;
+    out->focus_used = LSPSM(r)->focus.used;
     return true;
 }
 
 void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform)
 {
-    if (!r->lspsm)
+    if (!LSPSM(r))
         return;
-    r->lspsm->light_override = light != NULL;
+    LSPSM(r)->light_override = light != NULL;
     if (light)
-        r->lspsm->light = r_v3(light[0], light[1], light[2]);
-    r->lspsm->no_cull = no_cull;
-    r->lspsm->uniform = uniform;
+        LSPSM(r)->light = r_v3(light[0], light[1], light[2]);
+    LSPSM(r)->no_cull = no_cull;
+    LSPSM(r)->uniform = uniform;
 }
 
 bool r_fx_lspsm_read(r_game *r, const char *what, float *out)
 {
-    struct r_fx_lspsm *ls = r->lspsm;
+    struct r_fx_lspsm *ls = LSPSM(r);
     if (!ls)
         return false;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);

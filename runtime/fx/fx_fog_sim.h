@@ -1,6 +1,6 @@
 /* The fog map's mist (techniques A8), CPU side: particles lying over the
  * stage, moved once per game tick by a global wind plus local wind fields
- * that fast limbs leave behind them.  Pure C, no GL: r_fx_fog.c draws the
+ * that fast limbs leave behind them.  Pure C, no GL: fx_fog.c draws the
  * particles into the fog map each frame.
  *
  * Space is the top-down (x, z) plane: x along the ring, z towards the

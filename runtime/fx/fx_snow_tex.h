@@ -1,6 +1,6 @@
 /* Snow (techniques A7): the effect's procedural textures, plain CPU
  * functions so tests check them without GL, and the snow module's
- * read-back hooks for the tests (defined in r_fx_snow.c).
+ * read-back hooks for the tests (defined in fx_snow.c).
  *
  * Heights are metres above the ring top (y = 0).  The displacement map
  * covers the ring top, x and z in -half..+half, row j at
@@ -34,7 +34,7 @@ void r_snow_colors(uint8_t *rg, int n);
  * 0.5, a = 255). */
 void r_snow_detail_normals(uint8_t *rgba, int n);
 
-/* Test hooks (r_fx_snow.c).  which: "map" (the displacement map),
+/* Test hooks (fx_snow.c).  which: "map" (the displacement map),
  * "untouched", "trampled" (R_SNOW_MAP^2 floats) or "light" (the blurred
  * texture-space lighting, RGBA: r_fx_snow_light_size()^2 * 4).
  * False when the snow module has no such texture. */
