@@ -235,7 +235,7 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
     if (!c->d.downscale)
         c->d.downscale = c->d.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU;
     if (c->d.mode == CAP_SEQUENTIAL)
-        c->d.queue = CAP_QUEUE_NONE; /* everything on the game thread */
+        c->d.no_writer = true; /* everything on the game thread */
     c->gpu = c->d.downscale == CAP_DS_GPU;
     c->sink = sink;
     c->fmt = sink->fmt;
@@ -270,7 +270,7 @@ cap *cap_open(const cap_desc *desc, cap_sink *sink, rs_err *err)
         sink->ops->close(sink, false, NULL); /* a half-open sink cleans up too */
         goto fail;
     }
-    c->writer = cap_writer_start(sink, c->frame_bytes, c->d.queue == CAP_QUEUE_NONE ? 0 : c->d.queue, c->d.hashes, err);
+    c->writer = cap_writer_start(sink, c->frame_bytes, c->d.no_writer ? 0 : c->d.queue, c->d.hashes, err);
     if (!c->writer) {
         sink->ops->close(sink, false, NULL);
         goto fail;

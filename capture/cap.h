@@ -27,7 +27,6 @@ typedef enum cap_downscale { CAP_DS_DEFAULT, CAP_DS_GPU, CAP_DS_CPU } cap_downsc
 
 #define CAP_DEFAULT_PBO 2
 #define CAP_DEFAULT_QUEUE 120
-#define CAP_QUEUE_NONE (-1) /* write inline, no thread */
 #define CAP_MAX_PBO 8
 #define CAP_MAX_SCALE 8     /* render size / output size, per axis */
 
@@ -39,7 +38,9 @@ typedef struct cap_desc {
     cap_downscale downscale; /* default: GPU for async, CPU for sequential */
     cap_filter filter;       /* GPU downscale filter, default box (the CPU path is always box) */
     int pbo;                 /* ring size, default 2 */
-    int queue;               /* writer queue cap, default 120; CAP_QUEUE_NONE: inline */
+    int queue;               /* writer queue cap, default 120 */
+    bool no_writer;          /* write on the game thread: no writer thread, no queue
+                              * (always so in sequential mode) */
     FILE *hashes;            /* optional: "index hash" per output frame */
 } cap_desc;
 

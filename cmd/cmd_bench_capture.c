@@ -30,7 +30,7 @@ typedef struct run {
     double fps_each[MAX_RUNS];
     cap_mode mode;
     cap_downscale ds;
-    int pbo, queue; /* queue: CAP_QUEUE_NONE for 0 */
+    int pbo, queue; /* queue 0: no writer thread */
     int kind;       /* 0 capture, 1 render-only, 2 writer-only */
     double fps, ms_render, rss_mb;
     cap_stats st;
@@ -141,7 +141,7 @@ static bool do_run(bench *b, run *r, rs_err *err)
             return false;
         }
         cap *c = cap_open(&(cap_desc){.src_w = b->sw, .src_h = b->sh, .w = b->w, .h = b->h, .mode = r->mode,
-                                      .downscale = r->ds, .pbo = r->pbo, .queue = r->queue},
+                                      .downscale = r->ds, .pbo = r->pbo, .queue = r->queue, .no_writer = r->mode == CAP_ASYNC && r->queue == 0},
                           &s, err);
         if (!c)
             return false;
@@ -258,12 +258,12 @@ int bench_capture(int argc, char **argv)
     runs[nrun++] = (run){.name = "render-only", .kind = 1};
     runs[nrun++] = (run){.name = "writer-only", .kind = 2};
     runs[nrun++] = (run){.name = "sequential", .mode = CAP_SEQUENTIAL};
-    const int pbos[3] = {1, 2, 3}, queues[3] = {CAP_QUEUE_NONE, 8, 120};
+    const int pbos[3] = {1, 2, 3}, queues[3] = {0, 8, 120};
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
             run *r = &runs[nrun++];
             *r = (run){.mode = CAP_ASYNC, .pbo = pbos[i], .queue = queues[j]};
-            snprintf(r->name, sizeof r->name, "async pbo%d q%d", pbos[i], queues[j] < 0 ? 0 : queues[j]);
+            snprintf(r->name, sizeof r->name, "async pbo%d q%d", pbos[i], queues[j]);
         }
     /* the configurations interleaved, nrep times; each figure is the median */
     for (int rep = 0; rep < nrep; rep++)

@@ -143,7 +143,8 @@ int cmd_render(int argc, char **argv)
         case 'Q':
             if (!cli_int("--queue", optarg, 0, 1000, &v))
                 return RS_EXIT_USAGE;
-            cd.queue = v ? (int)v : CAP_QUEUE_NONE;
+            cd.queue = (int)v;
+            cd.no_writer = v == 0;
             break;
         case 'F':
             if (!cap_filter_parse(optarg, &cd.filter)) {
@@ -327,7 +328,7 @@ int cmd_render(int argc, char **argv)
                 out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, secs, secs > 0 ? st.frames / secs : 0.0,
                 cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
-                cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.queue == CAP_QUEUE_NONE || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
+                cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
                 st.high_water, st.fence_waits);
     status = RS_EXIT_OK;
 done:
