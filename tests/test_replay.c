@@ -10,6 +10,7 @@
 
 #include "../runtime/game/g_ai.h"
 #include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 #include "t.h"
 

@@ -11,6 +11,7 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 #include "../service/svc_config.h"
 #include "../service/svc_json.h"

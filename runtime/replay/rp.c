@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "../util/rs_file.h"
-#include "../util/rs_img.h" /* rs_crc32 */
+#include "../util/rs_hash.h"
 
 const char *rp_error_text(int code)
 {

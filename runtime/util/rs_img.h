@@ -14,10 +14,6 @@
 #include <stdint.h>
 
 #include "rs_err.h"
-/* rs_crc32 moved to rs_hash.h; included here until the files that still
- * reach it through this header (runtime/replay/rp.c, tests/test_replay.c,
- * tests/test_svc.c) include rs_hash.h themselves */
-#include "rs_hash.h"
 
 enum { RS_IMG_ERR_IO = 1, RS_IMG_ERR_FORMAT, RS_IMG_ERR_ARG };
 
