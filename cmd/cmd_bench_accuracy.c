@@ -329,10 +329,10 @@ int bench_accuracy(int argc, char **argv)
         }
     }
     if (!only || !strcmp(only, "water"))
-        r_water_accuracy_rows(stdout);
+        fx_water_sim_accuracy_rows(stdout);
     if (!only || !strcmp(only, "fog")) {
         plat *p = plat_create(&(plat_desc){.hidden = true}, &err);
-        bool ok = p && r_fx_fog_accuracy_rows(stdout, &err);
+        bool ok = p && fx_fog_accuracy_rows(stdout, &err);
         plat_destroy(p);
         if (!ok) {
             cli_error("bench", "fog map: %s", err.msg);

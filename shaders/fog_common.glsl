@@ -10,7 +10,7 @@
 // shader) takes tau = fog_depth(world), the optical depth from the eye
 // (the sky: fog_depth_sky(dir)); the fragment shader mixes with
 // fog_apply(lit, tau, dir).  Only when
-// u_fog_on == 1: r_fx_fog_bind sets it, with everything below, and it is 0
+// u_fog_on == 1: the fog module's bind hook (fog_bind, runtime/fx/fx_fog.c) sets it, with everything below, and it is 0
 // whenever the fog_map pass did not run this frame.
 #ifndef FOG_STEPS
 #define FOG_STEPS 4 // samples along the view ray

@@ -6,7 +6,7 @@
 // proxies and the fighters.  A second R8 map beside it marks the texels
 // whose nearest caster is a fighter, so the stage, which gets the
 // fighters' shadows from the blurred silhouette (A5) already, can leave
-// them out.  Only when u_lspsm_on == 1: r_fx_lspsm_bind sets it with
+// them out.  Only when u_lspsm_on == 1: lspsm_bind (runtime/fx/fx_lspsm.c) sets it with
 // everything below, and it is 0 whenever the map was not drawn this frame.
 uniform int u_lspsm_on;
 uniform sampler2DShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware

@@ -5,7 +5,7 @@
 // the snow's sheen: an IBL specular exponent (the spec16 maps)
 const float SNOW_EXPONENT = 16.0;
 // albedo of fresh and of fully trampled snow (linear), times the colour
-// texture's brightness (r_fx_snow_tex.h)
+// texture's brightness (fx_snow_tex.h)
 const vec3 SNOW_FRESH = vec3(0.90, 0.92, 0.96);
 const vec3 SNOW_TRAMPLED = vec3(0.70, 0.72, 0.76);
 // specular strength of fresh snow and inside a trampled dent (packed snow

@@ -13,7 +13,7 @@ in vec3 v_proj;
 in float v_lod;
 flat in vec3 v_key;
 uniform sampler2D u_light;    // rgb: key-off light, a: the key's share
-uniform sampler2D u_colors;   // r, g: fresh and trampled brightness (r_fx_snow_tex.h), tiling
+uniform sampler2D u_colors;   // r, g: fresh and trampled brightness (fx_snow_tex.h), tiling
 uniform sampler2D u_silhouette;
 uniform float u_color_tile;   // metres per repeat of the colour texture
 uniform float u_flash;        // lightning: extra light, 0..1

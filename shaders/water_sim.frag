@@ -2,8 +2,8 @@
 // Water (techniques A6): one step of the wave automaton on the 256x256
 // RGBA32F simulation texture (r: height, g: the height a step earlier),
 // drawn with cap_fullscreen.vert from one texture of the ping-pong pair
-// into the other.  The CPU reference r_water_step_raw
-// (runtime/render/r_fx_water_sim.c) computes the same, operation for
+// into the other.  The CPU reference fx_water_sim_step_raw
+// (runtime/render/fx_water_sim.c) computes the same, operation for
 // operation; tests/test_fx_water.c compares the two.
 //   h' = damping * ((2 h - h_prev) + C^2 * (hL + hR + hD + hU - 4 h))
 // C (the Courant number) is capped below 1/sqrt(2) on the CPU.  The edges

@@ -1,6 +1,6 @@
 #version 330 core
 // Water: a splat's bump, amp * (1 + cos(pi d / radius)) / 2 inside the
-// radius (r_water_splat_weight on the CPU), added to the height only.
+// radius (fx_water_sim_splat_weight on the CPU), added to the height only.
 flat in vec4 v_splat;
 out vec4 o_add;
 void main()

@@ -1,4 +1,4 @@
-/* The stage effects as a whole (runtime/render/r_fx*.c) and the afterimage
+/* The stage effects as a whole (runtime/render/r_fx.c, runtime/fx/) and the afterimage
  * motion blur: every effect's passes run only on stages that ask for the
  * effect, and the afterimage shows behind fast limbs, never over the
  * fighters.  Each effect's own tests are in tests/test_fx_<effect>.c. */

@@ -32,20 +32,20 @@ static void sweep(int t, float speed, float cur[3], float prev[3])
     prev[0] = x - step, prev[1] = 0.8f, prev[2] = 0.1f;
 }
 
-static void run_sim(r_fog_sim *s, int ticks, float speed)
+static void run_sim(fx_fog_sim *s, int ticks, float speed)
 {
     for (int t = 0; t < ticks; t++) {
         float cur[1][3], prev[1][3];
         sweep(t, speed, cur[0], prev[0]);
-        r_fog_sim_stir(s, cur, prev, 1);
-        r_fog_sim_step(s);
+        fx_fog_sim_stir(s, cur, prev, 1);
+        fx_fog_sim_step(s);
     }
 }
 
 static void t_sim_deterministic(void)
 {
-    r_fog_sim a, b, c;
-    T_ASSERT(r_fog_sim_init(&a, NULL) && r_fog_sim_init(&b, NULL));
+    fx_fog_sim a, b, c;
+    T_ASSERT(fx_fog_sim_init(&a, NULL) && fx_fog_sim_init(&b, NULL));
     T_EQ(a.n, 3000);
     run_sim(&a, 900, 6.0f);
     run_sim(&b, 900, 6.0f);
@@ -53,23 +53,23 @@ static void t_sim_deterministic(void)
     T_ASSERTF(!memcmp(a.wind, b.wind, (size_t)a.ncell * a.ncell * sizeof *a.wind), "local wind differs");
     T_EQ(a.tick, 900);
     /* a reset is a restart: the same bits again */
-    r_fog_sim_reset(&b, 0);
+    fx_fog_sim_reset(&b, 0);
     run_sim(&b, 900, 6.0f);
     T_ASSERT(!memcmp(a.p, b.p, (size_t)a.n * sizeof *a.p));
     /* and another seed is another mist */
-    T_ASSERT(r_fog_sim_init(&c, &(r_fog_sim_desc){.seed = 7}));
+    T_ASSERT(fx_fog_sim_init(&c, &(fx_fog_sim_desc){.seed = 7}));
     run_sim(&c, 900, 6.0f);
     T_ASSERT(memcmp(a.p, c.p, (size_t)a.n * sizeof *a.p) != 0);
-    r_fog_sim_free(&a), r_fog_sim_free(&b), r_fog_sim_free(&c);
+    fx_fog_sim_free(&a), fx_fog_sim_free(&b), fx_fog_sim_free(&c);
 }
 
-static void check_inside(const r_fog_sim *s, const char *what)
+static void check_inside(const fx_fog_sim *s, const char *what)
 {
     float h = s->d.half;
     for (int i = 0; i < s->n; i++) {
-        const r_fog_particle *p = &s->p[i];
+        const fx_fog_particle *p = &s->p[i];
         T_ASSERTF(p->x >= -h && p->x < h && p->z >= -h && p->z < h, "%s: particle %d at %g, %g", what, i, p->x, p->z);
-        float w = r_fog_sim_weight(s, p);
+        float w = fx_fog_sim_weight(s, p);
         T_ASSERTF(isfinite(w) && w >= 0 && w <= 1.5f, "%s: particle %d weighs %g", what, i, w);
     }
     for (int k = 0; k < s->ncell * s->ncell; k++)
@@ -80,14 +80,14 @@ static void check_inside(const r_fog_sim *s, const char *what)
 
 static void t_sim_stays_inside(void)
 {
-    r_fog_sim s;
+    fx_fog_sim s;
     /* a gale across a corner, limbs stirring, particles dying and born */
-    T_ASSERT(r_fog_sim_init(&s, &(r_fog_sim_desc){.wind = {9.0f, -14.0f}, .life_s = 2}));
+    T_ASSERT(fx_fog_sim_init(&s, &(fx_fog_sim_desc){.wind = {9.0f, -14.0f}, .life_s = 2}));
     for (int k = 0; k < 10; k++) {
         run_sim(&s, 200, 12.0f);
         check_inside(&s, "gale");
     }
-    r_fog_sim_free(&s);
+    fx_fog_sim_free(&s);
 }
 
 /* The minimal-image displacement on the torus. */
@@ -99,15 +99,15 @@ static float torus_d(float a, float b, float h)
 
 static void t_sim_wind_moves_the_mist(void)
 {
-    r_fog_sim s;
+    fx_fog_sim s;
     const float wind[2] = {0.8f, -0.3f};
-    T_ASSERT(r_fog_sim_init(&s, &(r_fog_sim_desc){.wind = {wind[0], wind[1]}, .immortal = true}));
-    r_fog_particle *start = malloc((size_t)s.n * sizeof *start);
+    T_ASSERT(fx_fog_sim_init(&s, &(fx_fog_sim_desc){.wind = {wind[0], wind[1]}, .immortal = true}));
+    fx_fog_particle *start = malloc((size_t)s.n * sizeof *start);
     T_ASSERT(start);
     memcpy(start, s.p, (size_t)s.n * sizeof *start);
     const int ticks = 3 * G_HZ;
     for (int t = 0; t < ticks; t++)
-        r_fog_sim_step(&s);
+        fx_fog_sim_step(&s);
     /* the mass centre (unwrapped) moved downwind by wind x 3 s */
     double mx = 0, mz = 0;
     for (int i = 0; i < s.n; i++)
@@ -117,20 +117,20 @@ static void t_sim_wind_moves_the_mist(void)
     T_ASSERTF(fabs(mx - wind[0] * 3) < 1e-3 && fabs(mz - wind[1] * 3) < 1e-3, "moved %.5f, %.5f", mx, mz);
     /* the default breeze blows too, and a reset at tick T finds the mist
      * drifted as far as T ticks of it take it */
-    r_fog_sim d;
-    T_ASSERT(r_fog_sim_init(&d, &(r_fog_sim_desc){.immortal = true}));
+    fx_fog_sim d;
+    T_ASSERT(fx_fog_sim_init(&d, &(fx_fog_sim_desc){.immortal = true}));
     T_ASSERT(d.d.wind[0] > 0);
     memcpy(start, d.p, (size_t)d.n * sizeof *start);
-    r_fog_sim_reset(&d, 600);
+    fx_fog_sim_reset(&d, 600);
     for (int i = 0; i < d.n; i++)
         T_ASSERTF(fabsf(torus_d(d.p[i].x, start[i].x, d.d.half) - d.d.wind[0] * 10) < 1e-3f, "reset at 600: %g",
                   torus_d(d.p[i].x, start[i].x, d.d.half));
     free(start);
-    r_fog_sim_free(&s), r_fog_sim_free(&d);
+    fx_fog_sim_free(&s), fx_fog_sim_free(&d);
 }
 
 /* A cloud of particles round the origin; a limb point crosses it along +x. */
-static void cloud(r_fog_sim *s)
+static void cloud(fx_fog_sim *s)
 {
     uint32_t q = 12345;
     for (int i = 0; i < s->n; i++) {
@@ -145,21 +145,21 @@ static void cloud(r_fog_sim *s)
 /* Mean x and |z| displacement of the cloud after a limb crossed it at speed. */
 static int cross_cloud(float speed, double *dx, double *dz, int *backwards, bool *moved)
 {
-    r_fog_sim s;
-    T_ASSERT(r_fog_sim_init(&s, &(r_fog_sim_desc){.count = 400, .calm = true, .immortal = true}));
+    fx_fog_sim s;
+    T_ASSERT(fx_fog_sim_init(&s, &(fx_fog_sim_desc){.count = 400, .calm = true, .immortal = true}));
     cloud(&s);
-    r_fog_particle *start = malloc((size_t)s.n * sizeof *start);
+    fx_fog_particle *start = malloc((size_t)s.n * sizeof *start);
     T_ASSERT(start);
     memcpy(start, s.p, (size_t)s.n * sizeof *start);
     int stirred = 0;
     float step = speed / G_HZ;
     for (float x = -1.0f; x < 1.0f; x += step) { /* at the height of a knee, on the fight plane */
         float cur[1][3] = {{x + step, 0.5f, 0}}, prev[1][3] = {{x, 0.5f, 0}};
-        stirred += r_fog_sim_stir(&s, cur, prev, 1);
-        r_fog_sim_step(&s);
+        stirred += fx_fog_sim_stir(&s, cur, prev, 1);
+        fx_fog_sim_step(&s);
     }
     for (int t = 0; t < 4 * G_HZ; t++) /* the wind it left dies down */
-        r_fog_sim_step(&s);
+        fx_fog_sim_step(&s);
     T_ASSERTF(!s.active, "the local wind still blows 4 s later");
     *dx = *dz = 0, *backwards = 0, *moved = false;
     for (int i = 0; i < s.n; i++) {
@@ -170,7 +170,7 @@ static int cross_cloud(float speed, double *dx, double *dz, int *backwards, bool
     }
     *dx /= s.n, *dz /= s.n;
     free(start);
-    r_fog_sim_free(&s);
+    fx_fog_sim_free(&s);
     return stirred;
 }
 
@@ -196,8 +196,8 @@ static void t_sim_fast_limb_pushes_the_mist(void)
 static void t_sim_extremes_stay_finite(void)
 {
     /* parameters from a fuzzer: defaults or clamps, never NaN */
-    r_fog_sim s;
-    T_ASSERT(r_fog_sim_init(&s, &(r_fog_sim_desc){.count = -5, .half = INFINITY, .wind = {NAN, 1e30f},
+    fx_fog_sim s;
+    T_ASSERT(fx_fog_sim_init(&s, &(fx_fog_sim_desc){.count = -5, .half = INFINITY, .wind = {NAN, 1e30f},
                                                   .speed_threshold = NAN, .radius = 1e9f, .gain = INFINITY,
                                                   .decay_s = -1, .max_speed = NAN, .cell = 1e-9f, .life_s = NAN,
                                                   .fade_s = INFINITY}));
@@ -212,24 +212,24 @@ static void t_sim_extremes_stay_finite(void)
     float prev[7][3] = {{0, 1, 0}, {0, 0, 0}, {-big, 1, big}, {-big, 1, 0}, {big, -big, -big}, {0.5f, 1, 0.5f},
                         {0.2f - v35, 1, 0}};
     for (int t = 0; t < 600; t++) {
-        int n = r_fog_sim_stir(&s, cur, prev, 7);
+        int n = fx_fog_sim_stir(&s, cur, prev, 7);
         T_ASSERTF(n == 1, "tick %d: %d points stirred (only the one at 35 m/s may)", t, n);
-        r_fog_sim_step(&s);
+        fx_fog_sim_step(&s);
     }
     cur[6][0] = 0.2f + 1e4f / G_HZ; /* 1e4 m/s: a cut */
-    T_EQ(r_fog_sim_stir(&s, cur, prev, 7), 0);
+    T_EQ(fx_fog_sim_stir(&s, cur, prev, 7), 0);
     check_inside(&s, "extreme inputs");
     float w[2];
-    r_fog_sim_wind_at(&s, NAN, INFINITY, w);
+    fx_fog_sim_wind_at(&s, NAN, INFINITY, w);
     T_ASSERT(w[0] == 0 && w[1] == 0);
-    r_fog_sim_wind_at(&s, 0.1f, 0.1f, w);
+    fx_fog_sim_wind_at(&s, 0.1f, 0.1f, w);
     T_ASSERTF(isfinite(w[0]) && w[0] > 0.5f * s.d.max_speed && w[0] <= s.d.max_speed, "local wind %g after a 35 m/s limb",
               w[0]);
     /* a particle put somewhere impossible is born again inside */
     s.p[0].x = NAN, s.p[1].z = INFINITY, s.p[2].x = -1e30f;
-    r_fog_sim_step(&s);
+    fx_fog_sim_step(&s);
     check_inside(&s, "after NaN particles");
-    r_fog_sim_free(&s);
+    fx_fog_sim_free(&s);
 }
 
 /* ---- GL ---- */
@@ -256,10 +256,10 @@ static r_stage mistvale(void)
 
 static float *read_map(r_game *r, int *n, float *half)
 {
-    T_ASSERT(r_fx_fog_read_map(r, NULL, n, half));
+    T_ASSERT(fx_fog_read_map(r, NULL, n, half));
     float *m = malloc((size_t)*n * *n * sizeof *m);
     T_ASSERT(m);
-    T_ASSERT(r_fx_fog_read_map(r, m, n, half));
+    T_ASSERT(fx_fog_read_map(r, m, n, half));
     return m;
 }
 
@@ -302,11 +302,11 @@ static void dump_frame(const char *name, const uint8_t *rgba)
  * draws the same tick again: no step, so the map holds exactly them. */
 static void place(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, const float (*xz)[2], int n)
 {
-    r_fog_sim *s = r_fx_fog_sim(r);
+    fx_fog_sim *s = fx_fog_get_sim(r);
     T_ASSERT(s && n <= s->d.count);
     s->n = n;
     for (int i = 0; i < n; i++)
-        s->p[i] = (r_fog_particle){xz[i][0], xz[i][1], 1.0f, 5.0f, 10.0f};
+        s->p[i] = (fx_fog_particle){xz[i][0], xz[i][1], 1.0f, 5.0f, 10.0f};
     t_draw_read(r, f, prev, cur, W, H, NULL, true);
 }
 
@@ -408,7 +408,7 @@ static void t_map_follows_the_game(void)
                 t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
                 if (run == 1 && t % 7 == 0) /* drawn again: steps 0 */
                     t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
-                stirred += run == 0 ? r_fx_fog_sim(r)->stirred : 0;
+                stirred += run == 0 ? fx_fog_get_sim(r)->stirred : 0;
             }
             prev = cur;
             g_step(&cur, &rp.inputs[2 * t], NULL);
@@ -457,7 +457,7 @@ static void t_fog_varies_at_equal_height(void)
     /* 2000 particles, uniform over x < cut (their sprites reach cut + 1 m) */
     static float xz[2000][2];
     uint32_t q = 99;
-    float h12 = r_fx_fog_sim(r)->d.half;
+    float h12 = fx_fog_get_sim(r)->d.half;
     for (int i = 0; i < 2000; i++) {
         q = q * 1664525u + 1013904223u;
         xz[i][0] = -h12 + 1.0f + (cut - (-h12 + 1.0f)) * (float)(q >> 8) / 16777216.0f;
@@ -658,7 +658,7 @@ static void t_fp16_extremes(void)
     place(r, &f, &cur, &back, (const float(*)[2])xz, 3000);
     check_finite(r, "one pile");
     /* a corrupted mist: weights and places no simulation makes */
-    r_fog_sim *s = r_fx_fog_sim(r);
+    fx_fog_sim *s = fx_fog_get_sim(r);
     s->p[0].weight = INFINITY, s->p[1].weight = NAN, s->p[2].weight = 1e30f, s->p[3].x = NAN, s->p[4].z = -INFINITY;
     t_draw_read(r, &f, &cur, &back, W, H, NULL, true);
     check_finite(r, "corrupted particles");
@@ -677,7 +677,7 @@ static void t_accuracy_rows(void)
     FILE *out = fopen(path, "w+");
     T_ASSERT(out);
     rs_err e = {0};
-    T_ASSERTF(r_fx_fog_accuracy_rows(out, &e), "%s", e.msg);
+    T_ASSERTF(fx_fog_accuracy_rows(out, &e), "%s", e.msg);
     rewind(out);
     char line[256];
     int n = 0, size[8];

@@ -88,7 +88,7 @@ static void t_holes_cut_the_ring_only_there(void)
     T_ASSERTF(cur.nholes >= 5, "%d holes at tick %d", cur.nholes, TICK);
     draw(r, &f, &st, &prev, &cur);
     T_ASSERT(t_pass_ran(r, "holes"));
-    T_EQ(r_fx_holes_drawn(r), cur.nholes);
+    T_EQ(fx_holes_drawn(r), cur.nholes);
     float *on = read(r, "hdr", 4), *don = read(r, "depth", 1);
     g_state p0 = prev, c0 = cur;
     p0.nholes = c0.nholes = 0;
@@ -152,7 +152,7 @@ static void t_thirty_holes_and_extremes(void)
             t_stage_extremes(&st);
         draw(r, &f, &st, &prev, &cur);
         T_ASSERT(t_pass_ran(r, "holes"));
-        T_EQ(r_fx_holes_drawn(r), G_MAX_HOLES);
+        T_EQ(fx_holes_drawn(r), G_MAX_HOLES);
         float *px = read(r, "hdr", 4);
         dump(pass ? "thirty_extreme" : "thirty", px);
         int bad = 0;

@@ -85,7 +85,7 @@ static void t_buildings_cast_shadows(void)
     T_ASSERT(t_pass_ran(r, "lspsm_map") && t_pass_ran(r, "buildings") && t_pass_ran(r, "lspsm_focus"));
     float *on = hdr(r);
     float *map = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *map), *flag = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *flag);
-    T_ASSERT(map && flag && r_fx_lspsm_read(r, "map", map) && r_fx_lspsm_read(r, "flag", flag));
+    T_ASSERT(map && flag && fx_lspsm_read(r, "map", map) && fx_lspsm_read(r, "flag", flag));
     size_t scenery = 0, fighters = 0;
     for (size_t i = 0; i < (size_t)R_LSPSM_MAP * R_LSPSM_MAP; i++) {
         scenery += map[i] < 1 && flag[i] < 0.5f;
@@ -133,13 +133,13 @@ static void t_culling_keeps_the_map(void)
     T_ASSERT(a && b);
     const uint64_t ticks[] = {600, 1500, 2400};
     for (size_t t = 0; t < 3; t++) {
-        r_fx_lspsm_stats s1, s2;
-        r_fx_lspsm_test_set(r, NULL, false, false);
+        fx_lspsm_stats s1, s2;
+        fx_lspsm_test_set(r, NULL, false, false);
         draw_run(r, &f, "plaza", ticks[t], 1);
-        T_ASSERT(r_fx_lspsm_stats_get(r, &s1) && r_fx_lspsm_read(r, "map", a));
-        r_fx_lspsm_test_set(r, NULL, true, false);
+        T_ASSERT(fx_lspsm_stats_get(r, &s1) && fx_lspsm_read(r, "map", a));
+        fx_lspsm_test_set(r, NULL, true, false);
         draw_run(r, &f, "plaza", ticks[t], 1);
-        T_ASSERT(r_fx_lspsm_stats_get(r, &s2) && r_fx_lspsm_read(r, "map", b));
+        T_ASSERT(fx_lspsm_stats_get(r, &s2) && fx_lspsm_read(r, "map", b));
         fprintf(stderr, "    tick %llu: %d of %d buildings cast into the view\n", (unsigned long long)ticks[t],
                 s1.casters_drawn, s1.casters);
         T_EQ(s2.casters_drawn, s2.casters);
@@ -169,13 +169,13 @@ static void t_focus_reads_the_pattern_one_frame_late(void)
     set_stage(r, &st);
     float *depth = malloc((size_t)W * H * sizeof *depth), samples[R_LSPSM_FOCUS_N], want[R_LSPSM_FOCUS_N];
     T_ASSERT(depth);
-    r_fx_lspsm_stats s;
+    fx_lspsm_stats s;
     g_state prev, cur;
     t_state_at("plaza", 900, &prev, &cur);
     draw(r, &f, &prev, &cur);
-    T_ASSERT(r_fx_lspsm_stats_get(r, &s));
+    T_ASSERT(fx_lspsm_stats_get(r, &s));
     T_ASSERTF(s.range == R_LSPSM_LIMIT, "first frame: range %g, want the limit", s.range);
-    T_ASSERT(r_fx_lspsm_read(r, "focus", samples));
+    T_ASSERT(fx_lspsm_read(r, "focus", samples));
     int w = 0, h = 0;
     T_ASSERT(r_game_read_buffer(r, "depth", depth, &w, &h));
     T_EQ(w, W);
@@ -195,7 +195,7 @@ static void t_focus_reads_the_pattern_one_frame_late(void)
     g_input in[2] = {0, 0};
     g_step(&next, in, NULL);
     draw(r, &f, &cur, &next);
-    T_ASSERT(r_fx_lspsm_stats_get(r, &s));
+    T_ASSERT(fx_lspsm_stats_get(r, &s));
     fprintf(stderr, "    focus: %d samples, farthest %.1f m, range %.1f m (sky in view: %d samples)\n", s.focus_used,
             s.focus_farthest, s.range, sky);
     T_EQ(s.focus_used, R_LSPSM_FOCUS_N);
@@ -203,7 +203,7 @@ static void t_focus_reads_the_pattern_one_frame_late(void)
     /* a new look: back to the limit, the pending samples forgotten */
     set_stage(r, &st);
     draw(r, &f, &cur, &next);
-    T_ASSERT(r_fx_lspsm_stats_get(r, &s));
+    T_ASSERT(fx_lspsm_stats_get(r, &s));
     T_ASSERT(s.range == R_LSPSM_LIMIT);
     free(depth);
     r_game_destroy(r);
@@ -257,7 +257,7 @@ static void t_fighters_no_self_shadow_but_each_others(void)
     /* above */
     const float up[3] = {0, 1, 0};
     set_stage(r, &st);
-    r_fx_lspsm_test_set(r, up, false, false);
+    fx_lspsm_test_set(r, up, false, false);
     draw(r, &f, &prev, &cur);
     float *on = hdr(r);
     st.lspsm = false;
@@ -283,7 +283,7 @@ static void t_fighters_no_self_shadow_but_each_others(void)
     const float side[3] = {1, 0.12f, 0};
     st.lspsm = true;
     set_stage(r, &st);
-    r_fx_lspsm_test_set(r, side, false, false);
+    fx_lspsm_test_set(r, side, false, false);
     draw(r, &f, &prev, &cur);
     float *lit = hdr(r);
     double m_on[2], m_off[2];
@@ -322,16 +322,16 @@ static void t_parallel_and_antiparallel_light(void)
     /* exactly parallel (light behind the camera) and anti-parallel */
     for (int s = 0; s < 2; s++) {
         float L[3] = {s ? v.x : -v.x, s ? v.y : -v.y, s ? v.z : -v.z};
-        r_fx_lspsm_test_set(r, L, false, false);
+        fx_lspsm_test_set(r, L, false, false);
         draw(r, &f, &prev, &cur);
-        r_fx_lspsm_stats k;
-        T_ASSERT(r_fx_lspsm_stats_get(r, &k));
+        fx_lspsm_stats k;
+        T_ASSERT(fx_lspsm_stats_get(r, &k));
         float *px = hdr(r);
         int bad = 0;
         for (size_t i = 0; i < (size_t)W * H * 4; i++)
             bad += !isfinite(px[i]);
         float shadow[16];
-        T_ASSERT(r_fx_lspsm_read(r, "shadow", shadow));
+        T_ASSERT(fx_lspsm_read(r, "shadow", shadow));
         for (int i = 0; i < 16; i++)
             bad += !isfinite(shadow[i]);
         fprintf(stderr, "    %s: angle %.4f rad, warp %g\n", s ? "anti-parallel" : "parallel", k.gamma, k.warp);
@@ -351,10 +351,10 @@ static void t_parallel_and_antiparallel_light(void)
         double a = k * 0.5 * 3.14159265358979 / 180;
         float L[3] = {(float)(-v.x * cos(a) + side.x * sin(a)), (float)(-v.y * cos(a) + side.y * sin(a)),
                       (float)(-v.z * cos(a) + side.z * sin(a))};
-        r_fx_lspsm_test_set(r, L, false, false);
+        fx_lspsm_test_set(r, L, false, false);
         draw(r, &f, &prev, &cur);
-        r_fx_lspsm_stats st2;
-        T_ASSERT(r_fx_lspsm_stats_get(r, &st2));
+        fx_lspsm_stats st2;
+        T_ASSERT(fx_lspsm_stats_get(r, &st2));
         warp[k] = st2.warp;
         if (k % 10 == 0) {
             float *px = hdr(r);
@@ -380,7 +380,7 @@ static void t_parallel_and_antiparallel_light(void)
         T_ASSERTF(warp[k] == 0, "%.1f deg: warped inside the band's end", k * 0.5);
     T_ASSERTF(most > 0, "the warp never came in");
     T_ASSERTF(jump <= 0.1f * most, "a pop: the warp jumps by %.4f at %.1f deg (full strength %.4f)", jump, at * 0.5, most);
-    r_fx_lspsm_test_set(r, NULL, false, false);
+    fx_lspsm_test_set(r, NULL, false, false);
     r_game_destroy(r);
     t_fb_free(&f);
     plat_destroy(p);

@@ -36,8 +36,8 @@ static void t_height_textures(void)
     static float un[N * N], tr[N * N], again[N * N];
     const float halves[] = {4.0f, 4.5f, 3.5f};
     for (size_t k = 0; k < sizeof halves / sizeof halves[0]; k++) {
-        r_snow_untouched(un, N, halves[k]);
-        r_snow_trampled(tr, N, halves[k]);
+        fx_snow_tex_untouched(un, N, halves[k]);
+        fx_snow_tex_trampled(tr, N, halves[k]);
         float umin = 1, umax = 0, tmin = 1, tmax = 0, gap = 1;
         double sum = 0, sum2 = 0;
         for (int i = 0; i < N * N; i++) {
@@ -61,7 +61,7 @@ static void t_height_textures(void)
                 step = fmaxf(step, fabsf(un[j * N + i + 1] - un[j * N + i]));
         T_ASSERTF(step < 0.01f, "untouched jumps %g m between neighbours", step);
         /* deterministic */
-        r_snow_untouched(again, N, halves[k]);
+        fx_snow_tex_untouched(again, N, halves[k]);
         T_ASSERT(!memcmp(un, again, sizeof un));
     }
 }
@@ -70,8 +70,8 @@ static void t_color_textures(void)
 {
     enum { S = R_SNOW_TEX };
     static uint8_t c[S * S * 2], nm[S * S * 4];
-    r_snow_colors(c, S);
-    r_snow_detail_normals(nm, S);
+    fx_snow_tex_colors(c, S);
+    fx_snow_tex_detail_normals(nm, S);
     double fresh = 0, trampled = 0;
     int lo = 255, hi = 0;
     for (int i = 0; i < S * S; i++) {
@@ -108,9 +108,9 @@ typedef struct maps {
 
 static void read_maps(r_game *r, maps *m)
 {
-    T_ASSERT(r_fx_snow_read(r, "map", m->map));
-    T_ASSERT(r_fx_snow_read(r, "untouched", m->un));
-    T_ASSERT(r_fx_snow_read(r, "trampled", m->tr));
+    T_ASSERT(fx_snow_read(r, "map", m->map));
+    T_ASSERT(fx_snow_read(r, "untouched", m->un));
+    T_ASSERT(fx_snow_read(r, "trampled", m->tr));
     T_EQ(gl.GetError(), GL_NO_ERROR);
 }
 
@@ -182,7 +182,7 @@ static void t_contacts_lower_the_map(void)
     const float under[2] = {0.09f, 0.06f}, px[2] = {centre(64), centre(192)}, pz = centre(176);
     for (int k = 0; k < 2; k++) {
         r_fx_capsule b = bone_at(px[k], pz, under[k] + 0.05f, 0.05f);
-        r_fx_snow_stamp(r, &b, 1);
+        fx_snow_stamp(r, &b, 1);
     }
     read_maps(r, &m);
     for (int k = 0; k < 2; k++) {
@@ -194,7 +194,7 @@ static void t_contacts_lower_the_map(void)
     }
     /* a bone above the snow leaves no print */
     r_fx_capsule above = bone_at(0, -1.5f, R_SNOW_UNTOUCHED_HI + 0.06f, 0.05f);
-    r_fx_snow_stamp(r, &above, 1);
+    fx_snow_stamp(r, &above, 1);
     read_maps(r, &m);
     T_ASSERT(m.map[texel(0, -1.5f)] == m.un[texel(0, -1.5f)]);
     check_bounds(&m, "after the prints");
@@ -219,7 +219,7 @@ static void t_never_below_trampled_and_reset(void)
     for (int k = 0; k < 4; k++)
         deep[k] = bone_at(-2.5f + 0.01f * (float)k, 2.0f, 0.0f, 0.12f);
     for (int n = 0; n < 3000; n++)
-        r_fx_snow_stamp(r, deep, 4);
+        fx_snow_stamp(r, deep, 4);
     read_maps(r, &m);
     check_bounds(&m, "3000 stamps");
     int t = texel(-2.5f, 2.0f), lowered = 0, moved = 0;
@@ -393,7 +393,7 @@ static void t_fp16_extremes(void)
     g_init(&st, snowfield(), 1);
     const r_stage base = *r_game_stage(r);
     static float hdr[W * H * 4];
-    const int nl = r_fx_snow_light_size();
+    const int nl = fx_snow_light_size();
     float *light = malloc((size_t)nl * nl * 4 * sizeof *light);
     T_ASSERT(light);
     const struct {
@@ -427,7 +427,7 @@ static void t_fp16_extremes(void)
         read_hdr(r, hdr);
         for (int i = 0; i < W * H * 4; i++)
             T_ASSERTF(isfinite(hdr[i]) && fabsf(hdr[i]) <= R_HALF_MAX, "%s: hdr[%d] = %g", cases[k].what, i, hdr[i]);
-        T_ASSERT(r_fx_snow_read(r, "light", light));
+        T_ASSERT(fx_snow_read(r, "light", light));
         for (int i = 0; i < nl * nl * 4; i++)
             T_ASSERTF(isfinite(light[i]) && light[i] >= 0 && light[i] <= R_HALF_MAX, "%s: light[%d] = %g", cases[k].what, i,
                       light[i]);

@@ -33,13 +33,13 @@ enum { W = 320, H = 180, NN = R_WATER_N * R_WATER_N * 2 };
  * against the damping; over a million steps it must not grow past it. */
 static void t_cpu_bounded_for_a_million_steps(void)
 {
-    r_water_params p = {.size = 2.0f};
-    r_water_run run;
-    T_ASSERT(r_water_forced_run(&p, false, 64, 1000000, 1000, &run));
+    fx_water_sim_params p = {.size = 2.0f};
+    fx_water_sim_run run;
+    T_ASSERT(fx_water_sim_forced_run(&p, false, 64, 1000000, 1000, &run));
     double ratio = run.e_max / run.e_ref;
     fprintf(stderr, "    C %.3f damping %.3f: energy after 1000 steps %.4g, max over 1e6 steps %.4g (ratio %.3f), last %.4g, "
                     "max |h| %.4f m, %.2f us/step\n",
-            r_water_courant_clamp(0), 0.985, run.e_ref, run.e_max, ratio, run.e_last, run.h_absmax, run.ms * 1000 / run.steps);
+            fx_water_sim_courant_clamp(0), 0.985, run.e_ref, run.e_max, ratio, run.e_last, run.h_absmax, run.ms * 1000 / run.steps);
     T_ASSERT(run.finite);
     T_ASSERTF(run.e_ref > 1e-6, "the forcing made no waves (energy %g)", run.e_ref);
     T_ASSERTF(ratio < 2.0, "energy grew: max %g vs %g after 1000 steps", run.e_max, run.e_ref);
@@ -50,14 +50,14 @@ static void t_cpu_bounded_for_a_million_steps(void)
  * checkerboard mode grows every step until the height clamp holds it. */
 static void t_cpu_over_the_cap_blows_up(void)
 {
-    r_water_params p = {.size = 2.0f, .courant = 0.75f, .damping = 0.985f};
-    r_water_run capped, raw;
+    fx_water_sim_params p = {.size = 2.0f, .courant = 0.75f, .damping = 0.985f};
+    fx_water_sim_run capped, raw;
     /* through the checked path the request is capped, and stable */
-    T_ASSERT(r_water_forced_run(&p, false, 64, 20000, 1000, &capped));
+    T_ASSERT(fx_water_sim_forced_run(&p, false, 64, 20000, 1000, &capped));
     T_ASSERTF(capped.finite && capped.e_max / capped.e_ref < 2.0 && capped.h_absmax < 0.5f * 0.08f,
               "C = 0.75 through the cap is unstable: energy ratio %g, max |h| %g m", capped.e_max / capped.e_ref,
               capped.h_absmax);
-    T_ASSERT(r_water_forced_run(&p, true, 64, 20000, 1000, &raw));
+    T_ASSERT(fx_water_sim_forced_run(&p, true, 64, 20000, 1000, &raw));
     fprintf(stderr, "    C 0.75 capped to %.4f: max energy %.4g, max |h| %.4f m; uncapped: max energy %.4g (x%.3g), max |h| %.4f m\n",
             R_WATER_COURANT_MAX, capped.e_max, capped.h_absmax, raw.e_max, raw.e_max / capped.e_max, raw.h_absmax);
     /* the checkerboard mode grows until the height clamp stops it */
@@ -67,34 +67,34 @@ static void t_cpu_over_the_cap_blows_up(void)
     T_ASSERT(R_WATER_COURANT_MAX < R_WATER_CFL);
     const float asks[] = {0.75f, 1.0f, 1e30f, INFINITY};
     for (size_t k = 0; k < sizeof asks / sizeof asks[0]; k++)
-        T_ASSERTF(r_water_courant_clamp(asks[k]) == R_WATER_COURANT_MAX, "%g -> %g", asks[k], r_water_courant_clamp(asks[k]));
-    T_ASSERT(r_water_courant_clamp(NAN) == r_water_courant_clamp(0));
-    T_ASSERT(r_water_courant_clamp(-1) == r_water_courant_clamp(0));
-    T_ASSERT(r_water_courant_clamp(0.3f) == 0.3f);
-    r_water_params q = {.courant = 5, .damping = 7, .h_max = -1};
-    r_water_params_fix(&q);
+        T_ASSERTF(fx_water_sim_courant_clamp(asks[k]) == R_WATER_COURANT_MAX, "%g -> %g", asks[k], fx_water_sim_courant_clamp(asks[k]));
+    T_ASSERT(fx_water_sim_courant_clamp(NAN) == fx_water_sim_courant_clamp(0));
+    T_ASSERT(fx_water_sim_courant_clamp(-1) == fx_water_sim_courant_clamp(0));
+    T_ASSERT(fx_water_sim_courant_clamp(0.3f) == 0.3f);
+    fx_water_sim_params q = {.courant = 5, .damping = 7, .h_max = -1};
+    fx_water_sim_params_fix(&q);
     T_ASSERT(q.courant == R_WATER_COURANT_MAX && q.damping == 1.0f && q.h_max > 0);
 }
 
 /* Strength proportional to speed; no motion, no wave; nothing off the water. */
 static void t_splats_follow_speed(void)
 {
-    r_water_params p = {0};
-    r_water_params_fix(&p);
-    r_water_splat a, b;
-    T_ASSERT(r_water_splat_for(&p, R_WATER_N, 0.5f, -0.2f, 0.06f, 0.12f, 1.0f, &a));
-    T_ASSERT(r_water_splat_for(&p, R_WATER_N, 0.5f, -0.2f, 0.06f, 0.12f, 2.0f, &b));
+    fx_water_sim_params p = {0};
+    fx_water_sim_params_fix(&p);
+    fx_water_sim_splat a, b;
+    T_ASSERT(fx_water_sim_splat_for(&p, R_WATER_N, 0.5f, -0.2f, 0.06f, 0.12f, 1.0f, &a));
+    T_ASSERT(fx_water_sim_splat_for(&p, R_WATER_N, 0.5f, -0.2f, 0.06f, 0.12f, 2.0f, &b));
     T_ASSERT(a.amp < 0 && fabsf(b.amp - 2 * a.amp) < 1e-7f);
     T_ASSERT(fabsf(a.x - (0.5f + 4) * 32) < 1e-3f && fabsf(a.y - (-0.2f + 4) * 32) < 1e-3f);
-    T_ASSERT(!r_water_splat_for(&p, R_WATER_N, 0.5f, -0.2f, 0.06f, 0.12f, 0.0f, &a)); /* still */
-    T_ASSERT(!r_water_splat_for(&p, R_WATER_N, 4.5f, 0, 0.06f, 0.12f, 3.0f, &a));     /* off the ring */
-    T_ASSERT(!r_water_splat_for(&p, R_WATER_N, NAN, 0, 0.06f, 0.12f, 3.0f, &a));
-    T_ASSERT(!r_water_splat_for(&p, R_WATER_N, 0, 0, 0.06f, 0.12f, NAN, &a));
-    T_ASSERT(r_water_splat_for(&p, R_WATER_N, 0, 0, 0.06f, 0.12f, 1e9f, &a) && a.amp == -p.amp_max); /* capped */
+    T_ASSERT(!fx_water_sim_splat_for(&p, R_WATER_N, 0.5f, -0.2f, 0.06f, 0.12f, 0.0f, &a)); /* still */
+    T_ASSERT(!fx_water_sim_splat_for(&p, R_WATER_N, 4.5f, 0, 0.06f, 0.12f, 3.0f, &a));     /* off the ring */
+    T_ASSERT(!fx_water_sim_splat_for(&p, R_WATER_N, NAN, 0, 0.06f, 0.12f, 3.0f, &a));
+    T_ASSERT(!fx_water_sim_splat_for(&p, R_WATER_N, 0, 0, 0.06f, 0.12f, NAN, &a));
+    T_ASSERT(fx_water_sim_splat_for(&p, R_WATER_N, 0, 0, 0.06f, 0.12f, 1e9f, &a) && a.amp == -p.amp_max); /* capped */
     /* the bump on the grid: the centre cell gets almost amp, nothing outside the radius */
     static float g[NN];
-    r_water_splat s = {100.5f, 60.5f, 3.0f, -0.01f};
-    r_water_add_splat(R_WATER_N, g, &s);
+    fx_water_sim_splat s = {100.5f, 60.5f, 3.0f, -0.01f};
+    fx_water_sim_add_splat(R_WATER_N, g, &s);
     T_ASSERT(fabsf(g[(60 * R_WATER_N + 100) * 2] + 0.01f) < 1e-9f);
     T_ASSERT(g[(60 * R_WATER_N + 104) * 2] == 0 && g[(60 * R_WATER_N + 100) * 2 + 1] == 0);
     T_ASSERT(g[(61 * R_WATER_N + 101) * 2] < 0);
@@ -133,29 +133,29 @@ static void t_gpu_matches_cpu(void)
 {
     plat *p = t_context("egl");
     r_game *r = game_new();
-    const r_water_params *prm = r_fx_water_params(r);
+    const fx_water_sim_params *prm = fx_water_params(r);
     T_ASSERT(prm);
     static float cpu[NN], tmp[NN], gpu[NN];
     memset(cpu, 0, sizeof cpu);
-    T_ASSERT(r_fx_water_write(r, cpu));
+    T_ASSERT(fx_water_write(r, cpu));
     rgl_error_reset();
     double worst = 0, scale = 0;
     for (int t = 0; t < 200; t++) {
         /* three feet: one sweeping, one circling, one stamping now and then;
          * one splat crosses the grid's edge */
-        r_water_splat s[3];
+        fx_water_sim_splat s[3];
         int ns = 0;
-        s[ns++] = (r_water_splat){60.0f + 40.0f * sinf(t * 0.07f), 128.3f, 2.7f, -0.004f * (1.2f + cosf(t * 0.07f))};
-        s[ns++] = (r_water_splat){180.0f + 20.0f * cosf(t * 0.05f), 90.0f + 20.0f * sinf(t * 0.05f), 4.5f, -0.003f};
+        s[ns++] = (fx_water_sim_splat){60.0f + 40.0f * sinf(t * 0.07f), 128.3f, 2.7f, -0.004f * (1.2f + cosf(t * 0.07f))};
+        s[ns++] = (fx_water_sim_splat){180.0f + 20.0f * cosf(t * 0.05f), 90.0f + 20.0f * sinf(t * 0.05f), 4.5f, -0.003f};
         if (t % 40 < 3)
-            s[ns++] = (r_water_splat){1.2f, 200.7f, 3.0f, -0.008f};
-        T_ASSERT(r_fx_water_gpu_steps(r, s, ns, 1));
-        r_water_step(prm, R_WATER_N, cpu, tmp);
+            s[ns++] = (fx_water_sim_splat){1.2f, 200.7f, 3.0f, -0.008f};
+        T_ASSERT(fx_water_gpu_steps(r, s, ns, 1));
+        fx_water_sim_step(prm, R_WATER_N, cpu, tmp);
         for (int k = 0; k < ns; k++)
-            r_water_add_splat(R_WATER_N, tmp, &s[k]);
+            fx_water_sim_add_splat(R_WATER_N, tmp, &s[k]);
         memcpy(cpu, tmp, sizeof cpu);
     }
-    T_ASSERT(r_fx_water_read(r, gpu));
+    T_ASSERT(fx_water_read(r, gpu));
     T_EQ(rgl_error_count(), 0);
     for (size_t k = 0; k < NN; k++) {
         worst = fmax(worst, fabs((double)gpu[k] - cpu[k]));
@@ -214,7 +214,7 @@ static void t_shallows_waves_and_picture(void)
         t_draw_read(r, &f, &m.prev, &m.cur, W, H, NULL, false);
         T_ASSERT(t_pass_ran(r, "water_sim") && t_pass_ran(r, "water_reflect") && t_pass_ran(r, "water_under") && t_pass_ran(r, "water_surface"));
     }
-    T_ASSERT(r_fx_water_read(r, g));
+    T_ASSERT(fx_water_read(r, g));
     still = grid_absmax(g);
     /* the fight */
     int most_splats = 0;
@@ -223,11 +223,11 @@ static void t_shallows_waves_and_picture(void)
         if (m.cur.tick < 300)
             continue;
         t_draw_read(r, &f, &m.prev, &m.cur, W, H, NULL, false);
-        if (r_fx_water_last_splats(r) > most_splats)
-            most_splats = r_fx_water_last_splats(r);
+        if (fx_water_last_splats(r) > most_splats)
+            most_splats = fx_water_last_splats(r);
     }
     t_draw_read(r, &f, &m.prev, &m.cur, W, H, wet, false);
-    T_ASSERT(r_fx_water_read(r, g));
+    T_ASSERT(fx_water_read(r, g));
     float moving = grid_absmax(g);
     fprintf(stderr, "    max |h|: standing (40 ticks of intro) %.2g m, fighting (120 ticks) %.4f m, up to %d splats a tick\n",
             still, moving, most_splats);
@@ -267,7 +267,7 @@ static void check_finite(r_game *r, const char *what, bool stepped)
         T_ASSERTF(isfinite(buf[k]) && fabsf(buf[k]) <= R_HALF_MAX, "%s: hdr[%zu] = %g", what, k, buf[k]);
     if (!stepped)
         return;
-    T_ASSERT(r_fx_water_read(r, g)); /* a step made every cell finite again */
+    T_ASSERT(fx_water_read(r, g)); /* a step made every cell finite again */
     for (size_t k = 0; k < NN; k++)
         T_ASSERTF(isfinite(g[k]) && fabsf(g[k]) <= 1.0f, "%s: simulation[%zu] = %g", what, k, g[k]);
 }
@@ -321,7 +321,7 @@ static void t_no_nan_or_inf(void)
                     float v = cases[k].poison == 1 ? NAN : cases[k].poison == 2 ? INFINITY : 1e30f;
                     g[i] = (i / 2 + i / (2 * R_WATER_N)) & 1 ? v : -v; /* a checkerboard of both signs */
                 }
-                T_ASSERT(r_fx_water_write(r, g));
+                T_ASSERT(fx_water_write(r, g));
                 t_draw_read(r, &f, &m.cur, &m.cur, W, H, NULL, false); /* the same tick again: the surface reads the raw state */
                 check_finite(r, cases[k].what, false);
             }

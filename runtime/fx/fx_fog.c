@@ -52,7 +52,7 @@ static const fog_look default_look = {
 
 struct r_fx_fog {
     fog_look look;
-    r_fog_sim sim;
+    fx_fog_sim sim;
     GLuint prog;          /* fog_splat.vert/.frag */
     GLuint vao, vbo;
     float *inst;          /* x, z, weight per sprite, wrapped copies included */
@@ -98,12 +98,12 @@ static bool make_map(struct r_fx_fog *fg, int size, rs_err *err)
 /* Step 2: the particles as sprites into the map; returns the sprites drawn. */
 static int draw_map(r_game *r, struct r_fx_fog *fg)
 {
-    const r_fog_sim *s = &fg->sim;
+    const fx_fog_sim *s = &fg->sim;
     float h = s->d.half, R = fminf(fg->look.sprite_m, s->d.half / 2), sum = 0;
     int n = 0;
     for (int i = 0; i < s->n; i++) {
-        const r_fog_particle *p = &s->p[i];
-        float w = r_fog_sim_weight(s, p);
+        const fx_fog_particle *p = &s->p[i];
+        float w = fx_fog_sim_weight(s, p);
         if (!(w > 0 && w < 1e6f && fabsf(p->x) < 2 * h && fabsf(p->z) < 2 * h)) /* also NaN, Inf: never */
             continue;
         sum += w;
@@ -183,12 +183,12 @@ static void sim_follow(r_game *r)
     float cur[4 * G_BONES][3], prev[4 * G_BONES][3];
     int n = limb_points(f, cur, prev);
     if (f->reset) { /* a new sequence: the seeded mist, stirred by this tick's motion */
-        r_fog_sim_reset(&fg->sim, f->cur->tick);
-        r_fog_sim_stir(&fg->sim, cur, prev, n);
+        fx_fog_sim_reset(&fg->sim, f->cur->tick);
+        fx_fog_sim_stir(&fg->sim, cur, prev, n);
     } else
         for (int k = 0; k < f->steps; k++) { /* the last tick's motion stands for each tick missed */
-            r_fog_sim_stir(&fg->sim, cur, prev, n);
-            r_fog_sim_step(&fg->sim);
+            fx_fog_sim_stir(&fg->sim, cur, prev, n);
+            fx_fog_sim_step(&fg->sim);
         }
 }
 
@@ -274,7 +274,7 @@ static void fog_destroy(r_game *r)
         gl.DeleteBuffers(1, &fg->vbo);
     if (fg->prog)
         gl.DeleteProgram(fg->prog);
-    r_fog_sim_free(&fg->sim);
+    fx_fog_sim_free(&fg->sim);
     free(fg->inst);
     free(fg);
     r_fx_set_state(r, &fx_fog_module, NULL);
@@ -287,7 +287,7 @@ static bool fog_create(r_game *r, rs_err *err)
         return rs_fail(err, 1, "fog: out of memory");
     r_fx_set_state(r, &fx_fog_module, fg);
     fg->look = default_look;
-    if (!r_fog_sim_init(&fg->sim, NULL)) {
+    if (!fx_fog_sim_init(&fg->sim, NULL)) {
         fog_destroy(r);
         return rs_fail(err, 1, "fog: out of memory for the mist");
     }
@@ -331,12 +331,12 @@ const r_fx_module fx_fog_module = {
 
 /* ---- tests and bench accuracy ---- */
 
-r_fog_sim *r_fx_fog_sim(r_game *r)
+fx_fog_sim *fx_fog_get_sim(r_game *r)
 {
     return FOG(r) ? &FOG(r)->sim : NULL;
 }
 
-bool r_fx_fog_read_map(r_game *r, float *out, int *size, float *half)
+bool fx_fog_read_map(r_game *r, float *out, int *size, float *half)
 {
     struct r_fx_fog *fg = FOG(r);
     if (!fg || !fg->tex)
@@ -391,7 +391,7 @@ static void acc_row(r_game *r, struct r_fx_fog *fg, const float *ref, float *map
         ms[k] = (rs_now() - t0) * 1e3;
     }
     qsort(ms, ACC_RUNS, sizeof ms[0], by_value);
-    r_fx_fog_read_map(r, map, NULL, NULL);
+    fx_fog_read_map(r, map, NULL, NULL);
     for (int j = 0; j < ACC_GRID; j++)
         for (int i = 0; i < ACC_GRID; i++) {
             double x = -6.0 + 12.0 * i / (ACC_GRID - 1), z = -6.0 + 12.0 * j / (ACC_GRID - 1);
@@ -402,7 +402,7 @@ static void acc_row(r_game *r, struct r_fx_fog *fg, const float *ref, float *map
     out[0] = ms[ACC_RUNS / 2], out[1] = sqrt(se / (ACC_GRID * ACC_GRID)), out[2] = worst;
 }
 
-bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err)
+bool fx_fog_accuracy_rows(FILE *out, rs_err *err)
 {
     static const int sizes[] = {32, 64, 128, 256, 512};
     r_game *r = r_game_create(err);
@@ -417,12 +417,12 @@ bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err)
     struct r_fx_fog *fg = FOG(r);
     /* a mist that has drifted for 5 s, with a kick's worth of local wind:
      * a limb point sweeping through the middle at 6 m/s */
-    r_fog_sim_reset(&fg->sim, 0);
+    fx_fog_sim_reset(&fg->sim, 0);
     for (int t = 0; t < 300; t++) {
         float cur[1][3] = {{-3.0f + 0.1f * (float)(t % 60), 1.0f, 0}}, prev[1][3] = {{cur[0][0] - 0.1f, 1.0f, 0}};
         double t0 = rs_now();
-        r_fog_sim_stir(&fg->sim, cur, prev, 1);
-        r_fog_sim_step(&fg->sim);
+        fx_fog_sim_stir(&fg->sim, cur, prev, 1);
+        fx_fog_sim_step(&fg->sim);
         if (t >= 300 - ACC_RUNS)
             sim_ms[t - (300 - ACC_RUNS)] = (rs_now() - t0) * 1e3;
     }
@@ -432,7 +432,7 @@ bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err)
     if (!make_map(fg, ACC_REF, err))
         goto done;
     draw_map(r, fg);
-    r_fx_fog_read_map(r, ref, NULL, NULL);
+    fx_fog_read_map(r, ref, NULL, NULL);
     fprintf(out, "\nFog map (%d particles, sprite radius %.2f m, map over +-%.0f m): size vs a %dx%d map, density at\n"
                  "%dx%d points over the ring (|x|, |z| <= 6 m) in units of the mean density (1), without and with\n"
                  "the optional blur; ms per fog_map draw (sprites, and the blur), glFinish-timed, median of %d;\n"

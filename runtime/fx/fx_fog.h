@@ -9,15 +9,15 @@
 #include "../util/rs_err.h"
 
 struct r_game;
-struct r_fog_sim;
+struct fx_fog_sim;
 
 /* The mist simulation (NULL when the module was not created). */
-struct r_fog_sim *r_fx_fog_sim(struct r_game *r);
+struct fx_fog_sim *fx_fog_get_sim(struct r_game *r);
 /* The map of the frame drawn last: size x size floats, row = z, covering
  * x, z in +-half metres; out NULL asks the size only. */
-bool r_fx_fog_read_map(struct r_game *r, float *out, int *size, float *half);
+bool fx_fog_read_map(struct r_game *r, float *out, int *size, float *half);
 /* The "fog-map resolution vs time" table of bench accuracy (needs a
  * current GL context). */
-bool r_fx_fog_accuracy_rows(FILE *out, rs_err *err);
+bool fx_fog_accuracy_rows(FILE *out, rs_err *err);
 
 #endif

@@ -18,7 +18,7 @@ static float pick(float v, float def, float lo, float hi)
     return v < lo ? lo : v > hi ? hi : v;
 }
 
-void r_fog_sim_defaults(r_fog_sim_desc *d)
+void fx_fog_sim_defaults(fx_fog_sim_desc *d)
 {
     d->count = d->count > 0 ? (d->count > R_FOG_MAX_PARTICLES ? R_FOG_MAX_PARTICLES : d->count) : 3000;
     d->half = pick(d->half, 12.0f, 1.0f, 100.0f);
@@ -66,7 +66,7 @@ static float wrap(float v, float h)
     return v;
 }
 
-static void born(r_fog_sim *s, r_fog_particle *p)
+static void born(fx_fog_sim *s, fx_fog_particle *p)
 {
     float h = s->d.half;
     p->x = (rnd(&s->rng) * 2 - 1) * h;
@@ -76,11 +76,11 @@ static void born(r_fog_sim *s, r_fog_particle *p)
     p->age = 0;
 }
 
-bool r_fog_sim_init(r_fog_sim *s, const r_fog_sim_desc *d)
+bool fx_fog_sim_init(fx_fog_sim *s, const fx_fog_sim_desc *d)
 {
     memset(s, 0, sizeof *s);
-    s->d = d ? *d : (r_fog_sim_desc){0};
-    r_fog_sim_defaults(&s->d);
+    s->d = d ? *d : (fx_fog_sim_desc){0};
+    fx_fog_sim_defaults(&s->d);
     int nc = (int)ceilf(2 * s->d.half / s->d.cell);
     s->ncell = nc < 4 ? 4 : nc > R_FOG_MAX_CELLS ? R_FOG_MAX_CELLS : nc;
     s->cell = 2 * s->d.half / (float)s->ncell;
@@ -89,21 +89,21 @@ bool r_fog_sim_init(r_fog_sim *s, const r_fog_sim_desc *d)
     s->p = calloc((size_t)s->n, sizeof *s->p);
     s->wind = calloc((size_t)s->ncell * (size_t)s->ncell, sizeof *s->wind);
     if (!s->p || !s->wind) {
-        r_fog_sim_free(s);
+        fx_fog_sim_free(s);
         return false;
     }
-    r_fog_sim_reset(s, 0);
+    fx_fog_sim_reset(s, 0);
     return true;
 }
 
-void r_fog_sim_free(r_fog_sim *s)
+void fx_fog_sim_free(fx_fog_sim *s)
 {
     free(s->p);
     free(s->wind);
     s->p = NULL, s->wind = NULL, s->n = 0;
 }
 
-void r_fog_sim_reset(r_fog_sim *s, uint64_t tick)
+void fx_fog_sim_reset(fx_fog_sim *s, uint64_t tick)
 {
     s->rng = s->d.seed;
     s->tick = tick;
@@ -117,7 +117,7 @@ void r_fog_sim_reset(r_fog_sim *s, uint64_t tick)
     for (int k = 0; k < 2; k++)
         shift[k] = (float)fmod(s->d.wind[k] * secs, span);
     for (int i = 0; i < s->n; i++) {
-        r_fog_particle *p = &s->p[i];
+        fx_fog_particle *p = &s->p[i];
         born(s, p);
         p->age = rnd(&s->rng) * p->life; /* staggered: the steady state, not a wave of births */
         p->x = wrap(p->x + shift[0], s->d.half);
@@ -126,15 +126,15 @@ void r_fog_sim_reset(r_fog_sim *s, uint64_t tick)
 }
 
 /* The grid cell of index i (any integer) on the torus. */
-static int cell_index(const r_fog_sim *s, int i)
+static int cell_index(const fx_fog_sim *s, int i)
 {
     i %= s->ncell;
     return i < 0 ? i + s->ncell : i;
 }
 
-int r_fog_sim_stir(r_fog_sim *s, const float (*cur)[3], const float (*prev)[3], int n)
+int fx_fog_sim_stir(fx_fog_sim *s, const float (*cur)[3], const float (*prev)[3], int n)
 {
-    const r_fog_sim_desc *d = &s->d;
+    const fx_fog_sim_desc *d = &s->d;
     float R = d->radius, h = d->half;
     int reach = (int)ceilf(R / s->cell) + 1;
     if (reach > s->ncell / 2) /* never visit a cell twice round the torus */
@@ -179,7 +179,7 @@ int r_fog_sim_stir(r_fog_sim *s, const float (*cur)[3], const float (*prev)[3], 
     return s->stirred;
 }
 
-void r_fog_sim_wind_at(const r_fog_sim *s, float x, float z, float out[2])
+void fx_fog_sim_wind_at(const fx_fog_sim *s, float x, float z, float out[2])
 {
     out[0] = out[1] = 0;
     if (!s->active || !isfinite(x) || !isfinite(z))
@@ -197,9 +197,9 @@ void r_fog_sim_wind_at(const r_fog_sim *s, float x, float z, float out[2])
     }
 }
 
-void r_fog_sim_step(r_fog_sim *s)
+void fx_fog_sim_step(fx_fog_sim *s)
 {
-    const r_fog_sim_desc *d = &s->d;
+    const fx_fog_sim_desc *d = &s->d;
     /* the local wind dies down; once it is all but gone, the grid is
      * cleared and particles skip it until a limb stirs again */
     if (s->active) {
@@ -216,9 +216,9 @@ void r_fog_sim_step(r_fog_sim *s)
     }
     float vmax = d->max_speed;
     for (int i = 0; i < s->n; i++) {
-        r_fog_particle *p = &s->p[i];
+        fx_fog_particle *p = &s->p[i];
         float w[2];
-        r_fog_sim_wind_at(s, p->x, p->z, w);
+        fx_fog_sim_wind_at(s, p->x, p->z, w);
         float vx = d->wind[0] + d->gain * w[0], vz = d->wind[1] + d->gain * w[1];
         float sp = sqrtf(vx * vx + vz * vz);
         if (sp > vmax)
@@ -239,7 +239,7 @@ static float smooth01(float t)
     return t * t * (3 - 2 * t);
 }
 
-float r_fog_sim_weight(const r_fog_sim *s, const r_fog_particle *p)
+float fx_fog_sim_weight(const fx_fog_sim *s, const fx_fog_particle *p)
 {
     if (s->d.immortal || !(s->d.fade_s > 0))
         return p->weight;

@@ -37,7 +37,7 @@
 #define R_FOG_MAX_CELLS 256 /* per edge of the local wind grid */
 
 /* Zero (or out of range) means the default, given after each field. */
-typedef struct r_fog_sim_desc {
+typedef struct fx_fog_sim_desc {
     int count;             /* particles: 3000 */
     float half;            /* the square's half edge, m: 12 */
     uint32_t seed;         /* 0x6d697374 ("mist") */
@@ -53,17 +53,17 @@ typedef struct r_fog_sim_desc {
     float life_s;          /* mean particle life, s: 12 (each +-1/3 at random) */
     float fade_s;          /* fade in and out at birth and death, s: 1 */
     bool immortal;         /* never reborn (tests: pure wrap-around) */
-} r_fog_sim_desc;
+} fx_fog_sim_desc;
 
-typedef struct r_fog_particle {
+typedef struct fx_fog_particle {
     float x, z;
     float weight;   /* 0.5..1.5, picked at birth */
     float age, life; /* seconds */
-} r_fog_particle;
+} fx_fog_particle;
 
-typedef struct r_fog_sim {
-    r_fog_sim_desc d;      /* with the defaults applied */
-    r_fog_particle *p;
+typedef struct fx_fog_sim {
+    fx_fog_sim_desc d;      /* with the defaults applied */
+    fx_fog_particle *p;
     int n;
     float (*wind)[2];      /* local wind grid, ncell x ncell, row = z */
     int ncell;
@@ -71,35 +71,35 @@ typedef struct r_fog_sim {
     float decay;           /* per tick factor, exp(-dt / decay_s) */
     uint32_t rng;
     uint64_t tick;         /* ticks simulated since the reset, plus the reset tick */
-    int stirred;           /* limb points that stirred in the last r_fog_sim_stir */
+    int stirred;           /* limb points that stirred in the last fx_fog_sim_stir */
     bool active;           /* some local wind is blowing (else the grid is all zero) */
-} r_fog_sim;
+} fx_fog_sim;
 
 /* Fills in the defaults and clamps every field into its range. */
-void r_fog_sim_defaults(r_fog_sim_desc *d);
+void fx_fog_sim_defaults(fx_fog_sim_desc *d);
 
 /* Allocates and resets (tick 0).  false when out of memory. */
-bool r_fog_sim_init(r_fog_sim *s, const r_fog_sim_desc *d);
-void r_fog_sim_free(r_fog_sim *s);
+bool fx_fog_sim_init(fx_fog_sim *s, const fx_fog_sim_desc *d);
+void fx_fog_sim_free(fx_fog_sim *s);
 
 /* Back to the seeded layout, calm local wind.  The layout is shifted by
  * the global wind over `tick` ticks, so a replay seeked to a tick finds
  * the mist drifted about as far as it would have drifted since tick 0. */
-void r_fog_sim_reset(r_fog_sim *s, uint64_t tick);
+void fx_fog_sim_reset(fx_fog_sim *s, uint64_t tick);
 
 /* Local wind from limb points: cur[i] is a point of a bone now, prev[i]
  * the same point one tick earlier (x, y, z metres; speed = distance x
  * G_HZ).  Returns how many stirred. */
-int r_fog_sim_stir(r_fog_sim *s, const float (*cur)[3], const float (*prev)[3], int n);
+int fx_fog_sim_stir(fx_fog_sim *s, const float (*cur)[3], const float (*prev)[3], int n);
 
 /* One game tick (1 / G_HZ s): local wind decays, particles move, age,
  * wrap round the square and are born again when their life ends. */
-void r_fog_sim_step(r_fog_sim *s);
+void fx_fog_sim_step(fx_fog_sim *s);
 
 /* A particle's weight now: its birth weight times the fade envelope. */
-float r_fog_sim_weight(const r_fog_sim *s, const r_fog_particle *p);
+float fx_fog_sim_weight(const fx_fog_sim *s, const fx_fog_particle *p);
 
 /* The local wind (m/s) at (x, z), bilinear and wrapping like the mist. */
-void r_fog_sim_wind_at(const r_fog_sim *s, float x, float z, float out[2]);
+void fx_fog_sim_wind_at(const fx_fog_sim *s, float x, float z, float out[2]);
 
 #endif

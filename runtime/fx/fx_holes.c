@@ -33,14 +33,14 @@
 #include "fx_holes.h"
 
 extern const r_fx_module fx_holes_module;
-#define HOLES(r) ((struct r_fx_holes *)r_fx_state((r), &fx_holes_module))
+#define HOLES(r) ((struct fx_holes *)r_fx_state((r), &fx_holes_module))
 
 #define SPHERE_SEG 32
 #define SPHERE_RINGS 8
 #define LIFT 0.4f /* the sphere's centre stands 0.4 r above the floor */
 #define STENCIL_HOLES 0x7F
 
-struct r_fx_holes {
+struct fx_holes {
     GLuint vao, vbo, ibo;
     GLsizei count;
     int drawn; /* holes drawn in the frame drawn last */
@@ -77,7 +77,7 @@ static int nearer_first(const void *a, const void *b)
 static void run_holes(void *u)
 {
     r_game *r = u;
-    struct r_fx_holes *hs = HOLES(r);
+    struct fx_holes *hs = HOLES(r);
     frame *f = &r->f;
     const g_state *st = f->cur;
     bool prepass = r_ran(f, r, "z_prepass");
@@ -157,7 +157,7 @@ static const r_pass holes_passes[] = {
 
 static void holes_destroy(r_game *r)
 {
-    struct r_fx_holes *hs = HOLES(r);
+    struct fx_holes *hs = HOLES(r);
     if (!hs)
         return;
     r_free_mesh(&hs->vao, &hs->vbo, &hs->ibo);
@@ -167,7 +167,7 @@ static void holes_destroy(r_game *r)
 
 static bool holes_create(r_game *r, rs_err *err)
 {
-    struct r_fx_holes *hs = calloc(1, sizeof *hs);
+    struct fx_holes *hs = calloc(1, sizeof *hs);
     if (!hs)
         return rs_fail(err, 1, "holes: out of memory");
     r_fx_set_state(r, &fx_holes_module, hs);
@@ -216,7 +216,7 @@ const r_fx_module fx_holes_module = {
     .warmup = R_FX_STATELESS,
 };
 
-int r_fx_holes_drawn(r_game *r)
+int fx_holes_drawn(r_game *r)
 {
     return HOLES(r) ? HOLES(r)->drawn : 0;
 }

@@ -5,6 +5,6 @@
 struct r_game;
 
 /* How many holes the frame drawn last cut into the ring. */
-int r_fx_holes_drawn(struct r_game *r);
+int fx_holes_drawn(struct r_game *r);
 
 #endif

@@ -21,7 +21,7 @@
  *                on the GPU and read into a pixel-pack buffer; the next
  *                frame maps it.
  *
- * The receivers (shaders/lspsm_common.glsl, r_fx_lspsm_bind): the ring,
+ * The receivers (shaders/lspsm_common.glsl, lspsm_bind): the ring,
  * the ground and the buildings look the map up at their own position
  * (pushed along the normal); the fighters look it up where the ray towards
  * the light leaves their own box (no self-shadow, others' shadows received)
@@ -75,7 +75,7 @@ struct r_fx_lspsm {
     bool no_cull, uniform;
     bool light_override;
     r_vec3 light;
-    r_fx_lspsm_stats stats;
+    fx_lspsm_stats stats;
 };
 
 static bool need_map(void *u)
@@ -398,7 +398,7 @@ const r_fx_module fx_lspsm_module = {
 
 /* ---- tests, bench and --passes ---- */
 
-bool r_fx_lspsm_stats_get(r_game *r, r_fx_lspsm_stats *out)
+bool fx_lspsm_stats_get(r_game *r, fx_lspsm_stats *out)
 {
     if (!LSPSM(r))
         return false;
@@ -408,7 +408,7 @@ bool r_fx_lspsm_stats_get(r_game *r, r_fx_lspsm_stats *out)
     return true;
 }
 
-void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform)
+void fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform)
 {
     if (!LSPSM(r))
         return;
@@ -419,7 +419,7 @@ void r_fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool unifo
     LSPSM(r)->uniform = uniform;
 }
 
-bool r_fx_lspsm_read(r_game *r, const char *what, float *out)
+bool fx_lspsm_read(r_game *r, const char *what, float *out)
 {
     struct r_fx_lspsm *ls = LSPSM(r);
     if (!ls)

@@ -8,20 +8,20 @@
 struct r_game;
 
 /* What the last frame's lspsm_map did. */
-typedef struct r_fx_lspsm_stats {
+typedef struct fx_lspsm_stats {
     int casters, casters_drawn;   /* buildings, and those that passed culling */
     int city_triangles, proxy_triangles;
     float range;                  /* the shadow range used (the focus), m */
     float warp, gamma;            /* r_lspsm's warp strength and view-light angle */
     float focus_farthest;         /* the farthest sample the focus found, m */
     int focus_used;               /* samples that counted */
-} r_fx_lspsm_stats;
-bool r_fx_lspsm_stats_get(struct r_game *r, r_fx_lspsm_stats *out);
+} fx_lspsm_stats;
+bool fx_lspsm_stats_get(struct r_game *r, fx_lspsm_stats *out);
 /* Tests and bench: force the light direction (NULL: the stage's key),
  * switch caster culling off, or the warp (plain uniform shadow mapping). */
-void r_fx_lspsm_test_set(struct r_game *r, const float *light, bool no_cull, bool uniform);
+void fx_lspsm_test_set(struct r_game *r, const float *light, bool no_cull, bool uniform);
 /* Tests: "map" (1024x1024 depth floats), "flag" (1024x1024), "focus"
  * (20x16 depth samples of the frame drawn last), "shadow" (16 floats). */
-bool r_fx_lspsm_read(struct r_game *r, const char *what, float *out);
+bool fx_lspsm_read(struct r_game *r, const char *what, float *out);
 
 #endif

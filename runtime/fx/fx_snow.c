@@ -213,8 +213,8 @@ static bool snow_create(r_game *r, rs_err *err)
         free(px);
         return rs_fail(err, 1, "out of memory for the snow");
     }
-    s->color_tex = color_tex(r_snow_colors, px, GL_RG8, GL_RG);
-    s->detail_tex = color_tex(r_snow_detail_normals, px, GL_RGBA8, GL_RGBA);
+    s->color_tex = color_tex(fx_snow_tex_colors, px, GL_RG8, GL_RG);
+    s->detail_tex = color_tex(fx_snow_tex_detail_normals, px, GL_RGBA8, GL_RGBA);
     free(px);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st_map != GL_FRAMEBUFFER_COMPLETE || st_light != GL_FRAMEBUFFER_COMPLETE)
@@ -231,10 +231,10 @@ static bool make_heights(struct r_fx_snow *s, float half, rs_err *err)
     float *h = malloc((size_t)n * n * sizeof *h);
     if (!h)
         return rs_fail(err, 1, "out of memory for the snow");
-    r_snow_untouched(h, n, half);
+    fx_snow_tex_untouched(h, n, half);
     gl.BindTexture(GL_TEXTURE_2D, s->untouched_tex);
     gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, n, n, GL_RED, GL_FLOAT, h);
-    r_snow_trampled(h, n, half);
+    fx_snow_tex_trampled(h, n, half);
     gl.BindTexture(GL_TEXTURE_2D, s->trampled_tex);
     gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, n, n, GL_RED, GL_FLOAT, h);
     gl.BindTexture(GL_TEXTURE_2D, 0);
@@ -426,12 +426,12 @@ static void run_surface(void *u)
 
 /* ---- test hooks (fx_snow_tex.h) ---- */
 
-int r_fx_snow_light_size(void)
+int fx_snow_light_size(void)
 {
     return SNOW_LIGHT;
 }
 
-bool r_fx_snow_read(r_game *r, const char *which, float *out)
+bool fx_snow_read(r_game *r, const char *which, float *out)
 {
     struct r_fx_snow *s = SNOW(r);
     if (!s)
@@ -450,7 +450,7 @@ bool r_fx_snow_read(r_game *r, const char *which, float *out)
     return true;
 }
 
-void r_fx_snow_stamp(r_game *r, const r_fx_capsule *caps, int n)
+void fx_snow_stamp(r_game *r, const r_fx_capsule *caps, int n)
 {
     struct r_fx_snow *s = SNOW(r);
     if (!s || !s->half || n <= 0)

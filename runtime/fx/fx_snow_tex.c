@@ -45,7 +45,7 @@ static void fit(float *h, size_t count, float lo, float hi)
         h[i] = fminf(fmaxf(lo + (h[i] - mn) * k, lo), hi);
 }
 
-void r_snow_untouched(float *h, int n, float half)
+void fx_snow_tex_untouched(float *h, int n, float half)
 {
     const float pi = 3.14159265f;
     for (int j = 0; j < n; j++)
@@ -62,7 +62,7 @@ void r_snow_untouched(float *h, int n, float half)
     fit(h, (size_t)n * n, R_SNOW_UNTOUCHED_LO, R_SNOW_UNTOUCHED_HI);
 }
 
-void r_snow_trampled(float *h, int n, float half)
+void fx_snow_tex_trampled(float *h, int n, float half)
 {
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++) {
@@ -79,7 +79,7 @@ static uint8_t u8(float v)
     return (uint8_t)lrintf(fminf(fmaxf(v, 0), 1) * 255);
 }
 
-void r_snow_colors(uint8_t *rg, int n)
+void fx_snow_tex_colors(uint8_t *rg, int n)
 {
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++) {
@@ -101,7 +101,7 @@ static float crust(int x, int y, int n)
     return vnoise(u, v, 24, 51) * 0.7f + vnoise(u * 3, v * 3, 72, 52) * 0.3f;
 }
 
-void r_snow_detail_normals(uint8_t *rgba, int n)
+void fx_snow_tex_detail_normals(uint8_t *rgba, int n)
 {
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++) {

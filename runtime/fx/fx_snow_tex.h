@@ -20,30 +20,30 @@
 
 /* n x n heights of the untouched snow over a ring of half-size `half`:
  * broad drifts with wind ripples, exactly spanning UNTOUCHED_LO..HI. */
-void r_snow_untouched(float *h, int n, float half);
+void fx_snow_tex_untouched(float *h, int n, float half);
 /* The fully trampled minimum: compacted, lumpy, TRAMPLED_LO..HI.  Below
  * the untouched heights everywhere (the ranges do not overlap). */
-void r_snow_trampled(float *h, int n, float half);
+void fx_snow_tex_trampled(float *h, int n, float half);
 /* The two colour textures, fresh and trampled snow, packed into one
  * tiling RG8 texture so a pixel takes one fetch: snow has no hue of its
  * own, so each is a brightness times a tint (SNOW_FRESH, SNOW_TRAMPLED in
  * shaders/snow_common.glsl).  r: fresh (faint drifts), g: trampled
  * (blotchy, with grit).  n x n x 2 bytes. */
-void r_snow_colors(uint8_t *rg, int n);
+void fx_snow_tex_colors(uint8_t *rg, int n);
 /* Tiling RGBA8 tangent-space normal map of the snow's crust (xyz * 0.5 +
  * 0.5, a = 255). */
-void r_snow_detail_normals(uint8_t *rgba, int n);
+void fx_snow_tex_detail_normals(uint8_t *rgba, int n);
 
 /* Test hooks (fx_snow.c).  which: "map" (the displacement map),
  * "untouched", "trampled" (R_SNOW_MAP^2 floats) or "light" (the blurred
- * texture-space lighting, RGBA: r_fx_snow_light_size()^2 * 4).
+ * texture-space lighting, RGBA: fx_snow_light_size()^2 * 4).
  * False when the snow module has no such texture. */
 typedef struct r_game r_game;
-bool r_fx_snow_read(r_game *r, const char *which, float *out);
-int r_fx_snow_light_size(void);
+bool fx_snow_read(r_game *r, const char *which, float *out);
+int fx_snow_light_size(void);
 /* Stamps n capsules into the map the way a tick's contacts are stamped
  * (the next frame's reset restarts it). */
 typedef struct r_fx_capsule r_fx_capsule;
-void r_fx_snow_stamp(r_game *r, const r_fx_capsule *caps, int n);
+void fx_snow_stamp(r_game *r, const r_fx_capsule *caps, int n);
 
 #endif

@@ -36,7 +36,7 @@ enum { W_SIM, W_SPLAT, W_NORMAL, W_MIRROR, W_UNDER, W_SURFACE, W_PROGS };
 #define MESH_N 64        /* surface quads per side: 12.5 cm; the normal map carries the finer detail */
 #define COLOR_SIZE 128   /* the turbidity textures */
 #define MAX_SPLATS (2 * G_BONES)
-/* the look (not the automaton: r_water_params) */
+/* the look (not the automaton: fx_water_sim_params) */
 #define REFRACT 0.025f      /* screen uv offset per unit of normal tilt */
 #define DISTORT 0.04f       /* the same for the reflection map */
 #define TURB_BASE 0.15f     /* deep-colour share of flat water */
@@ -48,13 +48,13 @@ static const float fog_color[3] = {0.10f, 0.26f, 0.27f};
 
 typedef struct r_fx_water {
     bool built;
-    r_water_params prm;
+    fx_water_sim_params prm;
     GLuint prog[W_PROGS];
     GLuint sim_tex[2], sim_fbo[2];
     int cur; /* the sim texture holding the latest state */
     GLuint normal_tex, normal_fbo;
     GLuint splat_vao, splat_vbo;
-    r_water_splat splat[MAX_SPLATS];
+    fx_water_sim_splat splat[MAX_SPLATS];
     int nsplat;
     GLuint mesh_vao, mesh_vbo, mesh_ibo;
     GLsizei mesh_count;
@@ -200,7 +200,7 @@ static void free_gl(r_fx_water *w)
     if (w->splat_vbo)
         gl.DeleteBuffers(1, &w->splat_vbo);
     free_targets(w);
-    r_water_params prm = w->prm;
+    fx_water_sim_params prm = w->prm;
     memset(w, 0, sizeof *w);
     w->prm = prm;
 }
@@ -239,7 +239,7 @@ static bool build(r_fx_water *w, rs_err *err)
     gl.BindBuffer(GL_ARRAY_BUFFER, w->splat_vbo);
     gl.BufferData(GL_ARRAY_BUFFER, sizeof w->splat, NULL, GL_STREAM_DRAW);
     gl.EnableVertexAttribArray(0);
-    gl.VertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(r_water_splat), (void *)0);
+    gl.VertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(fx_water_sim_splat), (void *)0);
     gl.BindVertexArray(0);
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
     uint8_t *px = malloc((size_t)COLOR_SIZE * COLOR_SIZE * 4);
@@ -268,7 +268,7 @@ static bool create(r_game *r, rs_err *err)
     if (!w)
         return rs_fail(err, 1, "out of memory");
     r_fx_set_state(r, &fx_water_module, w);
-    r_water_params_fix(&w->prm);
+    fx_water_sim_params_fix(&w->prm);
     return true;
 }
 
@@ -317,7 +317,7 @@ static void clear_state(r_fx_water *w)
 
 /* steps automaton steps, each followed by the splats (additive points into
  * the red channel: an impulse of vertical velocity, h_prev untouched) */
-static void gpu_steps(r_game *r, r_fx_water *w, const r_water_splat *s, int ns, int steps)
+static void gpu_steps(r_game *r, r_fx_water *w, const fx_water_sim_splat *s, int ns, int steps)
 {
     if (steps <= 0)
         return;
@@ -331,7 +331,7 @@ static void gpu_steps(r_game *r, r_fx_water *w, const r_water_splat *s, int ns, 
         gl.BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)((size_t)ns * sizeof *s), s);
         gl.BindBuffer(GL_ARRAY_BUFFER, 0);
     }
-    const r_water_params *p = &w->prm;
+    const fx_water_sim_params *p = &w->prm;
     for (int k = 0; k < steps; k++) {
         int dst = 1 - w->cur;
         gl.BindFramebuffer(GL_FRAMEBUFFER, w->sim_fbo[dst]);
@@ -379,7 +379,7 @@ static void run_sim(void *u)
     int nc = r_fx_contacts(f->caps, f->caps_prev, R_WATER_LEVEL, c, MAX_SPLATS);
     w->nsplat = 0;
     for (int k = 0; k < nc; k++)
-        if (r_water_splat_for(&w->prm, R_WATER_N, c[k].x, c[k].z, c[k].radius, c[k].depth, c[k].speed,
+        if (fx_water_sim_splat_for(&w->prm, R_WATER_N, c[k].x, c[k].z, c[k].radius, c[k].depth, c[k].speed,
                               &w->splat[w->nsplat]))
             w->nsplat++;
     /* one step per game tick; a frame that skipped ticks replays this
@@ -568,12 +568,12 @@ static void run_surface(void *u)
 
 /* ---- for tests (fx_water_sim.h) ---- */
 
-const r_water_params *r_fx_water_params(r_game *r)
+const fx_water_sim_params *fx_water_params(r_game *r)
 {
     return WATER(r) && WATER(r)->built ? &WATER(r)->prm : NULL;
 }
 
-bool r_fx_water_gpu_steps(r_game *r, const r_water_splat *s, int ns, int steps)
+bool fx_water_gpu_steps(r_game *r, const fx_water_sim_splat *s, int ns, int steps)
 {
     r_fx_water *w = WATER(r);
     if (!w || !w->built || ns < 0 || ns > MAX_SPLATS)
@@ -584,7 +584,7 @@ bool r_fx_water_gpu_steps(r_game *r, const r_water_splat *s, int ns, int steps)
     return true;
 }
 
-bool r_fx_water_read(r_game *r, float *grid)
+bool fx_water_read(r_game *r, float *grid)
 {
     r_fx_water *w = WATER(r);
     float *px = w && w->built ? malloc((size_t)R_WATER_N * R_WATER_N * 4 * sizeof *px) : NULL;
@@ -600,7 +600,7 @@ bool r_fx_water_read(r_game *r, float *grid)
     return true;
 }
 
-bool r_fx_water_write(r_game *r, const float *grid)
+bool fx_water_write(r_game *r, const float *grid)
 {
     r_fx_water *w = WATER(r);
     float *px = w && w->built ? calloc((size_t)R_WATER_N * R_WATER_N * 4, sizeof *px) : NULL;
@@ -615,7 +615,7 @@ bool r_fx_water_write(r_game *r, const float *grid)
     return true;
 }
 
-int r_fx_water_last_splats(r_game *r)
+int fx_water_last_splats(r_game *r)
 {
     return WATER(r) ? WATER(r)->nsplat : 0;
 }

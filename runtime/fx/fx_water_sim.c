@@ -18,15 +18,15 @@ static float pick(float v, float def, float lo, float hi)
     return v < lo ? lo : v > hi ? hi : v;
 }
 
-float r_water_courant_clamp(float c)
+float fx_water_sim_courant_clamp(float c)
 {
     /* above the cap the checkerboard mode grows every step: refuse it */
     return !(c > 0) ? 0.58f : c > R_WATER_COURANT_MAX ? R_WATER_COURANT_MAX : c < 0.01f ? 0.01f : c;
 }
 
-void r_water_params_fix(r_water_params *p)
+void fx_water_sim_params_fix(fx_water_sim_params *p)
 {
-    p->courant = r_water_courant_clamp(p->courant);
+    p->courant = fx_water_sim_courant_clamp(p->courant);
     p->damping = pick(p->damping, 0.985f, 0.5f, 1.0f);
     p->h_max = pick(p->h_max, 0.08f, 0.001f, 1.0f);
     p->gain = pick(p->gain, 0.0015f, 0.0f, 0.1f);
@@ -51,7 +51,7 @@ static inline float cell(float c2, float damping, float h_max, float h, float hp
     return safe(damping * ((2.0f * h - hp) + c2 * lap), h_max);
 }
 
-void r_water_step_raw(float courant, float damping, float h_max, int n, const float *restrict src, float *restrict dst)
+void fx_water_sim_step_raw(float courant, float damping, float h_max, int n, const float *restrict src, float *restrict dst)
 {
     const float c2 = courant * courant;
     for (int j = 0; j < n; j++) {
@@ -74,25 +74,25 @@ void r_water_step_raw(float courant, float damping, float h_max, int n, const fl
     }
 }
 
-void r_water_step(const r_water_params *p, int n, const float *src, float *dst)
+void fx_water_sim_step(const fx_water_sim_params *p, int n, const float *src, float *dst)
 {
-    r_water_params q = *p;
-    r_water_params_fix(&q);
-    r_water_step_raw(q.courant, q.damping, q.h_max, n, src, dst);
+    fx_water_sim_params q = *p;
+    fx_water_sim_params_fix(&q);
+    fx_water_sim_step_raw(q.courant, q.damping, q.h_max, n, src, dst);
 }
 
 /* ---- splats ---- */
 
-float r_water_splat_weight(float d, float radius)
+float fx_water_sim_splat_weight(float d, float radius)
 {
     return d < radius ? 0.5f + 0.5f * cosf(PI_F * d / radius) : 0.0f;
 }
 
-bool r_water_splat_for(const r_water_params *p, int n, float wx, float wz, float cap_radius, float depth, float speed,
-                       r_water_splat *out)
+bool fx_water_sim_splat_for(const fx_water_sim_params *p, int n, float wx, float wz, float cap_radius, float depth, float speed,
+                       fx_water_sim_splat *out)
 {
-    r_water_params q = *p;
-    r_water_params_fix(&q);
+    fx_water_sim_params q = *p;
+    fx_water_sim_params_fix(&q);
     float cells = (float)n / q.size; /* grid units per metre */
     float x = (wx + q.size * 0.5f) * cells, y = (wz + q.size * 0.5f) * cells;
     if (!(x >= 0 && x < (float)n && y >= 0 && y < (float)n)) /* off the water (or NaN) */
@@ -107,11 +107,11 @@ bool r_water_splat_for(const r_water_params *p, int n, float wx, float wz, float
     amp = amp > q.amp_max ? q.amp_max : amp;
     float radius = q.splash * cap_radius * cells;
     radius = !(radius >= 1.0f) ? 1.0f : radius > 16.0f ? 16.0f : radius;
-    *out = (r_water_splat){x, y, radius, -amp}; /* a dent: the part pushes the water away */
+    *out = (fx_water_sim_splat){x, y, radius, -amp}; /* a dent: the part pushes the water away */
     return true;
 }
 
-void r_water_add_splat(int n, float *grid, const r_water_splat *s)
+void fx_water_sim_add_splat(int n, float *grid, const fx_water_sim_splat *s)
 {
     /* the cells the shader's point sprite covers that lie within the radius */
     int i0 = (int)floorf(s->x - s->radius), i1 = (int)ceilf(s->x + s->radius);
@@ -123,13 +123,13 @@ void r_water_add_splat(int n, float *grid, const r_water_splat *s)
             float dx = ((float)i + 0.5f) - s->x, dy = ((float)j + 0.5f) - s->y;
             float d = sqrtf(dx * dx + dy * dy);
             if (d < s->radius)
-                grid[((size_t)j * n + i) * 2] += s->amp * r_water_splat_weight(d, s->radius);
+                grid[((size_t)j * n + i) * 2] += s->amp * fx_water_sim_splat_weight(d, s->radius);
         }
 }
 
 /* ---- energy and long runs ---- */
 
-double r_water_energy(float courant, int n, const float *g)
+double fx_water_sim_energy(float courant, int n, const float *g)
 {
     double kin = 0, pot = 0;
     for (int j = 0; j < n; j++) {
@@ -180,15 +180,15 @@ static int forcing(float size, long t, float pos[3][2], float speed[3])
     return m;
 }
 
-bool r_water_forced_run(const r_water_params *p, bool raw, int n, long steps, long ref_steps, r_water_run *out)
+bool fx_water_sim_forced_run(const fx_water_sim_params *p, bool raw, int n, long steps, long ref_steps, fx_water_sim_run *out)
 {
     memset(out, 0, sizeof *out);
-    r_water_params q = *p;
+    fx_water_sim_params q = *p;
     if (!raw)
-        r_water_params_fix(&q);
+        fx_water_sim_params_fix(&q);
     else { /* the splat parameters still take their defaults; C and damping stay as given */
-        r_water_params d = q;
-        r_water_params_fix(&d);
+        fx_water_sim_params d = q;
+        fx_water_sim_params_fix(&d);
         d.courant = q.courant, d.damping = q.damping;
         q = d;
     }
@@ -200,19 +200,19 @@ bool r_water_forced_run(const r_water_params *p, bool raw, int n, long steps, lo
     out->finite = true;
     double t0 = rs_now();
     for (long t = 0; t < steps; t++) {
-        r_water_step_raw(q.courant, q.damping, q.h_max, n, a, b);
+        fx_water_sim_step_raw(q.courant, q.damping, q.h_max, n, a, b);
         float pos[3][2], speed[3];
         int m = forcing(q.size, t, pos, speed);
         for (int k = 0; k < m; k++) {
-            r_water_splat s;
-            if (r_water_splat_for(&q, n, pos[k][0], pos[k][1], 0.06f, 0.12f, speed[k], &s))
-                r_water_add_splat(n, b, &s);
+            fx_water_sim_splat s;
+            if (fx_water_sim_splat_for(&q, n, pos[k][0], pos[k][1], 0.06f, 0.12f, speed[k], &s))
+                fx_water_sim_add_splat(n, b, &s);
         }
         float *tmp = a;
         a = b, b = tmp;
         if ((t + 1) % R_WATER_RUN_SAMPLE && t + 1 != ref_steps && t + 1 != steps)
             continue;
-        double e = r_water_energy(q.courant, n, a);
+        double e = fx_water_sim_energy(q.courant, n, a);
         if (!isfinite(e))
             out->finite = false;
         if (e > out->e_max || !isfinite(e))
@@ -249,7 +249,7 @@ static double worst_growth(double c, double d)
     return worst;
 }
 
-void r_water_accuracy_rows(FILE *out)
+void fx_water_sim_accuracy_rows(FILE *out)
 {
     static const struct {
         float c;
@@ -257,25 +257,25 @@ void r_water_accuracy_rows(FILE *out)
     } rows[] = {{0.25f, false}, {0.5f, false}, {0.58f, false},   {0.6f, false},   {0.7f, false},
                 {0.7071f, false}, {0.75f, false}, {0.7071f, true}, {0.75f, true}};
     enum { N = 64, STEPS = 100000, REF = 1000, TN = R_WATER_N, TSTEPS = 200 };
-    r_water_params def = {0};
-    r_water_params_fix(&def);
+    fx_water_sim_params def = {0};
+    fx_water_sim_params_fix(&def);
     /* the game's step: 256 x 256 on the CPU (the GPU does it in the game) */
     float *a = calloc((size_t)TN * TN * 2, sizeof *a), *b = calloc((size_t)TN * TN * 2, sizeof *b);
     double us = 0;
     if (a && b) {
         double t0 = rs_now();
         for (int t = 0; t < TSTEPS; t++) {
-            r_water_step(&def, TN, a, b);
+            fx_water_sim_step(&def, TN, a, b);
             float *tmp = a;
             a = b, b = tmp;
         }
         us = (rs_now() - t0) * 1e6 / TSTEPS;
     }
     free(a), free(b);
-    r_water_params small = def;
+    fx_water_sim_params small = def;
     small.size = 2.0f; /* 64 cells over 2 m: splats a few cells wide, as in the game */
-    r_water_run base;
-    if (!r_water_forced_run(&small, false, N, STEPS, REF, &base))
+    fx_water_sim_run base;
+    if (!fx_water_sim_forced_run(&small, false, N, STEPS, REF, &base))
         return;
     fprintf(out,
             "\nWater automaton (techniques A6): Courant number C = c dt / dx against stability.  Damping %.3f;\n"
@@ -288,10 +288,10 @@ void r_water_accuracy_rows(FILE *out)
     fprintf(out, "%9s %8s %8s %10s %12s %12s %10s %7s\n", "C asked", "C used", "margin", "growth", "E max/E 1000",
             "vs default", "max |h| m", "finite");
     for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
-        r_water_params p = small;
-        p.courant = rows[k].raw ? rows[k].c : r_water_courant_clamp(rows[k].c);
-        r_water_run run;
-        if (!r_water_forced_run(&p, rows[k].raw, N, STEPS, REF, &run))
+        fx_water_sim_params p = small;
+        p.courant = rows[k].raw ? rows[k].c : fx_water_sim_courant_clamp(rows[k].c);
+        fx_water_sim_run run;
+        if (!fx_water_sim_forced_run(&p, rows[k].raw, N, STEPS, REF, &run))
             return;
         fprintf(out, "%9.4f %8.4f %8.4f %10.6f %12.3f %12.3g %10.4f %7s%s\n", rows[k].c, p.courant,
                 R_WATER_COURANT_MAX / p.courant, worst_growth(p.courant, p.damping),

@@ -35,8 +35,8 @@
 #define R_WATER_COURANT_MAX 0.706f /* the cap, just below the CFL limit (margin 1.0016) */
 #define R_WATER_MAX_STEPS 8        /* steps one frame runs at most (more ticks: the rest are dropped) */
 
-typedef struct r_water_params {
-    /* zero (or NaN) means the default; r_water_params_fix applies them */
+typedef struct fx_water_sim_params {
+    /* zero (or NaN) means the default; fx_water_sim_params_fix applies them */
     float courant;  /* C = c dt / dx: 0.58, the shallow-water speed sqrt(g * 0.12 m) = 1.085 m/s
                        at dt = 1/60 s, dx = 8 m / 256; capped at R_WATER_COURANT_MAX */
     float damping;  /* amplitude kept per step: 0.985 (a ripple fades to 1/e in about 1.1 s);
@@ -46,80 +46,80 @@ typedef struct r_water_params {
     float amp_max;  /* |splat height| cap, m: 0.012 */
     float splash;   /* splat radius / capsule radius: 1.5 */
     float size;     /* metres the grid spans: 8 (2 x the shallows ring_half) */
-} r_water_params;
+} fx_water_sim_params;
 
 /* Fills zeros and NaNs with the defaults above and clamps every value into
- * its range (courant through r_water_courant_clamp). */
-void r_water_params_fix(r_water_params *p);
+ * its range (courant through fx_water_sim_courant_clamp). */
+void fx_water_sim_params_fix(fx_water_sim_params *p);
 /* The Courant number a step may use: (0, R_WATER_COURANT_MAX]; NaN or <= 0
  * gives the default. */
-float r_water_courant_clamp(float c);
+float fx_water_sim_courant_clamp(float c);
 
 /* One step of the n x n grid, src -> dst (2 n^2 floats each, not
- * overlapping), with p fixed (r_water_params_fix) first. */
-void r_water_step(const r_water_params *p, int n, const float *src, float *dst);
+ * overlapping), with p fixed (fx_water_sim_params_fix) first. */
+void fx_water_sim_step(const fx_water_sim_params *p, int n, const float *src, float *dst);
 /* The same without any check of C or damping: for the stability test and
  * the accuracy table, which show what the cap prevents. */
-void r_water_step_raw(float courant, float damping, float h_max, int n, const float *src, float *dst);
+void fx_water_sim_step_raw(float courant, float damping, float h_max, int n, const float *src, float *dst);
 
 /* A splat in grid units: centre (texel k's centre at k + 0.5), radius in
  * cells, height added at the centre (m). */
-typedef struct r_water_splat {
+typedef struct fx_water_sim_splat {
     float x, y, radius, amp;
-} r_water_splat;
+} fx_water_sim_splat;
 
 /* The splat for a contact at world (wx, wz) of a capsule of radius
  * cap_radius reaching `depth` under the surface, moving at `speed` m/s:
  * height -gain * speed * immersion (a dent; immersion = depth / 2 radius,
  * at most 1), capped at amp_max, radius splash * cap_radius (1..16 cells).
  * False when the centre is off the grid or the height is 0 or not finite. */
-bool r_water_splat_for(const r_water_params *p, int n, float wx, float wz, float cap_radius, float depth, float speed,
-                       r_water_splat *out);
+bool fx_water_sim_splat_for(const fx_water_sim_params *p, int n, float wx, float wz, float cap_radius, float depth, float speed,
+                       fx_water_sim_splat *out);
 /* Adds the splat's bump to h: amp * (1 + cos(pi d / radius)) / 2 at the
  * cells whose centres are within radius of its centre. */
-void r_water_add_splat(int n, float *grid, const r_water_splat *s);
+void fx_water_sim_add_splat(int n, float *grid, const fx_water_sim_splat *s);
 /* The bump's weight at distance d (the shader's formula). */
-float r_water_splat_weight(float d, float radius);
+float fx_water_sim_splat_weight(float d, float radius);
 
 /* The discrete energy: sum (h - h_prev)^2 + C^2 sum over neighbour pairs
  * (h_a - h_b)^2 (double sums; Inf when the grid holds Inf or NaN). */
-double r_water_energy(float courant, int n, const float *grid);
+double fx_water_sim_energy(float courant, int n, const float *grid);
 
 /* A long run with forcing like the game's: two "feet" stepping and
  * sweeping through the water, splatted every step through
- * r_water_splat_for.  raw: C and damping go to r_water_step_raw as given
+ * fx_water_sim_splat_for.  raw: C and damping go to fx_water_sim_step_raw as given
  * (no cap).  e_ref is the energy after ref_steps; e_max the largest over
  * the whole run, sampled every R_WATER_RUN_SAMPLE steps (a damped grid
  * under bounded forcing changes little in that time; the samples halve
  * the run's cost). */
 #define R_WATER_RUN_SAMPLE 10
-typedef struct r_water_run {
+typedef struct fx_water_sim_run {
     double e_ref, e_max, e_last;
     float h_absmax;   /* largest |h| seen */
     bool finite;      /* no NaN or Inf anywhere, ever */
     long steps;
     double ms;        /* wall time of the whole run */
-} r_water_run;
-bool r_water_forced_run(const r_water_params *p, bool raw, int n, long steps, long ref_steps, r_water_run *out);
+} fx_water_sim_run;
+bool fx_water_sim_forced_run(const fx_water_sim_params *p, bool raw, int n, long steps, long ref_steps, fx_water_sim_run *out);
 
 /* `ringside bench accuracy`'s water rows: per Courant number, the
  * stability margin (cap / C), the largest energy over a long forced run
  * against the energy after its first 1000 steps, the worst mode's growth
  * per step (analytic) and the CPU time of a 256 x 256 step.  ~10 s. */
-void r_water_accuracy_rows(FILE *out);
+void fx_water_sim_accuracy_rows(FILE *out);
 
 /* ---- the GPU side (fx_water.c), for tests ---- */
 struct r_game;
 /* The parameters the water passes use (NULL before a water stage loaded). */
-const r_water_params *r_fx_water_params(struct r_game *r);
+const fx_water_sim_params *fx_water_params(struct r_game *r);
 /* Runs `steps` steps of the GPU automaton now, injecting the splats after
  * each step as the sim pass does.  Needs a loaded water stage. */
-bool r_fx_water_gpu_steps(struct r_game *r, const r_water_splat *s, int ns, int steps);
+bool fx_water_gpu_steps(struct r_game *r, const fx_water_sim_splat *s, int ns, int steps);
 /* The current state, R_WATER_N^2 * 2 floats (height, previous). */
-bool r_fx_water_read(struct r_game *r, float *grid);
+bool fx_water_read(struct r_game *r, float *grid);
 /* Replaces the state (tests put NaN and Inf in it). */
-bool r_fx_water_write(struct r_game *r, const float *grid);
+bool fx_water_write(struct r_game *r, const float *grid);
 /* Splats the sim pass injected per step in the last frame. */
-int r_fx_water_last_splats(struct r_game *r);
+int fx_water_last_splats(struct r_game *r);
 
 #endif

@@ -1,6 +1,6 @@
 /* Destruction holes (techniques D) as game state: where heavy hits leave
  * craters in the ring floor of a destructible stage.  The renderer draws
- * them with stencil (runtime/render/r_fx_holes.c); here they are only
+ * them with stencil (runtime/fx/fx_holes.c); here they are only
  * placed, kept from overlapping and capped, in fixed point, so a replay
  * makes the same holes on every machine. */
 #include "g_local.h"
