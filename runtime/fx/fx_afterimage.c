@@ -16,20 +16,20 @@
 #include "../render/r_shader.h"
 
 extern const r_fx_module fx_afterimage_module;
-#define AFTERIMAGE(r) ((struct r_fx_afterimage *)r_fx_state((r), &fx_afterimage_module))
+#define AFTERIMAGE(r) ((struct fx_afterimage_state *)r_fx_state((r), &fx_afterimage_module))
 
 #define OPACITY 0.6f /* the copy's alpha at rest; the speed fade scales it */
 
-typedef struct r_fx_afterimage {
+typedef struct fx_afterimage_state {
     GLuint prog;
     float radius[16]; /* per bone: the mesh's largest vertex distance from the bone origin */
     float fast[2][16];
     bool any_fast;    /* this frame */
-} r_fx_afterimage;
+} fx_afterimage_state;
 
 static bool create(r_game *r, rs_err *err)
 {
-    r_fx_afterimage *a = calloc(1, sizeof *a);
+    fx_afterimage_state *a = calloc(1, sizeof *a);
     if (!a)
         return rs_fail(err, 1, "out of memory");
     r_fx_set_state(r, &fx_afterimage_module, a);
@@ -59,7 +59,7 @@ static bool create(r_game *r, rs_err *err)
 
 static void destroy(r_game *r)
 {
-    r_fx_afterimage *a = AFTERIMAGE(r);
+    fx_afterimage_state *a = AFTERIMAGE(r);
     if (!a)
         return;
     gl.DeleteProgram(a->prog);
@@ -96,7 +96,7 @@ static float bone_speed(const float cur[16], const float prev[16], float len, co
 static bool needed(void *u)
 {
     r_game *r = u;
-    r_fx_afterimage *a = AFTERIMAGE(r);
+    fx_afterimage_state *a = AFTERIMAGE(r);
     if (!a || r->stage.afterimage == R_AFTERIMAGE_OFF)
         return false;
     a->any_fast = false;
@@ -116,7 +116,7 @@ static bool needed(void *u)
 static void run(void *u)
 {
     r_game *r = u;
-    r_fx_afterimage *a = AFTERIMAGE(r);
+    fx_afterimage_state *a = AFTERIMAGE(r);
     frame *f = &r->f;
     GLuint p = a->prog;
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);

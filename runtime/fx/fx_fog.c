@@ -30,7 +30,7 @@
 #include "../render/r_shader.h"
 
 extern const r_fx_module fx_fog_module;
-#define FOG(r) ((struct r_fx_fog *)r_fx_state((r), &fx_fog_module))
+#define FOG(r) ((struct fx_fog_state *)r_fx_state((r), &fx_fog_module))
 
 /* What the fog looks like (A8 gives no numbers; these suit mistvale). */
 typedef struct fog_look {
@@ -50,7 +50,7 @@ static const fog_look default_look = {
     .brightness = 1.0f, .albedo = 0.9f, .g = 0.35f,
 };
 
-struct r_fx_fog {
+struct fx_fog_state {
     fog_look look;
     fx_fog_sim sim;
     GLuint prog;          /* fog_splat.vert/.frag */
@@ -64,7 +64,7 @@ struct r_fx_fog {
 
 /* ---- the map ---- */
 
-static void free_map(struct r_fx_fog *fg)
+static void free_map(struct fx_fog_state *fg)
 {
     GLuint tex[2] = {fg->tex, fg->tmp_tex}, fbo[2] = {fg->fbo, fg->tmp_fbo};
     gl.DeleteTextures(2, tex);
@@ -73,7 +73,7 @@ static void free_map(struct r_fx_fog *fg)
     fg->size = 0;
 }
 
-static bool make_map(struct r_fx_fog *fg, int size, rs_err *err)
+static bool make_map(struct fx_fog_state *fg, int size, rs_err *err)
 {
     if (fg->size == size)
         return true;
@@ -96,7 +96,7 @@ static bool make_map(struct r_fx_fog *fg, int size, rs_err *err)
 }
 
 /* Step 2: the particles as sprites into the map; returns the sprites drawn. */
-static int draw_map(r_game *r, struct r_fx_fog *fg)
+static int draw_map(r_game *r, struct fx_fog_state *fg)
 {
     const fx_fog_sim *s = &fg->sim;
     float h = s->d.half, R = fminf(fg->look.sprite_m, s->d.half / 2), sum = 0;
@@ -177,7 +177,7 @@ static int limb_points(const frame *f, float cur[][3], float prev[][3])
  * (fog_advance). */
 static void sim_follow(r_game *r)
 {
-    struct r_fx_fog *fg = FOG(r);
+    struct fx_fog_state *fg = FOG(r);
     const frame *f = &r->f;
     /* step 1: the mist follows the game's ticks, never the frame rate */
     float cur[4 * G_BONES][3], prev[4 * G_BONES][3];
@@ -221,7 +221,7 @@ static float half_clamp(float v)
 static void fog_bind(r_game *r, GLuint p, int unit, int what)
 {
     (void)what;
-    struct r_fx_fog *fg = FOG(r);
+    struct fx_fog_state *fg = FOG(r);
     bool on = fg && r->stage.fog && r_ran(&r->f, r, "fog_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_fog_on"), on);
@@ -264,7 +264,7 @@ static void fog_bind(r_game *r, GLuint p, int unit, int what)
 
 static void fog_destroy(r_game *r)
 {
-    struct r_fx_fog *fg = FOG(r);
+    struct fx_fog_state *fg = FOG(r);
     if (!fg)
         return;
     free_map(fg);
@@ -282,7 +282,7 @@ static void fog_destroy(r_game *r)
 
 static bool fog_create(r_game *r, rs_err *err)
 {
-    struct r_fx_fog *fg = calloc(1, sizeof *fg);
+    struct fx_fog_state *fg = calloc(1, sizeof *fg);
     if (!fg)
         return rs_fail(err, 1, "fog: out of memory");
     r_fx_set_state(r, &fx_fog_module, fg);
@@ -338,7 +338,7 @@ fx_fog_sim *fx_fog_get_sim(r_game *r)
 
 bool fx_fog_read_map(r_game *r, float *out, int *size, float *half)
 {
-    struct r_fx_fog *fg = FOG(r);
+    struct fx_fog_state *fg = FOG(r);
     if (!fg || !fg->tex)
         return false;
     if (size)
@@ -378,7 +378,7 @@ static int by_value(const void *a, const void *b)
 
 /* One map size: the median ms of a fog_map draw (glFinish-timed) and the
  * rms and largest density error at the sample points against ref. */
-static void acc_row(r_game *r, struct r_fx_fog *fg, const float *ref, float *map, double out[3])
+static void acc_row(r_game *r, struct fx_fog_state *fg, const float *ref, float *map, double out[3])
 {
     double ms[ACC_RUNS], se = 0, worst = 0;
     float half = fg->sim.d.half;
@@ -414,7 +414,7 @@ bool fx_fog_accuracy_rows(FILE *out, rs_err *err)
             rs_fail(err, 1, "fog accuracy: out of memory");
         goto done;
     }
-    struct r_fx_fog *fg = FOG(r);
+    struct fx_fog_state *fg = FOG(r);
     /* a mist that has drifted for 5 s, with a kick's worth of local wind:
      * a limb point sweeping through the middle at 6 m/s */
     fx_fog_sim_reset(&fg->sim, 0);

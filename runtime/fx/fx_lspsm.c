@@ -48,12 +48,12 @@
 #include "fx_lspsm.h"
 
 extern const r_fx_module fx_lspsm_module;
-#define LSPSM(r) ((struct r_fx_lspsm *)r_fx_state((r), &fx_lspsm_module))
+#define LSPSM(r) ((struct fx_lspsm_state *)r_fx_state((r), &fx_lspsm_module))
 
 #define KEEP 0.4f         /* a fighter in full shadow keeps 40 % of the key light */
 #define DEPTH_BIAS 0.0005f /* receivers, window depth units */
 
-struct r_fx_lspsm {
+struct fx_lspsm_state {
     GLuint prog_map, prog_focus;
     GLuint map_tex, flag_tex, map_fbo; /* 1024x1024 depth (compare mode) + R8 fighter flag */
     GLuint focus_tex, focus_fbo;       /* 20x16 R32F */
@@ -97,7 +97,7 @@ static r_vec3 to_light(const r_game *r)
     return LSPSM(r)->light_override ? LSPSM(r)->light : r->f.light_dir;
 }
 
-static void take_focus(struct r_fx_lspsm *ls, bool reset)
+static void take_focus(struct fx_lspsm_state *ls, bool reset)
 {
     if (reset) {
         ls->pending = false;
@@ -123,7 +123,7 @@ static void take_focus(struct r_fx_lspsm *ls, bool reset)
 static void run_map(void *u)
 {
     r_game *r = u;
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     frame *f = &r->f;
     take_focus(ls, f->reset);
     r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
@@ -174,7 +174,7 @@ static void run_map(void *u)
 static void run_buildings(void *u)
 {
     r_game *r = u;
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     GLuint p = r->prog[P_STAGE];
     r_begin_opaque(r);
     r_stage_uniforms(r, p, 2);
@@ -190,7 +190,7 @@ static void run_buildings(void *u)
 static void run_focus(void *u)
 {
     r_game *r = u;
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     frame *f = &r->f;
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->focus_fbo);
     gl.Viewport(0, 0, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H);
@@ -229,7 +229,7 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
 {
     if (what != R_FX_BIND_SCENE)
         return;
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     bool on = ls && r->stage.lspsm && r_ran(&r->f, r, "lspsm_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
@@ -264,7 +264,7 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
 
 /* ---- the module ---- */
 
-static void free_city(struct r_fx_lspsm *ls)
+static void free_city(struct fx_lspsm_state *ls)
 {
     r_free_mesh(&ls->city_vao, &ls->city_vbo, &ls->city_ibo);
     r_free_mesh(&ls->proxy_vao, &ls->proxy_vbo, &ls->proxy_ibo);
@@ -274,7 +274,7 @@ static void free_city(struct r_fx_lspsm *ls)
 
 static void lspsm_destroy(r_game *r)
 {
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     if (!ls)
         return;
     free_city(ls);
@@ -291,7 +291,7 @@ static void lspsm_destroy(r_game *r)
 
 static bool lspsm_create(r_game *r, rs_err *err)
 {
-    struct r_fx_lspsm *ls = calloc(1, sizeof *ls);
+    struct fx_lspsm_state *ls = calloc(1, sizeof *ls);
     if (!ls)
         return rs_fail(err, 1, "lspsm: out of memory");
     r_fx_set_state(r, &fx_lspsm_module, ls);
@@ -338,7 +338,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
 /* A new look: the buildings of its layout (their meshes), the focus afresh. */
 static bool lspsm_load(r_game *r, rs_err *err)
 {
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     free_city(ls);
     ls->pending = false;
     ls->focus.range = 0;
@@ -421,7 +421,7 @@ void fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform
 
 bool fx_lspsm_read(r_game *r, const char *what, float *out)
 {
-    struct r_fx_lspsm *ls = LSPSM(r);
+    struct fx_lspsm_state *ls = LSPSM(r);
     if (!ls)
         return false;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);

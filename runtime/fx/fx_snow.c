@@ -40,7 +40,7 @@
 #include "../render/r_shader.h"
 
 extern const r_fx_module fx_snow_module;
-#define SNOW(r) ((struct r_fx_snow *)r_fx_state((r), &fx_snow_module))
+#define SNOW(r) ((struct fx_snow_state *)r_fx_state((r), &fx_snow_module))
 
 #define SNOW_LIGHT 256              /* texture-space lighting texels per side */
 /* The surface grid: a vertex on every SNOW_COL_STRIDE-th map texel along
@@ -61,7 +61,7 @@ extern const r_fx_module fx_snow_module;
 
 enum { S_RESET, S_STAMP, S_LIGHT, S_KEY, S_SURFACE, S_PROGS };
 
-struct r_fx_snow {
+struct fx_snow_state {
     GLuint prog[S_PROGS];
     GLuint map_tex, map_fbo;              /* the displacement map (RES_SNOW) */
     GLuint untouched_tex, trampled_tex;   /* heights, same size as the map */
@@ -113,7 +113,7 @@ static int grid_axis(short *out, bool rows)
 
 /* The grid over the ring top: one vertex attribute, the (column, row)
  * codes of grid_axis; snow_surface.vert makes positions from the map. */
-static bool build_grid(struct r_fx_snow *s)
+static bool build_grid(struct fx_snow_state *s)
 {
     short cols[R_SNOW_MAP + 4], rows[R_SNOW_MAP + 4];
     int nc = grid_axis(cols, false), nr = grid_axis(rows, true);
@@ -154,7 +154,7 @@ static bool build_grid(struct r_fx_snow *s)
 
 static void snow_destroy(r_game *r)
 {
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     if (!s)
         return;
     for (int i = 0; i < S_PROGS; i++)
@@ -173,7 +173,7 @@ static void snow_destroy(r_game *r)
 
 static bool snow_create(r_game *r, rs_err *err)
 {
-    struct r_fx_snow *s = calloc(1, sizeof *s);
+    struct fx_snow_state *s = calloc(1, sizeof *s);
     if (!s)
         return rs_fail(err, 1, "out of memory for the snow");
     r_fx_set_state(r, &fx_snow_module, s);
@@ -225,7 +225,7 @@ static bool snow_create(r_game *r, rs_err *err)
 }
 
 /* The untouched and trampled heights for a ring of this size. */
-static bool make_heights(struct r_fx_snow *s, float half, rs_err *err)
+static bool make_heights(struct fx_snow_state *s, float half, rs_err *err)
 {
     const int n = R_SNOW_MAP;
     float *h = malloc((size_t)n * n * sizeof *h);
@@ -254,7 +254,7 @@ static bool snow_load(r_game *r, rs_err *err)
 /* Bone capsules that dip below the highest untouched snow; the stamp
  * shader finds, texel by texel, how far each actually reaches under the
  * snow there. */
-static void add_contacts(struct r_fx_snow *s, const r_fx_capsule caps[2][G_BONES], const r_fx_capsule prev[2][G_BONES])
+static void add_contacts(struct fx_snow_state *s, const r_fx_capsule caps[2][G_BONES], const r_fx_capsule prev[2][G_BONES])
 {
     r_fx_contact c[2 * G_BONES];
     int n = r_fx_contacts(caps, prev, R_SNOW_UNTOUCHED_HI, c, 2 * G_BONES);
@@ -271,7 +271,7 @@ static void add_contacts(struct r_fx_snow *s, const r_fx_capsule caps[2][G_BONES
 static bool need_map(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     if (!r->stage.snow || !s)
         return false;
     /* the contacts are found here so that a tick without any costs no pass */
@@ -285,7 +285,7 @@ static bool need_map(void *u)
 
 static void stamp(r_game *r, const r_fx_capsule *caps, int n)
 {
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     GLuint p = s->prog[S_STAMP];
     float a[MAX_STAMPS][4], b[MAX_STAMPS][3];
     gl.UseProgram(p);
@@ -311,7 +311,7 @@ static void stamp(r_game *r, const r_fx_capsule *caps, int n)
     gl.Disable(GL_BLEND);
 }
 
-static void map_target(struct r_fx_snow *s)
+static void map_target(struct fx_snow_state *s)
 {
     gl.BindFramebuffer(GL_FRAMEBUFFER, s->map_fbo);
     gl.Viewport(0, 0, R_SNOW_MAP, R_SNOW_MAP);
@@ -324,7 +324,7 @@ static void map_target(struct r_fx_snow *s)
 static void run_map(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     bool reset = r->f.reset;
     if (s->half != ring_half(r)) { /* the ring changed size under the same look */
         if (!make_heights(s, ring_half(r), NULL))
@@ -353,7 +353,7 @@ static bool need_snow(void *u)
 static void run_light(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     GLuint p = s->prog[S_LIGHT];
     gl.BindFramebuffer(GL_FRAMEBUFFER, s->light_fbo);
     gl.Viewport(0, 0, SNOW_LIGHT, SNOW_LIGHT);
@@ -385,7 +385,7 @@ static void run_light(void *u)
 static void run_light_blur(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     r_blur_into(r, s->tmp_fbo, s->light_tex, 0, SNOW_LIGHT, SNOW_LIGHT, 1, 0);
     r_blur_into(r, s->light_fbo, s->tmp_tex, 0, SNOW_LIGHT, SNOW_LIGHT, 0, 1);
 }
@@ -395,7 +395,7 @@ static void run_light_blur(void *u)
 static void run_surface(void *u)
 {
     r_game *r = u;
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     frame *f = &r->f;
     GLuint p = s->prog[S_SURFACE];
     r_begin_opaque(r);
@@ -433,7 +433,7 @@ int fx_snow_light_size(void)
 
 bool fx_snow_read(r_game *r, const char *which, float *out)
 {
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     if (!s)
         return false;
     GLuint t = !strcmp(which, "map")         ? s->map_tex
@@ -452,7 +452,7 @@ bool fx_snow_read(r_game *r, const char *which, float *out)
 
 void fx_snow_stamp(r_game *r, const r_fx_capsule *caps, int n)
 {
-    struct r_fx_snow *s = SNOW(r);
+    struct fx_snow_state *s = SNOW(r);
     if (!s || !s->half || n <= 0)
         return;
     map_target(s);

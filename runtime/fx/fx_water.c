@@ -29,7 +29,7 @@
 #include "../render/r_shader.h"
 
 extern const r_fx_module fx_water_module;
-#define WATER(r) ((struct r_fx_water *)r_fx_state((r), &fx_water_module))
+#define WATER(r) ((struct fx_water_state *)r_fx_state((r), &fx_water_module))
 
 enum { W_SIM, W_SPLAT, W_NORMAL, W_MIRROR, W_UNDER, W_SURFACE, W_PROGS };
 
@@ -46,7 +46,7 @@ enum { W_SIM, W_SPLAT, W_NORMAL, W_MIRROR, W_UNDER, W_SURFACE, W_PROGS };
 #define FOG_DEPTH 8.0f      /* ... and added per metre of depth, 1/m^2 */
 static const float fog_color[3] = {0.10f, 0.26f, 0.27f};
 
-typedef struct r_fx_water {
+typedef struct fx_water_state {
     bool built;
     fx_water_sim_params prm;
     GLuint prog[W_PROGS];
@@ -63,7 +63,7 @@ typedef struct r_fx_water {
     int sw, sh;
     GLuint refl_tex, refl_depth, refl_fbo;
     GLuint under_tex, under_fbo;
-} r_fx_water;
+} fx_water_state;
 
 /* ---- building ---- */
 
@@ -117,7 +117,7 @@ static GLuint color_tex(uint8_t *px, bool deep)
 
 /* The surface grid (u, v, 0) and the skirt: per edge a strip from the
  * surface (u, v, 2) down to the ring floor (u, v, 1). */
-static bool build_mesh(r_fx_water *w)
+static bool build_mesh(fx_water_state *w)
 {
     const int n = MESH_N, row = n + 1, ngrid = row * row, nv = ngrid + 4 * 2 * row;
     float *v = malloc((size_t)nv * 3 * sizeof *v);
@@ -173,7 +173,7 @@ static bool build_mesh(r_fx_water *w)
     return true;
 }
 
-static void free_targets(r_fx_water *w)
+static void free_targets(fx_water_state *w)
 {
     GLuint tex[] = {w->refl_tex, w->under_tex};
     gl.DeleteTextures(2, tex);
@@ -184,7 +184,7 @@ static void free_targets(r_fx_water *w)
     w->sw = w->sh = 0;
 }
 
-static void free_gl(r_fx_water *w)
+static void free_gl(fx_water_state *w)
 {
     for (int i = 0; i < W_PROGS; i++)
         if (w->prog[i])
@@ -205,7 +205,7 @@ static void free_gl(r_fx_water *w)
     w->prm = prm;
 }
 
-static bool build(r_fx_water *w, rs_err *err)
+static bool build(fx_water_state *w, rs_err *err)
 {
     static const struct {
         int id;
@@ -264,7 +264,7 @@ fail:
 
 static bool create(r_game *r, rs_err *err)
 {
-    r_fx_water *w = calloc(1, sizeof *w);
+    fx_water_state *w = calloc(1, sizeof *w);
     if (!w)
         return rs_fail(err, 1, "out of memory");
     r_fx_set_state(r, &fx_water_module, w);
@@ -285,7 +285,7 @@ static void destroy(r_game *r)
  * but the screen-sized targets, which only a water stage needs. */
 static bool load(r_game *r, rs_err *err)
 {
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     if (w && !r->stage.water)
         free_targets(w);
     return !r->stage.water || !w || w->built || build(w, err);
@@ -306,7 +306,7 @@ static void restore_draw_state(void)
     gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
-static void clear_state(r_fx_water *w)
+static void clear_state(fx_water_state *w)
 {
     const float zero[4] = {0, 0, 0, 0};
     for (int k = 0; k < 2; k++) {
@@ -317,7 +317,7 @@ static void clear_state(r_fx_water *w)
 
 /* steps automaton steps, each followed by the splats (additive points into
  * the red channel: an impulse of vertical velocity, h_prev untouched) */
-static void gpu_steps(r_game *r, r_fx_water *w, const fx_water_sim_splat *s, int ns, int steps)
+static void gpu_steps(r_game *r, fx_water_state *w, const fx_water_sim_splat *s, int ns, int steps)
 {
     if (steps <= 0)
         return;
@@ -368,7 +368,7 @@ static float ring_half(const r_game *r)
 static void run_sim(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     frame *f = &r->f;
     if (f->reset)
         clear_state(w);
@@ -403,7 +403,7 @@ static void run_sim(void *u)
 
 /* ---- the reflection and the under-water image ---- */
 
-static void ensure_targets(r_fx_water *w, int sw, int sh)
+static void ensure_targets(fx_water_state *w, int sw, int sh)
 {
     if (w->sw == sw && w->sh == sh)
         return;
@@ -426,7 +426,7 @@ static void ensure_targets(r_fx_water *w, int sw, int sh)
 static void run_reflect(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     frame *f = &r->f;
     ensure_targets(w, f->w, f->h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->refl_fbo);
@@ -496,7 +496,7 @@ static void water_box(const r_game *r, float half, int box[4])
 static void run_under(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     frame *f = &r->f;
     ensure_targets(w, f->w, f->h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->under_fbo);
@@ -533,7 +533,7 @@ static void run_under(void *u)
 static void run_surface(void *u)
 {
     r_game *r = u;
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     frame *f = &r->f;
     float half = ring_half(r);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
@@ -575,7 +575,7 @@ const fx_water_sim_params *fx_water_params(r_game *r)
 
 bool fx_water_gpu_steps(r_game *r, const fx_water_sim_splat *s, int ns, int steps)
 {
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     if (!w || !w->built || ns < 0 || ns > MAX_SPLATS)
         return false;
     gpu_steps(r, w, s, ns, steps);
@@ -586,7 +586,7 @@ bool fx_water_gpu_steps(r_game *r, const fx_water_sim_splat *s, int ns, int step
 
 bool fx_water_read(r_game *r, float *grid)
 {
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     float *px = w && w->built ? malloc((size_t)R_WATER_N * R_WATER_N * 4 * sizeof *px) : NULL;
     if (!px)
         return false;
@@ -602,7 +602,7 @@ bool fx_water_read(r_game *r, float *grid)
 
 bool fx_water_write(r_game *r, const float *grid)
 {
-    r_fx_water *w = WATER(r);
+    fx_water_state *w = WATER(r);
     float *px = w && w->built ? calloc((size_t)R_WATER_N * R_WATER_N * 4, sizeof *px) : NULL;
     if (!px)
         return false;
