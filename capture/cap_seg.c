@@ -171,8 +171,9 @@ static bool manifest_read(const char *seg, cap_seg_info *out, rs_err *err)
     else if (!manifest_line(&p, "frames", v[2], sizeof v[2]) || sscanf(v[2], "%" SCNu64 "%c", &m->frames, &tail) != 1 ||
              m->frames != m->end - m->first)
         bad = "no 'frames' line equal to END - FIRST";
-    else if (!manifest_line(&p, "bytes", v[3], sizeof v[3]) || sscanf(v[3], "%" SCNu64 "%c", &m->bytes, &tail) != 1)
-        bad = "no valid 'bytes' line";
+    else if (!manifest_line(&p, "bytes", v[3], sizeof v[3]) || sscanf(v[3], "%" SCNu64 "%c", &m->bytes, &tail) != 1 ||
+             m->bytes < m->frames) /* every packet has a byte at least: bounds what reading it back allocates */
+        bad = "no valid 'bytes' line (at least one a frame)";
     else if (!manifest_line(&p, "crc32", v[4], sizeof v[4]) || strlen(v[4]) != 8 ||
              sscanf(v[4], "%" SCNx32 "%c", &m->crc, &tail) != 1)
         bad = "no valid 'crc32' line";
