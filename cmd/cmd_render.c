@@ -55,9 +55,10 @@ static void help(void)
            "                     needs an image pattern output (.png)\n"
            "  --no-hud           leave out bars, timer and announcements\n"
            "  --hdr-format F     the HDR buffer: rgba16f (default) or r11g11b10f (no alpha)\n"
-           "  --ticks A:B        write only ticks A to B-1 (the game still runs from tick 0,\n"
-           "                     so frame A is the same as in a full render; image names and\n"
-           "                     --hashes lines are numbered A..B-1)\n"
+           "  --ticks A:B        write only ticks A to B-1, bit for bit the frames a full render\n"
+           "                     writes there: the game runs from tick 0 and the effects that\n"
+           "                     carry history (water, snow, mist, LSPSM) are warmed up first;\n"
+           "                     image names and --hashes lines are numbered A..B-1\n"
            "  --segment KEY      write a segment that 'ringside join' can put together with the\n"
            "                     others (.mp4, .mkv or .webm): first frame a keyframe, closed GOP,\n"
            "                     timestamps from tick A; beside it OUT.seg, its manifest (KEY,\n"
@@ -360,6 +361,11 @@ int cmd_render(int argc, char **argv)
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
                 st.high_water, st.fence_waits);
+    if (!quiet && t_first > 0)
+        fprintf(stderr,
+                "ringside render: warm-up for tick %" PRIu64 ": the effects' history from tick %" PRIu64 " (%" PRIu64
+                " ticks advanced, %" PRIu64 " of them drawn) in %.2f s; the frames took %.2f s (docs/effects.md, History)\n",
+                t_first, j.warm_from, t_first - j.warm_from, j.warm_drawn, j.ms_warm / 1e3, j.ms_draw / 1e3);
     status = RS_EXIT_OK;
 done:
     sigaction(SIGINT, &old_int, NULL);

@@ -41,5 +41,18 @@ t_other_size_and_capture() {
     same mistvale 100 103 --size 96x54 --render-size 192x108 --capture sequential || return 1
 }
 
-t_run every_demo_from_a_mid_tick other_size_and_capture
+# the summary says how far back the warm-up went: nothing on dojo, LSPSM's
+# window (drawn) on plaza, from tick 0 on shallows
+t_warmup_reported() {
+    for c in "dojo:from tick 240 (0 ticks advanced, 0 of them drawn)" \
+        "plaza:from tick 12 (228 ticks advanced, 228 of them drawn)" \
+        "shallows:from tick 0 (240 ticks advanced, 0 of them drawn)"; do
+        demo=${c%%:*} want=${c#*:}
+        "$RS_BIN" render "$SRC/demos/$demo.rsr" -o /dev/null --ticks 240:241 --size 64x36 --render-size 64x36 \
+            2>err.txt || { cat err.txt; return 1; }
+        grep -qF "warm-up for tick 240: the effects' history $want" err.txt || { echo "$demo:"; cat err.txt; return 1; }
+    done
+}
+
+t_run every_demo_from_a_mid_tick other_size_and_capture warmup_reported
 t_done
