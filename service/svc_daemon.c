@@ -139,12 +139,13 @@ static void worker_clear(svc_daemon *d, worker *w)
         }
     if (w->job.unit.kind == SVC_UNIT_SEGMENT && !w->keep)
         svc_segment_remove(w->f.segdir, w->job.unit.index, w->job.unit.attempts);
-    /* the job is over (failed, cancelled, done): its segments go too */
+    /* the job is over (failed, cancelled, done): its segments go too, and
+     * whatever crashed attempts (of any daemon) left */
     svc_job cur;
     rs_err err = {0};
-    if (w->f.segdir[0] && d->store->ops->get(d->store, w->job.id, &cur, &err) == 1 && cur.state != SVC_QUEUED &&
+    if (w->busy && d->store->ops->get(d->store, w->job.id, &cur, &err) == 1 && cur.state != SVC_QUEUED &&
         cur.state != SVC_RUNNING)
-        svc_remove_dir(w->f.segdir);
+        svc_remove_job_files(&d->cfg, w->job.id);
     svc_job_free(&w->job);
     free(w->units);
     free(w->bad);

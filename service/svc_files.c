@@ -200,6 +200,22 @@ void svc_remove_dir(const char *path)
     rmdir(path);
 }
 
+void svc_remove_job_files(const svc_config *cfg, int64_t id)
+{
+    char prefix[48], path[1400];
+    snprintf(prefix, sizeof prefix, ".job%" PRId64 "-", id);
+    DIR *dir = opendir(cfg->output);
+    struct dirent *e;
+    while (dir && (e = readdir(dir)))
+        if (!strncmp(e->d_name, prefix, strlen(prefix))) {
+            snprintf(path, sizeof path, "%s/%s", cfg->output, e->d_name);
+            if (unlink(path) != 0 && (errno == EISDIR || errno == EPERM))
+                svc_remove_dir(path);
+        }
+    if (dir)
+        closedir(dir);
+}
+
 /* ".jobN-..." -> N; 0 when the name is not one of ours. */
 static int64_t job_of(const char *name)
 {

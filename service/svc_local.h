@@ -119,6 +119,9 @@ void svc_segment_path(char *out, size_t n, const char *segdir, int index, int at
 void svc_segment_remove(const char *segdir, int index, int attempt);
 /* A directory and what is in it. */
 void svc_remove_dir(const char *path);
+/* Everything hidden of job id in the output directory (".jobN-..."): its
+ * segments, temporaries of crashed renders and joins.  For a job that is over. */
+void svc_remove_job_files(const svc_config *cfg, int64_t id);
 /* Leftovers of jobs that are over or unknown, and of dead daemons' work files. */
 void svc_sweep(svc_daemon *d);
 
