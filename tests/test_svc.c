@@ -567,6 +567,42 @@ static void t_json_job(void)
     job_is(&j, JOB_HEAD "\"cancelled\"," JOB_NAME "\"frames_done\":0,\"frames_total\":0,\"progress\":0.0000,", false);
 }
 
+/* A split job: its segment count, and with its units who rendered what. */
+static void t_json_split_job(void)
+{
+    svc_job j = job(SVC_RUNNING);
+    j.segments = 2, j.segment_ticks = 60, j.frames_total = 120, j.frames_done = 90, j.fps = 20;
+    job_is(&j, "\"segment_seconds\":1,\"segment_count\":2,\"url\":", false);
+    svc_unit u[3] = {
+        {.kind = SVC_UNIT_SEGMENT, .index = 0, .first_tick = 0, .end_tick = 60, .state = SVC_DONE, .attempts = 2,
+         .renders = 1, .frames_done = 60},
+        {.kind = SVC_UNIT_SEGMENT, .index = 1, .first_tick = 60, .end_tick = 120, .state = SVC_RUNNING, .attempts = 1,
+         .frames_done = 30},
+        {.kind = SVC_UNIT_JOIN, .index = 2, .end_tick = 120},
+    };
+    snprintf(u[0].done_by, sizeof u[0].done_by, "box:1-ab/0");
+    snprintf(u[0].owner, sizeof u[0].owner, "stale"); /* a done unit names who finished it */
+    snprintf(u[0].error, sizeof u[0].error, "lease expired");
+    snprintf(u[1].owner, sizeof u[1].owner, "box:1-ab/1");
+    svc_buf b = {0};
+    svc_json_job(&b, &j, 3, u, 3);
+    T_ASSERT(b.p && !b.oom);
+    T_CONTAINS(b.p, "\"segment_seconds\":1,\"segment_count\":2,\"segments\":["
+                    "{\"index\":0,\"ticks\":[0,60],\"state\":\"done\",\"attempts\":2,\"renders\":1,"
+                    "\"frames_done\":60,\"worker\":\"box:1-ab/0\",\"error\":\"lease expired\"},"
+                    "{\"index\":1,\"ticks\":[60,120],\"state\":\"running\",\"attempts\":1,\"renders\":0,"
+                    "\"frames_done\":30,\"worker\":\"box:1-ab/1\",\"error\":null}],"
+                    "\"join\":{\"state\":\"queued\",\"attempts\":0,\"renders\":0,\"frames_done\":0,"
+                    "\"worker\":null,\"error\":null},\"url\":\"/jobs/42\"}");
+    T_CONTAINS(b.p, "\"progress\":0.7500,\"fps\":20.00,\"eta_s\":1.5,");
+    svc_buf_free(&b);
+    /* unsplit: not a word more than before */
+    j = job(SVC_RUNNING);
+    svc_json_job(&b, &j, 3, u, 3);
+    T_ASSERT(!strstr(b.p, "segment"));
+    svc_buf_free(&b);
+}
+
 static void t_json_buf_growth(void)
 {
     svc_buf b = {0};
@@ -847,7 +883,7 @@ T_MAIN({"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"c
        {"config_load_errors", t_config_load_errors}, {"config_finish", t_config_finish},
        {"config_dump_roundtrip", t_config_dump_roundtrip}, {"config_dump_hash", t_config_dump_hash},
        {"json_str_fixed", t_json_str_fixed}, {"json_str_f5_lead", t_json_str_f5_lead},
-       {"json_str_random", t_json_str_random}, {"json_job", t_json_job}, {"json_buf_growth", t_json_buf_growth},
+       {"json_str_random", t_json_str_random}, {"json_job", t_json_job}, {"json_split_job", t_json_split_job}, {"json_buf_growth", t_json_buf_growth},
        {"range_cases", t_range_cases}, {"range_random", t_range_random}, {"upload_refusals", t_upload_refusals},
        {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
