@@ -280,7 +280,8 @@ static void on_prog_line(worker *w, char *line)
 
 static void on_err_line(svc_daemon *d, worker *w, char *line)
 {
-    if (!*line)
+    /* a usage error's second line says where help is: the first says why */
+    if (!*line || (strstr(line, "see 'ringside ") && strstr(line, "--help'")))
         return;
     /* "ringside render: x.rsr: desync ..." -> the part after "render: " */
     const char *m = strstr(line, "ringside render: ");
@@ -549,7 +550,7 @@ static void tend(svc_daemon *d, worker *w, double now)
     int64_t before = w->done;
     drain(d, w, &w->prog_fd, w->prog_buf, sizeof w->prog_buf, &w->prog_len, true);
     drain(d, w, &w->err_fd, w->err_buf, sizeof w->err_buf, &w->err_len, false);
-    if (w->done > before) {
+    if (w->done > before && w->job.unit.kind != SVC_UNIT_JOIN) { /* a join copies frames, it draws none */
         pthread_mutex_lock(&d->mu);
         d->frames_rendered += (uint64_t)(w->done - before);
         pthread_mutex_unlock(&d->mu);

@@ -597,7 +597,7 @@ static enum MHD_Result do_metrics(svc_daemon *d, struct MHD_Connection *c)
     for (int i = 0; i < d->cfg.workers; i++)
         if (d->live[i].job) {
             busy++;
-            fps += d->live[i].fps;
+            fps += d->live[i].kind == SVC_UNIT_JOIN ? 0 : d->live[i].fps;
         }
     uint64_t frames = d->frames_rendered, done = d->jobs_done, failed = d->jobs_failed, retried = d->jobs_retried;
     uint64_t crashes = d->worker_crashes, wd = d->watchdog_kills, rejected = d->uploads_rejected;
