@@ -47,6 +47,16 @@ const char *cap_error_text(int code)
     return rs_err_text_of(code, RS_ERR_MOD_CAP, text, (int)(sizeof text / sizeof text[0]));
 }
 
+const char *cap_error_name(int code)
+{
+    static const char *const name[] = {
+#define X(id, t) #id,
+        CAP_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_CAP, name, (int)(sizeof name / sizeof name[0]));
+}
+
 bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err)
 {
     memset(s, 0, sizeof *s);

@@ -25,7 +25,17 @@
     X(ENCODER, "the encoder or the container refused the frames")                                     \
     X(GL, "the GL side of capture failed (target incomplete, fence or mapping)")                      \
     X(NOMEM, "out of memory, or no writer thread")                                                     \
-    X(FAILED, "the capture was closed as failed with no more precise reason")
+    X(FAILED, "the capture was closed as failed with no more precise reason")                          \
+    /* segments (cap_seg.h): why a segment cannot be joined */                                       \
+    X(SEG_MISSING, "a segment file or its manifest (.seg) is missing")                                 \
+    X(SEG_MANIFEST, "a segment's manifest is unreadable or malformed")                                 \
+    X(SEG_KEY, "a segment belongs to another job or attempt (its key differs)")                        \
+    X(SEG_FORMAT, "a segment's container or frame size differs from the others or from the output")   \
+    X(SEG_TICKS, "a segment's ticks do not continue from the segment before")                          \
+    X(SEG_SIZE, "a segment file's byte size differs from its manifest (truncated or grown)")           \
+    X(SEG_MEDIA, "a segment file does not open, or its packets differ from its manifest")             \
+    X(SEG_CODEC, "a segment's codec parameters differ from the others (no stream copy possible)")      \
+    X(SEG_HASHES, "a segment's frame hash list is missing, malformed or differs from its manifest")
 
 typedef enum cap_error {
     CAP_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_CAP),
@@ -36,6 +46,9 @@ typedef enum cap_error {
 } cap_error;
 
 const char *cap_error_text(int code);
+/* The id's own name, "SEG_KEY" for CAP_ERR_SEG_KEY ("?" outside the list):
+ * join's `bad INDEX REASON` lines carry it, lower case, without "SEG_". */
+const char *cap_error_name(int code);
 
 /* Frame layouts a sink can take. */
 typedef enum cap_pixfmt {
@@ -64,8 +77,12 @@ struct cap_sink {
     uint64_t frames;
     /* added to frame numbers where they are shown: image-sequence names
      * and the --hashes list (render --ticks A:B numbers frames from A);
-     * video timestamps still start at 0 */
+     * video timestamps still start at 0, unless segment */
     uint64_t index_base;
+    /* a segment (render --segment, cap_seg.h; FFmpeg sinks only): video
+     * timestamps start at index_base too, the first frame is a keyframe
+     * and no frame refers outside the file (closed GOP) */
+    bool segment;
 };
 
 /* Picks the sink from the output's extension (.y4m, .mp4, .mkv, .webm,

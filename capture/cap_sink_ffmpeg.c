@@ -2,7 +2,16 @@
  * through libavformat/libavcodec.  Frames arrive as I420 (BT.709, limited
  * range, chroma at the centre) and are tagged as such.  Timing is exact:
  * time base 1/60, pts = frame index, every packet lasts one frame, so the
- * duration is frames / 60 s. */
+ * duration is frames / 60 s.
+ *
+ * A segment (s->segment, cap_seg.h) differs in two things only, so that
+ * every segment of one video has the same codec parameters: pts = tick
+ * (index_base + index), and the GOP is closed by flag as well as by
+ * x264's default.  Its first frame is a keyframe because every encoder
+ * starts with one.  With x264's B-frames (delay D = 2 at veryfast) the
+ * dts of the k-th packet is A + k - D: pts are consecutive, so x264's dts
+ * (the pts D packets earlier in presentation order) run on across
+ * segment boundaries without a gap or a repeat. */
 #ifdef RS_HAVE_FFMPEG /* configure.sh found libavformat; otherwise this file is empty */
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
@@ -109,6 +118,8 @@ static bool ff_open(cap_sink *s, rs_err *err)
     e->color_primaries = AVCOL_PRI_BT709;
     e->color_trc = AVCOL_TRC_BT709;
     e->chroma_sample_location = AVCHROMA_LOC_CENTER;
+    if (s->segment)
+        e->flags |= AV_CODEC_FLAG_CLOSED_GOP;
     if (!strcmp(codec->name, "libx264")) {
         av_opt_set(e->priv_data, "preset", "veryfast", 0);
         av_opt_set(e->priv_data, "crf", "20", 0);
@@ -131,7 +142,15 @@ static bool ff_open(cap_sink *s, rs_err *err)
         fail_av(err, CAP_ERR_CREATE, f->part, "cannot create", r);
         goto fail;
     }
-    if ((r = avformat_write_header(f->fmt, NULL)) < 0) {
+    AVDictionary *mux = NULL;
+    if (s->segment && !strcmp(ext, ".mp4"))
+        /* a segment from tick A starts with an empty edit of A ticks; in the
+         * default 1/1000 movie time scale that is rounded (68 ticks read
+         * back as 67.96), in a multiple of 60 it is exact */
+        av_dict_set(&mux, "movie_timescale", "15360", 0);
+    r = avformat_write_header(f->fmt, &mux);
+    av_dict_free(&mux);
+    if (r < 0) {
         fail_av(err, CAP_ERR_WRITE, s->path, "cannot write the header", r);
         goto fail;
     }
@@ -161,7 +180,7 @@ static bool ff_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *
             memcpy(f->frame->data[p] + (size_t)y * f->frame->linesize[p], plane + (size_t)y * pw, (size_t)pw);
         plane += (size_t)pw * ph;
     }
-    f->frame->pts = (int64_t)index;
+    f->frame->pts = (int64_t)index + (s->segment ? (int64_t)s->index_base : 0);
     if ((r = avcodec_send_frame(f->enc, f->frame)) < 0) {
         char what[64];
         snprintf(what, sizeof what, "encoding frame %llu", (unsigned long long)index);

@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <inttypes.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,6 +11,7 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_stage.h"
+#include "../runtime/util/rs_progress.h"
 
 void cli_error(const char *cmd, const char *fmt, ...)
 {
@@ -31,6 +33,17 @@ int cli_bad_option(const char *cmd, char *const *argv)
 {
     cli_error(cmd, "bad option or missing value '%s'", argv[optind - 1]);
     return cli_usage_error(cmd);
+}
+
+void cli_progress_fd(int fd, uint64_t done, uint64_t total, double *last)
+{
+    if (fd < 0)
+        return;
+    double now = rs_now();
+    if (done < total && now - *last < 0.25)
+        return;
+    *last = now;
+    dprintf(fd, "frames %" PRIu64 " %" PRIu64 "\n", done, total);
 }
 
 bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out)

@@ -5,7 +5,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2 };
+/* 3: join only, one or more segments are bad (they are to be rendered again) */
+enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2, RS_EXIT_SEGMENT = 3 };
 
 typedef struct cli_cmd {
     const char *name;
@@ -13,6 +14,10 @@ typedef struct cli_cmd {
     const char *summary;
 } cli_cmd;
 
+/* --progress-fd: "frames DONE TOTAL" on fd for programs (ringside serve),
+ * at most 4 lines a second, and always the last; fd < 0: nothing.
+ * last: when the previous line went out (start at 0). */
+void cli_progress_fd(int fd, uint64_t done, uint64_t total, double *last);
 /* Parses "WxH" with 1 <= W,H <= max; prints a usage error naming opt. */
 bool cli_size(const char *opt, const char *arg, int max, int *w, int *h);
 /* Parses a non-negative 64-bit number (decimal or 0x hex). */
@@ -42,6 +47,7 @@ int cmd_movie(int argc, char **argv);
 int cmd_attract(int argc, char **argv);
 int bench_upload(int argc, char **argv);
 int cmd_serve(int argc, char **argv);
+int cmd_join(int argc, char **argv);
 
 /* Exit status for a failed plat_create: 2 for an unknown backend name. */
 struct rs_err;

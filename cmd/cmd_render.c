@@ -1,4 +1,5 @@
 /* ringside render: a replay to a video, headless, one frame per tick. */
+#include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
 #include <signal.h>
@@ -6,10 +7,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../capture/cap.h"
+#include "../capture/cap_seg.h"
 #include "cli.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
@@ -27,7 +28,8 @@ static void help(void)
            "                       [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
-           "                       [--hdr-format rgba16f|r11g11b10f]\n\n"
+           "                       [--hdr-format rgba16f|r11g11b10f]\n"
+           "                       [--ticks A:B] [--segment KEY] [--progress-fd N]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension:\n"
            "%s.\n"
@@ -56,6 +58,12 @@ static void help(void)
            "  --ticks A:B        write only ticks A to B-1 (the game still runs from tick 0,\n"
            "                     so frame A is the same as in a full render; image names and\n"
            "                     --hashes lines are numbered A..B-1)\n"
+           "  --segment KEY      write a segment that 'ringside join' can put together with the\n"
+           "                     others (.mp4, .mkv or .webm): first frame a keyframe, closed GOP,\n"
+           "                     timestamps from tick A; beside it OUT.seg, its manifest (KEY,\n"
+           "                     ticks, sizes, checksums), written last.  KEY ([A-Za-z0-9._:-],\n"
+           "                     at most 64) names the job and attempt; --hashes, if given, must\n"
+           "                     be OUT with its extension replaced by .hashes (docs/segments.md)\n"
            "  --progress-fd N    also report progress on file descriptor N, for programs\n"
            "                     (ringside serve): 'frames DONE TOTAL' lines, and 'desync TICK'\n"
            "                     if the replay's state hashes stop matching\n"
@@ -76,20 +84,6 @@ static void on_signal(int sig)
     stop_requested = 1;
 }
 
-/* --progress-fd: machine-readable progress, at most 4 lines a second. */
-static void report_progress(int fd, uint64_t done, uint64_t total, double *last)
-{
-    if (fd < 0)
-        return;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    double now = (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-    if (done < total && now - *last < 0.25)
-        return;
-    *last = now;
-    dprintf(fd, "frames %" PRIu64 " %" PRIu64 "\n", done, total);
-}
-
 int cmd_render(int argc, char **argv)
 {
     static const struct option opts[] = {
@@ -102,8 +96,9 @@ int cmd_render(int argc, char **argv)
         {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
         {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
         {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
-        {"help", no_argument, 0, 'h'},             {0}};
-    const char *out = NULL, *hashes = NULL, *backend = NULL;
+        {"segment", required_argument, 0, 'S'},    {"help", no_argument, 0, 'h'},
+        {0}};
+    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
     r_game_opts go = {0};
@@ -184,6 +179,14 @@ int cmd_render(int argc, char **argv)
             break;
         }
         case 'H': hashes = optarg; break;
+        case 'S':
+            if (!cap_seg_key_ok(optarg)) {
+                cli_error("render", "--segment '%s': expected a key of 1 to %d characters from A-Z a-z 0-9 . _ : -", optarg,
+                          CAP_SEG_KEY_MAX);
+                return RS_EXIT_USAGE;
+            }
+            segment = optarg;
+            break;
         case 'b': backend = optarg; break;
         case 'q': quiet = true; break;
         case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
@@ -206,6 +209,20 @@ int cmd_render(int argc, char **argv)
     if (go.mask && fmt != CAP_RGBA) {
         cli_error("render", "--mask writes RGBA images: give -o an image pattern such as cut/f%%04d.png, not %s", out);
         return RS_EXIT_USAGE;
+    }
+    char seg_hashes[1100], seg_manifest[1100];
+    if (segment) {
+        /* join finds a segment's list by name, so there is one name for it */
+        cap_seg_hashes_path(out, seg_hashes, sizeof seg_hashes);
+        cap_seg_manifest_path(out, seg_manifest, sizeof seg_manifest);
+        if (!cap_seg_format_of(out)) {
+            cli_error("render", "--segment writes .mp4, .mkv or .webm, not %s", out);
+            return RS_EXIT_USAGE;
+        }
+        if (hashes && strcmp(hashes, seg_hashes) != 0) {
+            cli_error("render", "--segment: --hashes must be %s (where join looks for it), not %s", seg_hashes, hashes);
+            return RS_EXIT_USAGE;
+        }
     }
     go.quiet = quiet;
     if (!cap_check_sizes_for(fmt, cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
@@ -244,6 +261,12 @@ int cmd_render(int argc, char **argv)
     if (!cap_sink_for(out, cd.w, cd.h, &sink, &err))
         goto done;
     sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
+    sink.segment = segment != NULL;
+    /* a manifest says "complete": an older one must not vouch for the files this render replaces */
+    if (segment && unlink(seg_manifest) != 0 && errno != ENOENT) {
+        rs_fail(&err, 1, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
+        goto done;
+    }
     struct stat hst;
     if (hashes && stat(hashes, &hst) == 0 && !S_ISREG(hst.st_mode)) {
         rs_fail(&err, 1, "%s: exists and is not a regular file (--hashes)", hashes);
@@ -275,7 +298,7 @@ int cmd_render(int argc, char **argv)
     rs_progress prog;
     rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet);
     double last_report = 0;
-    report_progress((int)progress_fd, 0, t_end - t_first, &last_report);
+    cli_progress_fd((int)progress_fd, 0, t_end - t_first, &last_report);
     job_render j;
     bool ok = job_render_begin(
         &j, &(job_render_desc){.rp = &rp, .game = r, .target = &t, .cap = cp, .name = replay, .first = t_first, .end = t_end},
@@ -292,7 +315,7 @@ int cmd_render(int argc, char **argv)
         if (j.desync)
             break;
         rs_progress_update(&prog, tick + 1 - t_first);
-        report_progress((int)progress_fd, tick + 1 - t_first, t_end - t_first, &last_report);
+        cli_progress_fd((int)progress_fd, tick + 1 - t_first, t_end - t_first, &last_report);
     }
     if (j.desync) {
         /* the render's own words: the replay's message, and that no output is left */
@@ -320,6 +343,13 @@ int cmd_render(int argc, char **argv)
             goto done;
         }
         hpart[0] = 0;
+    }
+    if (segment && !cap_seg_seal(out, segment, t_first, t_end, hashes, &err)) {
+        /* no manifest, no segment: the files go too */
+        unlink(out);
+        if (hashes)
+            unlink(hashes);
+        goto done;
     }
     if (!quiet)
         fprintf(stderr,

@@ -32,10 +32,32 @@ bool job_render_begin(job_render *j, const job_render_desc *desc, rs_err *err)
         return rs_fail(err, 1, "%s: tick %" PRIu64 " is past the replay's end (%" PRIu64 " ticks)", d->name, d->end,
                        d->rp->ticks);
     g_init(&j->cur, d->rp->stage, d->rp->seed);
-    while (j->tick < d->first)
+    j->warm_from = d->first;
+    r_game_restart(d->game); /* tick 0, or the warm-up's first tick, starts a sequence */
+    if (d->first > 0) {
+        int64_t h = r_game_history(d->game, j->cur.stage, err);
+        if (h < R_GAME_FROM_START)
+            return false;
+        j->warm_from = h == R_GAME_FROM_START || (uint64_t)h >= d->first ? 0 : d->first - (uint64_t)h;
+    }
+    while (j->tick < j->warm_from)
         if (!step(j, err))
             return false;
-    return true;
+    double t0 = rs_now();
+    gl.BindFramebuffer(GL_FRAMEBUFFER, d->target->fbo);
+    bool ok = true;
+    while (ok && j->tick < d->first) {
+        j->prev = j->cur;
+        if (!(ok = step(j, err)))
+            break;
+        bool drew = false;
+        if (!(ok = r_game_advance(d->game, &j->prev, &j->cur, d->target->w, d->target->h, d->first - j->tick + 1, &drew)))
+            rs_fail(err, 1, "warming up for tick %" PRIu64 ": %s", d->first, r_game_error(d->game));
+        j->warm_drawn += drew;
+    }
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    j->ms_warm = (rs_now() - t0) * 1e3;
+    return ok;
 }
 
 int job_render_next(job_render *j, rs_err *err)

@@ -5,7 +5,9 @@
  * of tick T is drawn after stepping T's inputs, interpolating nothing
  * (prev = the state before T, cur = after, alpha 1), into the target's
  * framebuffer, and handed to the capture if there is one.  Ticks before the
- * first frame are simulated only.  Unless told not to, every tick is
+ * first frame are simulated, and those whose effect history reaches frame
+ * `first` (r_game_history) are advanced too, so that any frame is the
+ * one a render from tick 0 draws, bit for bit.  Unless told not to, every tick is
  * checked against the replay's checkpoints (rp_check_tick), so a replay
  * that desyncs stops at the first tick that differs.
  *
@@ -48,11 +50,17 @@ typedef struct job_render {
     uint64_t frames;         /* frames drawn */
     uint64_t desync;         /* 0, or the tick whose state hash did not match */
     double ms_draw;          /* simulate + draw calls of the drawn frames, on this thread, summed */
+    /* the warm-up before the first frame (r_game.h): effect history rebuilt
+     * from tick warm_from so that frame `first` is the full render's */
+    uint64_t warm_from;      /* first tick advanced (= first when no effect carries history) */
+    uint64_t warm_drawn;     /* of the warm-up ticks, those drawn (LSPSM's window) */
+    double ms_warm;          /* the warm-up's simulate + advance + draw calls, summed */
     size_t next_check;       /* for rp_check_tick */
 } job_render;
 
-/* Applies the defaults and simulates up to the first frame.  False with err
- * filled on a desync (j->desync says where) or a bad descriptor. */
+/* Applies the defaults, simulates up to the first frame and warms the
+ * effects up for it.  False with err filled on a desync (j->desync says
+ * where), a bad descriptor or a look that does not load. */
 bool job_render_begin(job_render *j, const job_render_desc *desc, rs_err *err);
 
 /* Simulates up to the next frame's tick, steps it, draws it and captures it.

@@ -14,6 +14,7 @@ static const cli_cmd commands[] = {
     {"shaders", cmd_shaders, "compile every shader in shaders/ and report errors"},
     {"play", cmd_play, "play in a window (or watch a replay), fixed 60 Hz"},
     {"render", cmd_render, "render a replay to a video (.y4m, .mp4, ...), headless"},
+    {"join", cmd_join, "join segments (render --segment) into one video, by stream copy"},
     {"record", cmd_record, "record a CPU-vs-CPU match headless to a replay"},
     {"attract", cmd_attract, "the cabinet's attract loop: movies and demos until a button starts a match"},
     {"movie", cmd_movie, "play a movie (Y4M or anything FFmpeg decodes) on the 60 Hz tick"},
@@ -34,7 +35,7 @@ static void usage(FILE *f)
     fprintf(f, "\nGL backends built in: %s (headless default: egl, then osmesa)\n"
                "environment: RINGSIDE_DATA (directory holding shaders/), RINGSIDE_GL_DEBUG=1,\n"
                "             RINGSIDE_EGL_DEVICE=N\n"
-               "exit status: 0 success, 1 failure, 2 bad usage\n"
+               "exit status: 0 success, 1 failure, 2 bad usage (join: 3, a bad segment)\n"
                "docs: README.md and docs/ in the source tree\n",
             plat_built_backends());
 }

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "../capture/cap.h"
+#include "../capture/cap_seg.h"
 #include "../capture/cap_writer.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
@@ -245,6 +246,28 @@ static void t_error_ids_have_texts(void)
             T_ASSERTF(strcmp(t, cap_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
     }
     T_ASSERT(!strcmp(cap_error_text(CAP_ERR_END), "?"));
+    /* join's 'bad INDEX REASON' words come from the ids' names */
+    T_ASSERT(!strcmp(cap_error_name(CAP_ERR_SEG_KEY), "SEG_KEY"));
+    T_ASSERT(!strcmp(cap_error_name(CAP_ERR_SEG_HASHES), "SEG_HASHES"));
+    T_ASSERT(!strcmp(cap_error_name(CAP_ERR_END), "?"));
+}
+
+/* The names a segment's files go by (join finds them by these rules). */
+static void t_segment_names(void)
+{
+    char p[64];
+    cap_seg_hashes_path("out/.job4/s2.mp4", p, sizeof p);
+    T_ASSERT(!strcmp(p, "out/.job4/s2.hashes"));
+    cap_seg_hashes_path("a.dir/seg", p, sizeof p); /* a dot in a directory is no extension */
+    T_ASSERT(!strcmp(p, "a.dir/seg.hashes"));
+    cap_seg_manifest_path("out/s2.webm", p, sizeof p);
+    T_ASSERT(!strcmp(p, "out/s2.webm.seg"));
+    T_ASSERT(!strcmp(cap_seg_format_of("x/s.mkv"), "mkv") && !strcmp(cap_seg_format_of("s.webm"), "webm"));
+    T_ASSERT(!cap_seg_format_of("s.y4m") && !cap_seg_format_of("mp4") && !cap_seg_format_of("a.mp4/s"));
+    T_ASSERT(cap_seg_key_ok("job42-a3") && cap_seg_key_ok("j:1.2_x") &&
+             cap_seg_key_ok("aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"));
+    T_ASSERT(!cap_seg_key_ok("") && !cap_seg_key_ok("a b") && !cap_seg_key_ok("a/b") && !cap_seg_key_ok("k\n") &&
+             !cap_seg_key_ok("aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"));
 }
 
 /* A test picture in a texture: gradients and hard edges; `shift` moves
@@ -365,4 +388,5 @@ T_MAIN({"queue_cap_holds", t_queue_cap_holds}, {"inline_queue", t_inline_queue},
        {"hash_is_fnv1a", t_hash_is_fnv1a}, {"cpu_yuv_known_colours", t_cpu_yuv_known_colours},
        {"cpu_downscale_averages_and_flips", t_cpu_downscale_averages_and_flips}, {"sizes", t_sizes},
        {"sink_errors", t_sink_errors}, {"error_ids_have_texts", t_error_ids_have_texts},
+       {"segment_names", t_segment_names},
        {"gpu_matches_cpu_egl", t_gpu_matches_cpu_egl}, {"gpu_matches_cpu_osmesa", t_gpu_matches_cpu_osmesa})

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../runtime/game/g_game.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_fx.h"
@@ -36,7 +37,7 @@ static void frame_at(const char *demo, uint64_t a, bool advance, frame_px *out)
         }
         rgl_error_reset();
         gl.BindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
-        T_ASSERTF(r_game_advance(r, &prev, &cur, W, H), "%s", r_game_error(r));
+        T_ASSERTF(r_game_advance(r, &prev, &cur, W, H, a - t, NULL), "%s", r_game_error(r));
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
         T_EQ(rgl_error_count(), 0);
         T_EQ(gl.GetError(), GL_NO_ERROR);
@@ -63,17 +64,78 @@ static void same_frame(const char *demo, uint64_t a, const char *effect)
     free(drawn), free(advanced);
 }
 
-/* Every module declares a warm-up and has a way to move its history on:
- * none (stateless), an advance hook, or the drawn frame (needs_frame). */
+/* Every module with history has a way to move it on: an advance hook, or
+ * the drawn frame (needs_frame). */
 static void t_every_module_declares_its_history(void)
 {
     for (int m = 0; m < r_fx_nmodules; m++) {
         const r_fx_module *mod = r_fx_modules[m];
-        T_ASSERTF(mod->warmup == R_FX_STATELESS || mod->warmup == R_FX_FROM_START || mod->warmup > 0,
-                  "%s: warm-up %d", mod->name, mod->warmup);
-        if (mod->warmup != R_FX_STATELESS)
+        if (mod->warmup)
             T_ASSERTF(mod->advance || mod->needs_frame, "%s carries history but has no way to advance it", mod->name);
+        if (mod->needs_frame)
+            T_ASSERTF(mod->advance, "%s: a windowed module needs advance for the resets before its window", mod->name);
     }
+}
+
+/* r_game_history per stage, as docs/effects.md lists it: from tick 0 where
+ * a simulation carries its state, LSPSM's window on plaza, nothing on the
+ * stages without stateful effects. */
+static void t_history_per_stage(void)
+{
+    plat *p = t_context("egl");
+    r_game *r = t_game_new(false);
+    static const struct {
+        const char *stage;
+        int64_t want;
+    } want[] = {{"dojo", 0},
+                {"harbor", 0},
+                {"temple", 0},
+                {"shallows", R_GAME_FROM_START},
+                {"snowfield", R_GAME_FROM_START},
+                {"mistvale", R_GAME_FROM_START},
+                {"plaza", 228},
+                {"quarry", 0}};
+    for (int i = 0; i < (int)(sizeof want / sizeof want[0]); i++) {
+        int st = -1;
+        for (int k = 0; k < G_STAGES; k++)
+            if (!strcmp(g_stages[k].name, want[i].stage))
+                st = k;
+        T_ASSERTF(st >= 0, "no stage %s", want[i].stage);
+        rs_err err = {0};
+        int64_t h = r_game_history(r, st, &err);
+        T_ASSERTF(h == want[i].want, "%s: history %lld ticks, want %lld (%s)", want[i].stage, (long long)h,
+                  (long long)want[i].want, err.msg);
+    }
+    r_game_destroy(r);
+    plat_destroy(p);
+}
+
+/* The warm-up is needed: on each stage with a simulation, drawing a tick
+ * straight after a restart (no history) differs from the full render, so
+ * the checks above and tests/test_ticks.sh fail when a warm-up is skipped. */
+static void t_history_matters(void)
+{
+    plat *p = t_context("egl");
+    static const char *demos[] = {"shallows", "snowfield", "mistvale"};
+    static const uint64_t at[] = {45, 120, 45}; /* the first footprints leave the stance's at 45 */
+    for (int i = 0; i < 3; i++) {
+        frame_px *drawn = calloc(1, sizeof *drawn), *cold = calloc(1, sizeof *cold);
+        T_ASSERT(drawn && cold);
+        frame_at(demos[i], at[i], false, drawn);
+        t_fb fb;
+        t_fb_make(&fb, W, H);
+        r_game *r = t_game_new(false);
+        g_state prev, cur;
+        t_state_at(demos[i], at[i], &prev, &cur);
+        t_draw_read(r, &fb, &prev, &cur, W, H, cold->rgba, false);
+        r_game_destroy(r);
+        t_fb_free(&fb);
+        T_ASSERTF(memcmp(drawn->rgba, cold->rgba, sizeof drawn->rgba), "%s: tick %llu drawn cold equals the full render",
+                  demos[i], (unsigned long long)at[i]);
+        free(drawn->hdr);
+        free(drawn), free(cold);
+    }
+    plat_destroy(p);
 }
 
 /* The ticks: long enough for contacts, splats and a stirred mist. */
@@ -107,6 +169,8 @@ static void t_lspsm_history(void)
 }
 
 T_MAIN({"every_module_declares_its_history", t_every_module_declares_its_history},
+       {"history_per_stage", t_history_per_stage},
+       {"history_matters", t_history_matters},
        {"fog_history", t_fog_history},
        {"snow_history", t_snow_history},
        {"water_history", t_water_history},

@@ -125,6 +125,29 @@ static void t_inconsistent_needed_is_an_error(void)
     T_CONTAINS(r_graph_error(&g), "frame 1:");
 }
 
+/* r_graph_run_skip: the passes in the mask are not called and not counted,
+ * and a reader of what they write is no error (their last contents stand
+ * in); the others run as usual. */
+static void t_run_skip(void)
+{
+    r_graph g;
+    rs_err e = {0};
+    r_graph_init(&g, 0, names, 4);
+    T_ASSERT(r_graph_add(&g, &(r_pass){"make_b", 0, R_B, yes, run0, 0}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"use_b", R_B, R_C, yes, run1, 0}, &e));
+    T_ASSERT(r_graph_add(&g, &(r_pass){"out", R_C, R_OUT, yes, run2, 0}, &e));
+    world w = {0};
+    T_EQ(r_graph_run_skip(&g, &w, 0x1 | 0x4), 0x2);
+    T_EQ(w.n, 1);
+    T_EQ(w.order[0], 1);
+    T_EQ(g.stats[0].runs + g.stats[0].skips, 0);
+    T_EQ(g.stats[1].runs, 1);
+    T_ASSERTF(!r_graph_error(&g)[0], "%s", r_graph_error(&g));
+    w.n = 0;
+    T_EQ(r_graph_run(&g, &w), 0x7);
+    T_EQ(w.n, 3);
+}
+
 /* Timing on a GL context: every pass that ran gets a time, skipped ones
  * none, and the report names them all. */
 static int frames_seen;
@@ -201,5 +224,5 @@ static void t_timing_and_report(void)
 }
 
 T_MAIN({"validation_at_add", t_validation_at_add}, {"skipped_pass_is_not_called", t_skipped_pass_is_not_called},
-       {"inconsistent_needed_is_an_error", t_inconsistent_needed_is_an_error},
+       {"inconsistent_needed_is_an_error", t_inconsistent_needed_is_an_error}, {"run_skip", t_run_skip},
        {"timing_and_report", t_timing_and_report})

@@ -531,6 +531,54 @@ static void t_focus_grow_shrink(void)
     }
 }
 
+/* r_lspsm_focus_memory: a range rebuilt from a reset with the last M
+ * frames' samples equals, bit for bit, the range after any longer history
+ * (render --ticks A:B draws those M frames before A); and M is tight: M - 1
+ * frames of a near wall after a far view are not enough. */
+static void t_focus_memory(void)
+{
+    seed();
+    frame_cam c = focus_cam();
+    r_lspsm_focus def = {0};
+    int m = r_lspsm_focus_memory(&def);
+    /* the limit shrinking 2 % a frame reaches the minimum (1 m of 100 m) */
+    int want = (int)ceil(log(R_LSPSM_MIN_RANGE / R_LSPSM_LIMIT) / log(1 - R_LSPSM_SHRINK));
+    T_ASSERTF(m >= want && m <= want + 2, "memory %d frames, want about %d", m, want);
+    enum { HIST = 900 };
+    static float depth[HIST][R_LSPSM_FOCUS_N];
+    for (int trial = 0; trial < 60; trial++) {
+        int n = m + (int)(urand() * (HIST - m)); /* frames of history */
+        for (int i = 0; i < n; i++) {
+            double u = urand();
+            /* walls near and far, sky now and then, and long near stretches at the end
+               (the slowest case for the rebuilt range: it must shrink all the way) */
+            double d = i > n - m / 2 && trial % 3 == 0 ? 0.2 : u < 0.05 ? 0 : urange(0.2, 150);
+            wall(depth[i], d);
+        }
+        r_lspsm_focus full = {0}, rebuilt = {0};
+        for (int i = 0; i < n; i++)
+            r_lspsm_focus_update(&full, depth[i], c.w, c.h, c.inv);
+        for (int i = n - m; i < n; i++)
+            r_lspsm_focus_update(&rebuilt, depth[i], c.w, c.h, c.inv);
+        T_ASSERTF(full.range == rebuilt.range, "trial %d: %d frames of history give %.9g, the last %d give %.9g", trial,
+                  n, full.range, m, rebuilt.range);
+    }
+    /* tight: the sky, then a near wall for m frames */
+    float sky[R_LSPSM_FOCUS_N], near[R_LSPSM_FOCUS_N];
+    wall(sky, 0);
+    wall(near, 0.2);
+    r_lspsm_focus full = {0}, rebuilt = {0};
+    r_lspsm_focus_update(&full, sky, c.w, c.h, c.inv);
+    for (int i = 0; i < 2 * m; i++)
+        r_lspsm_focus_update(&full, near, c.w, c.h, c.inv);
+    for (int i = 0; i < m - 1; i++)
+        r_lspsm_focus_update(&rebuilt, near, c.w, c.h, c.inv);
+    T_ASSERTF(full.range != rebuilt.range, "%d frames already rebuild the range (%.9g): the memory is not tight", m - 1,
+              rebuilt.range);
+    r_lspsm_focus_update(&rebuilt, near, c.w, c.h, c.inv);
+    T_ASSERTF(full.range == rebuilt.range, "%d frames: %.9g, want %.9g", m, rebuilt.range, full.range);
+}
+
 static void t_focus_nan(void)
 {
     frame_cam c = focus_cam();
@@ -756,5 +804,5 @@ static void t_density_rows(void)
 
 T_MAIN({"unit_cube_random", t_unit_cube_random}, {"unit_cube_degenerate", t_unit_cube_degenerate},
        {"density", t_density}, {"no_pop", t_no_pop}, {"focus_pattern", t_focus_pattern},
-       {"focus_grow_shrink", t_focus_grow_shrink}, {"focus_nan", t_focus_nan}, {"fade", t_fade},
+       {"focus_grow_shrink", t_focus_grow_shrink}, {"focus_memory", t_focus_memory}, {"focus_nan", t_focus_nan}, {"fade", t_fade},
        {"box_exit", t_box_exit}, {"cull", t_cull}, {"camera_from", t_camera_from}, {"density_rows", t_density_rows})

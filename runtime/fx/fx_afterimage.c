@@ -165,5 +165,4 @@ static const r_pass passes[] = {
 const r_fx_module fx_afterimage_module = {
     .name = "afterimage", .create = create, .destroy = destroy,
     .pass = {[R_FX_TRANSLUCENT] = passes}, .npass = {[R_FX_TRANSLUCENT] = 1},
-    .warmup = R_FX_STATELESS,
 };

@@ -205,6 +205,11 @@ static void fog_advance(r_game *r)
         sim_follow(r);
 }
 
+static int fog_warmup(r_game *r)
+{
+    return need_fog(r) ? R_FX_FROM_START : R_FX_STATELESS;
+}
+
 static const r_pass fog_passes[] = {
     {"fog_map", 0, RES_FOGMAP, need_fog, run_fog_map, 0},
 };
@@ -326,7 +331,7 @@ const r_fx_module fx_fog_module = {
     .pass = {fog_passes}, .npass = {(int)(sizeof fog_passes / sizeof fog_passes[0])},
     .res = {{RES_FOGMAP, "fog map", false}}, .scene_reads = RES_FOGMAP,
     .units = 1, .bind = fog_bind,
-    .warmup = R_FX_FROM_START, .advance = fog_advance,
+    .warmup = fog_warmup, .advance = fog_advance,
 };
 
 /* ---- tests and bench accuracy ---- */

@@ -213,7 +213,6 @@ const r_fx_module fx_holes_module = {
     .name = "holes", .create = holes_create, .destroy = holes_destroy,
     .pass = {holes_passes}, .npass = {(int)(sizeof holes_passes / sizeof holes_passes[0])},
     .scene_cleared = holes_scene_cleared, .draw_ring = holes_draw_ring,
-    .warmup = R_FX_STATELESS,
 };
 
 int fx_holes_drawn(r_game *r)

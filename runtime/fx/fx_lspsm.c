@@ -375,15 +375,30 @@ static bool lspsm_load(r_game *r, rs_err *err)
 
 /* History: the auto-focus range, and the depth samples read back one
  * frame late.  The range follows the farthest sample at once when it
- * grows and shrinks at most 2 % a frame (R_LSPSM_SHRINK), so in general
- * every frame since the reset counts; and the samples are the drawn
- * frame's depth buffer (the ring, the craters, the buildings, the
- * fighters), which only drawing the frame gives.  So there is no advance
- * hook: needs_frame makes r_game_advance draw the frame on an LSPSM stage,
- * which moves every module's history on exactly as a full render does. */
+ * grows and shrinks at most 2 % a frame (R_LSPSM_SHRINK); the samples are
+ * the drawn frame's depth buffer (the ring, the craters, the buildings,
+ * the fighters), which only drawing the frame gives.  So:
+ *   warm-up      r_lspsm_focus_memory frames (228 with the defaults): a
+ *                range rebuilt from a reset that long ago equals the full
+ *                render's, bit for bit (r_lspsm.h says why);
+ *   needs_frame  inside that window the frames are drawn;
+ *   advance      before it, only a reset reaches the module: it forgets
+ *                the samples and the range, so the window starts from the
+ *                reset state whatever this renderer drew before. */
+static int lspsm_warmup(r_game *r)
+{
+    return need_map(r) ? r_lspsm_focus_memory(&LSPSM(r)->focus) : R_FX_STATELESS;
+}
+
 static bool lspsm_needs_frame(r_game *r)
 {
     return need_map(r);
+}
+
+static void lspsm_advance(r_game *r)
+{
+    if (LSPSM(r) && r->f.reset)
+        take_focus(LSPSM(r), true);
 }
 
 const r_fx_module fx_lspsm_module = {
@@ -393,7 +408,7 @@ const r_fx_module fx_lspsm_module = {
               (int)(sizeof focus_passes / sizeof focus_passes[0])},
     .res = {{RES_LSPSM, "lspsm map", false}}, .scene_reads = RES_LSPSM,
     .units = 2, .bind = lspsm_bind,
-    .warmup = R_FX_FROM_START, .needs_frame = lspsm_needs_frame,
+    .warmup = lspsm_warmup, .advance = lspsm_advance, .needs_frame = lspsm_needs_frame,
 };
 
 /* ---- tests, bench and --passes ---- */

@@ -483,9 +483,14 @@ static void snow_advance(r_game *r)
         run_map(r);
 }
 
+static int snow_warmup(r_game *r)
+{
+    return need_snow(r) ? R_FX_FROM_START : R_FX_STATELESS;
+}
+
 const r_fx_module fx_snow_module = {
     .name = "snow", .create = snow_create, .destroy = snow_destroy, .load = snow_load,
     .pass = {pre, surface, NULL}, .npass = {3, 1, 0},
     .res = {{RES_SNOW, "snow", true}, {RES_SNOW_LIGHT, "snow light", false}},
-    .warmup = R_FX_FROM_START, .advance = snow_advance,
+    .warmup = snow_warmup, .advance = snow_advance,
 };

@@ -365,9 +365,11 @@ static float ring_half(const r_game *r)
     return st >= 0 && st < G_STAGES ? fx_to_float(g_stages[st].ring_half) : 4.0f;
 }
 
-static void run_sim(void *u)
+/* The automaton's part of water_sim: f->steps steps with this tick's
+ * splats (the history; water_advance runs only this).  False when no step
+ * ran and nothing was reset: the normal map still stands. */
+static bool step_sim(r_game *r)
 {
-    r_game *r = u;
     fx_water_state *w = WATER(r);
     frame *f = &r->f;
     if (f->reset)
@@ -386,9 +388,17 @@ static void run_sim(void *u)
      * tick's splats for each (there are no states between) */
     int steps = f->steps < R_WATER_MAX_STEPS ? f->steps : R_WATER_MAX_STEPS;
     gpu_steps(r, w, w->splat, w->nsplat, steps);
-    if (steps <= 0 && !f->reset)
+    return steps > 0 || f->reset;
+}
+
+static void run_sim(void *u)
+{
+    r_game *r = u;
+    fx_water_state *w = WATER(r);
+    if (!step_sim(r))
         return; /* the same tick again: the normal map stands */
-    /* the normal map from the heights */
+    /* the normal map from the heights: made for the drawn frame only (an
+     * advanced tick's would be made again before anyone reads it) */
     GLuint q = w->prog[W_NORMAL];
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->normal_fbo);
     gl.Viewport(0, 0, R_WATER_N, R_WATER_N);
@@ -636,11 +646,17 @@ static const r_pass surface[] = {
  * the normal map made from it: cleared on a reset, then one step per
  * tick with that tick's splats.  The waves are damped but never exactly
  * zero again, so every tick since the reset counts.  water_advance is the
- * water_sim pass: it draws into the automaton's own targets only. */
+ * water_sim pass's steps without the normal map (the drawn frame makes it
+ * from the heights): it draws into the automaton's own targets only. */
 static void water_advance(r_game *r)
 {
     if (need_water(r))
-        run_sim(r);
+        step_sim(r);
+}
+
+static int water_warmup(r_game *r)
+{
+    return need_water(r) ? R_FX_FROM_START : R_FX_STATELESS;
 }
 
 const r_fx_module fx_water_module = {
@@ -648,5 +664,5 @@ const r_fx_module fx_water_module = {
     .pass = {pre, surface, NULL}, .npass = {2, 2, 0},
     .res = {{RES_WATER, "water", true}, {RES_WATER_REFL, "water reflection", false},
             {RES_WATER_UNDER, "under water", false}},
-    .warmup = R_FX_FROM_START, .advance = water_advance,
+    .warmup = water_warmup, .advance = water_advance,
 };

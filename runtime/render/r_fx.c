@@ -67,11 +67,35 @@ bool r_fx_draw_ring(r_game *r)
     return false;
 }
 
-bool r_fx_needs_frame(r_game *r)
+int r_fx_warmup(r_game *r, const r_fx_module *m)
 {
-    for (int i = 0; i < r_fx_nmodules; i++)
-        if (r_fx_modules[i]->needs_frame && r_fx_modules[i]->needs_frame(r))
+    return m->warmup ? m->warmup(r) : R_FX_STATELESS;
+}
+
+int64_t r_fx_history(r_game *r)
+{
+    int64_t most = 0;
+    for (int i = 0; i < r_fx_nmodules; i++) {
+        int w = r_fx_warmup(r, r_fx_modules[i]);
+        if (w == R_FX_FROM_START)
+            return R_FX_FROM_START;
+        if (w > most)
+            most = w;
+    }
+    return most;
+}
+
+bool r_fx_needs_frame(r_game *r, uint64_t ahead)
+{
+    for (int i = 0; i < r_fx_nmodules; i++) {
+        const r_fx_module *m = r_fx_modules[i];
+        if (!m->needs_frame)
+            continue;
+        int w = r_fx_warmup(r, m);
+        bool in_window = w == R_FX_FROM_START || (w > 0 && ahead <= (uint64_t)w);
+        if (in_window && m->needs_frame(r))
             return true;
+    }
     return false;
 }
 

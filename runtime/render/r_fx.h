@@ -47,17 +47,28 @@
  * frame drawn last, 0 when a tick is drawn again) and restart when
  * r->f.reset is set, so a video of a replay (every tick drawn) is the same
  * on any machine.  What a module carries from one frame to the next is its
- * history; `advance` moves it on by exactly one game tick without drawing
- * (r_game_advance sets up r->f for that tick first), so that drawing ticks
- * 0..A-1 and then A gives the same frame A as advancing 0..A-1 and drawing
- * A.  `warmup` declares how much history frame A depends on:
- *   0 (R_FX_STATELESS)  none: the frame is a function of the game states
- *   N > 0               the last N ticks (older history has decayed)
- *   R_FX_FROM_START     every tick since the last reset (tick 0, a seek, a
- *                       new look)
- * A module whose history cannot be advanced without the frame itself says
- * so with needs_frame (true on this stage); r_game_advance then draws the
- * frame instead, which advances every module the way a full render does.
+ * history, and a render that starts at tick A > 0 (render --ticks A:B, a
+ * segment of a split job) rebuilds it exactly through three hooks:
+ *   warmup(r)       on the loaded stage, how much history frame A depends
+ *                   on: R_FX_STATELESS (0: the frame is a function of the
+ *                   game states), N > 0 (the last N ticks: older history
+ *                   provably no longer changes a bit of the frame), or
+ *                   R_FX_FROM_START (every tick since the last reset).
+ *                   NULL: stateless on every stage.
+ *   advance(r)      moves the history on by exactly one game tick without
+ *                   drawing (r_game_advance sets up r->f for the tick
+ *                   first, reset included).  Called on every advanced
+ *                   tick, inside the module's window or not, so that a
+ *                   reset reaches it; a module whose window is N ticks
+ *                   starts the window from its reset state.
+ *   needs_frame(r)  inside the module's window, true when its history
+ *                   cannot move on without the frame itself (LSPSM's
+ *                   auto-focus reads the drawn depth buffer): r_game_advance
+ *                   then draws the frame, which advances every module the
+ *                   way a full render does.
+ * So that drawing ticks 0..A-1 and then A gives the same frame A as
+ * advancing the ticks the modules ask for and drawing A
+ * (r_game_history says how far back that is).
  * docs/effects.md ("The effect contract") lists each effect's history. */
 #ifndef R_FX_H
 #define R_FX_H
@@ -129,9 +140,9 @@ typedef struct r_fx_module {
     bool (*scene_cleared)(r_game *r);
     bool (*draw_ring)(r_game *r);
     /* history */
-    int warmup;                       /* R_FX_STATELESS, N ticks or R_FX_FROM_START */
+    int (*warmup)(r_game *r);         /* on the loaded stage: R_FX_STATELESS, N ticks or R_FX_FROM_START */
     void (*advance)(r_game *r);       /* one game tick, r->f set up; draws nothing on screen */
-    bool (*needs_frame)(r_game *r);   /* its history needs the drawn frame on this stage */
+    bool (*needs_frame)(r_game *r);   /* in its window: its history needs the drawn frame */
 } r_fx_module;
 
 /* The table (runtime/fx/fx_table.c), in the order the passes run. */

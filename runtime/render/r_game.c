@@ -245,9 +245,22 @@ static bool build_graph(r_game *r, rs_err *err)
         &r_shadow_passes[4], &r_shadow_passes[5], NULL, &r_scene_pass, NULL, &r_sky_pass, NULL, &r_lens_pass,
         &r_post_passes[0], &r_post_passes[1], &r_post_passes[2], &r_post_passes[3], &r_post_passes[4], &r_hud_pass,
     };
+    /* The core's passes that only shade the picture: a frame drawn for the
+     * effects' history (LSPSM's focus reads the depth buffer) leaves them
+     * out.  z_prepass stays (the fighters are drawn over its depth), and so
+     * does every effect pass (an effect may step its history there). */
+    const r_pass *const shade_only[] = {
+        &r_shadow_passes[0], &r_shadow_passes[1], &r_shadow_passes[2], &r_shadow_passes[4], &r_shadow_passes[5],
+        &r_sky_pass, &r_lens_pass, &r_post_passes[0], &r_post_passes[1], &r_post_passes[2], &r_post_passes[3],
+        &r_post_passes[4], &r_hud_pass,
+    };
+    r->history_skip = 0;
     int phase = R_FX_PRE;
     for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
         if (order[i]) {
+            for (size_t k = 0; k < sizeof shade_only / sizeof shade_only[0]; k++)
+                if (order[i] == shade_only[k])
+                    r->history_skip |= (r_graph_mask)1 << r->graph.n;
             r_pass p = *order[i];
             if (p.run == r_scene_pass.run || p.run == r_sky_pass.run || p.run == r_lens_pass.run)
                 p.may_read |= fx_reads; /* what the modules bind into the scene's programs */
@@ -449,12 +462,33 @@ static void leave_state(GLint out)
     gl.Enable(GL_DEPTH_TEST);
 }
 
-bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h)
+static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip);
+
+int64_t r_game_history(r_game *r, int game_stage, rs_err *err)
+{
+    if (!r_game_prepare(r, game_stage, err))
+        return -2;
+    int64_t h = r_fx_history(r);
+    return h == R_FX_FROM_START ? R_GAME_FROM_START : h;
+}
+
+void r_game_restart(r_game *r)
+{
+    r->have_last = false;
+}
+
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h, uint64_t ahead, bool *drew)
 {
     rs_err err = {0};
-    if (w <= 0 || h <= 0 || !r_game_prepare(r, cur->stage, &err) ||
-        (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) || r_fx_needs_frame(r))
-        return r_game_draw(r, prev, cur, 1.0f, w, h); /* which reports the error, or draws */
+    if (drew)
+        *drew = false;
+    bool by_drawing = w <= 0 || h <= 0 || !r_game_prepare(r, cur->stage, &err) ||
+                      (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) || r_fx_needs_frame(r, ahead);
+    if (by_drawing) {
+        if (drew)
+            *drew = true;
+        return draw(r, prev, cur, 1.0f, w, h, r->history_skip); /* which reports the error, or draws */
+    }
     GLint out = 0;
     gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &out);
     known_state();
@@ -469,6 +503,11 @@ bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, i
 }
 
 bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h)
+{
+    return draw(r, prev, cur, alpha, w, h, 0);
+}
+
+static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip)
 {
     GLint out = 0;
     gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &out);
@@ -496,7 +535,7 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = w, f->h = h, f->out_fbo = out;
     r_frame_setup(r, f);
     r->mask_final = 0;
-    r_graph_run(&r->graph, r);
+    r_graph_run_skip(&r->graph, r, skip);
     leave_state(out);
     RGL_CHECK("r_game_draw");
     return true;

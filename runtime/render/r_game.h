@@ -60,13 +60,31 @@ const r_stage *r_game_stage(const r_game *r);
  * clears to black) when the stage could not be loaded: r_game_error. */
 bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h);
 const char *r_game_error(const r_game *r);
-/* Moves the stage effects' history (r_fx.h) on by the one game tick cur
- * without drawing it: ticks 0..A-1 advanced and tick A drawn give the same
- * frame A as ticks 0..A drawn (prev, w, h as r_game_draw would get them;
- * each tick in turn).  Where an effect's history needs the frame itself
- * (LSPSM's auto-focus), the frame is drawn into the bound framebuffer at
- * alpha 1.  Returns false as r_game_draw does. */
-bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h);
+/* Starting a render at tick A > 0 exactly (r_fx.h, "History"):
+ *
+ *   h = r_game_history(r, stage, err);        how far back frame A looks
+ *   from = h == R_GAME_FROM_START ? 0 : A - min(A, h);
+ *   r_game_restart(r);                        the first tick advanced resets
+ *   for (t = from; t < A; t++)                states before `from`: simulated only
+ *       r_game_advance(r, &prev_t, &cur_t, w, h, A - t);
+ *   r_game_draw(r, &prev_A, &cur_A, 1, w, h); the frame a full render draws
+ *
+ * r_game_history loads the stage's look (as r_game_prepare) and returns the
+ * ticks of history its effects carry into a frame: 0 (none: frame A needs
+ * nothing before it), N, or R_GAME_FROM_START (every tick from 0); -2 with
+ * err filled when the look cannot load. */
+#define R_GAME_FROM_START (-1)
+int64_t r_game_history(r_game *r, int game_stage, rs_err *err);
+/* The next frame drawn or advanced starts a new sequence (a reset). */
+void r_game_restart(r_game *r);
+/* Moves the stage effects' history on by the one game tick cur without
+ * drawing it; `ahead` is the number of ticks from this one to the first
+ * frame that will be drawn (>= 1).  Where an effect whose window holds
+ * this tick needs the frame itself (LSPSM's auto-focus), the frame is
+ * drawn into the bound framebuffer at alpha 1 and *drew (may be NULL) is
+ * set.  prev, w, h as r_game_draw would get them.  Returns false as
+ * r_game_draw does. */
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h, uint64_t ahead, bool *drew);
 
 /* --passes: time every pass; per_frame prints one line per frame to out. */
 void r_game_passes(r_game *r, bool per_frame, FILE *out);

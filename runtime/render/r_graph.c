@@ -102,6 +102,11 @@ static void collect(r_graph *g, int s)
 
 r_graph_mask r_graph_run(r_graph *g, void *user)
 {
+    return r_graph_run_skip(g, user, 0);
+}
+
+r_graph_mask r_graph_run_skip(r_graph *g, void *user, r_graph_mask skip)
+{
     int s = (int)(g->frame % R_GRAPH_LAG);
     if (g->timing)
         collect(g, s);
@@ -110,6 +115,10 @@ r_graph_mask r_graph_run(r_graph *g, void *user)
     g->ran_now = 0;
     for (int i = 0; i < g->n; i++) {
         const r_pass *p = &g->pass[i];
+        if (skip & ((r_graph_mask)1 << i)) {
+            produced |= p->writes;
+            continue;
+        }
         if (!p->needed(user)) {
             g->stats[i].skips++;
             continue;

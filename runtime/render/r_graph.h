@@ -86,6 +86,10 @@ bool r_graph_add(r_graph *g, const r_pass *p, rs_err *err);
 void r_graph_timing(r_graph *g, r_graph_frame_fn fn, void *user);
 /* Runs one frame; returns the mask of passes that ran (bit i = pass i). */
 r_graph_mask r_graph_run(r_graph *g, void *user);
+/* The same without the passes in `skip`: they are neither run nor counted,
+ * and what they write counts as produced (their last contents stand in).
+ * For frames drawn only for what they leave behind (r_game_advance). */
+r_graph_mask r_graph_run_skip(r_graph *g, void *user, r_graph_mask skip);
 /* Collects every outstanding timing (blocking). */
 void r_graph_flush(r_graph *g);
 void r_graph_release(r_graph *g);

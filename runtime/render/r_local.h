@@ -114,6 +114,8 @@ struct r_game {
     bool per_frame;
     FILE *passes_out;
     const char *res_names[32]; /* the graph's resources: the core's, then the effects' */
+    r_graph_mask history_skip; /* the core's passes that only shade: left out of frames drawn
+                                  for the effects' history (r_game_advance) */
     /* stage effects: each module's state, by its index in r_fx_modules (r_fx.h) */
     void *fx_state[R_FX_MAX_MODULES];
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
@@ -128,7 +130,10 @@ int r_fx_units(void);                          /* texture units the modules' bin
 void r_fx_bind(r_game *r, GLuint p, int what); /* every module's bind, units from R_FX_UNIT_FIRST */
 bool r_fx_scene_cleared(r_game *r);            /* an effect cleared the HDR target this frame */
 bool r_fx_draw_ring(r_game *r);                /* an effect drew the ring its own way */
-bool r_fx_needs_frame(r_game *r);              /* some history needs the frame drawn */
+int r_fx_warmup(r_game *r, const r_fx_module *m); /* its warm-up on the loaded stage */
+int64_t r_fx_history(r_game *r);               /* the most of them (R_FX_FROM_START wins) */
+bool r_fx_needs_frame(r_game *r, uint64_t ahead); /* a module whose window holds the tick `ahead` ticks
+                                                     before the first drawn one needs the frame */
 void r_fx_advance(r_game *r);                  /* every module's history, one tick */
 
 /* stencil bits: the scene pass marks the fighters' pixels */

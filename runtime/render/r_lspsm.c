@@ -381,3 +381,17 @@ float r_lspsm_focus_update(r_lspsm_focus *f, const float depth[R_LSPSM_FOCUS_N],
     f->range = (float)range;
     return f->range;
 }
+
+int r_lspsm_focus_memory(const r_lspsm_focus *f)
+{
+    double limit = pick(f->limit, R_LSPSM_LIMIT), shrink = fmin(pick(f->shrink, R_LSPSM_SHRINK), 1);
+    double min_range = fmin(pick(f->min_range, R_LSPSM_MIN_RANGE), limit);
+    /* the shrinking chain exactly as r_lspsm_focus_update computes it */
+    float range = (float)limit;
+    int n = 0;
+    while (range > min_range && n < 1 << 20) {
+        range = (float)fmax(min_range, (double)range * (1 - shrink));
+        n++;
+    }
+    return n;
+}

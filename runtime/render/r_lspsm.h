@@ -140,4 +140,15 @@ void r_lspsm_focus_gather(const float *depth, int w, int h, float out[R_LSPSM_FO
  * the state stays.  Returns the new range. */
 float r_lspsm_focus_update(r_lspsm_focus *f, const float depth[R_LSPSM_FOCUS_N], int w, int h, r_mat4 inv_vp);
 
+/* How many updates the range remembers.  Two chains of updates fed the
+ * same samples, one from any state and one from the limit (a reset), are
+ * equal, bit for bit, from the first update at which the second one lands
+ * on its target (it is never below the first, and the target is a lower
+ * bound of both); without landing, the second one can only shrink from the
+ * limit, and it reaches min_range after this many updates, where it must
+ * have landed.  So the range after n >= this many updates from a reset is
+ * the range after any longer history (every update having used >= 1
+ * sample, which a depth buffer always gives). */
+int r_lspsm_focus_memory(const r_lspsm_focus *f);
+
 #endif

@@ -1,0 +1,125 @@
+/* Segments: one video rendered in pieces, anywhere, and joined by stream
+ * copy (docs/segments.md).
+ *
+ * A segment is the video of ticks A..B-1 (`render --ticks A:B --segment
+ * KEY -o SEG.mp4`): its own file, first frame a keyframe, closed GOP,
+ * pts = tick in 1/60 (the sink does that: cap_sink.segment), the same
+ * encoder settings as every other segment.  Beside it:
+ *   SEG.mp4.seg    its manifest (cap_seg_info), written last and
+ *                  atomically: a manifest means the segment is complete;
+ *   SEG.hashes     its --hashes list, when it has one (the segment's name
+ *                  with the extension replaced: cap_seg_hashes_path).
+ * The manifest records what the file must be when read back through
+ * libavformat (packet count, CRC-32 of the packet payloads), so a join
+ * can tell a whole segment from a truncated, stale or foreign one before
+ * it writes anything.
+ *
+ *   render: cap_seg_seal(seg, key, A, B, hashes)       after the files are in place
+ *   join:   j = cap_join_open(&desc)                    output directory writable?
+ *           cap_seg_verify(segs, n, &want, bad, ctx)    every segment, and all together
+ *           cap_join_copy(j, segs, n, &bad)             stream copy
+ *           cap_join_close(j, ok)                       faststart, rename into place
+ *
+ * Failures carry CAP_ERR_SEG_* ids when a segment is at fault (join exits
+ * 3 and the segment is rendered again), other CAP_ERR_* ids when the
+ * output is (exit 1). */
+#ifndef CAP_SEG_H
+#define CAP_SEG_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cap_sink.h"
+
+#define CAP_SEG_KEY_MAX 64
+
+/* The manifest, SEG.seg, one "name value" line each:
+ *   ringside-segment 1
+ *   key job42-a3
+ *   format mp4
+ *   size 640x360
+ *   ticks 600 1200
+ *   frames 600
+ *   bytes 1234567
+ *   crc32 89abcdef
+ *   hashes 0123456789abcdef      ("hashes none" without a list) */
+typedef struct cap_seg_info {
+    char key[CAP_SEG_KEY_MAX + 1];
+    char format[8];        /* mp4, mkv or webm: the segment file's extension */
+    int w, h;
+    uint64_t first, end;   /* ticks first..end-1 */
+    uint64_t frames;       /* end - first */
+    uint64_t bytes;        /* the segment file's size */
+    uint32_t crc;          /* CRC-32 of every packet's payload, in the order libavformat reads them */
+    bool has_hashes;
+    uint64_t hashes_fnv;   /* FNV-1a 64 of the hash list's text */
+} cap_seg_info;
+
+/* One segment as join sees it. */
+typedef struct cap_seg {
+    const char *path;      /* the segment file */
+    cap_seg_info m;        /* its manifest (filled by cap_seg_verify) */
+    uint32_t codec_sig;    /* CRC of the codec id, size and extradata: equal across a video */
+    int reorder;           /* B-frame delay: the most any packet's pts lags its decode position */
+} cap_seg;
+
+/* [A-Za-z0-9._:-]{1,64} */
+bool cap_seg_key_ok(const char *key);
+/* "dir/s1.mp4" -> "dir/s1.mp4.seg" */
+void cap_seg_manifest_path(const char *seg, char *out, size_t n);
+/* "dir/s1.mp4" -> "dir/s1.hashes" */
+void cap_seg_hashes_path(const char *seg, char *out, size_t n);
+/* "mp4", "mkv", "webm", or NULL when path is none of them. */
+const char *cap_seg_format_of(const char *path);
+
+/* After a segment's render, with the file (and its hash list) in place:
+ * reads it back through libavformat, checks it is ticks first..end-1
+ * (count, keyframe, pts), and writes SEG.seg atomically.  hashes: its
+ * list, or NULL.  False (CAP_ERR_SEG_* or CAP_ERR_WRITE) leaves no
+ * manifest; the caller removes the files. */
+bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes, rs_err *err);
+
+/* What join wants of every segment. */
+typedef struct cap_seg_want {
+    const char *key;       /* required: segments of another job or attempt are bad */
+    const char *format;    /* required: the output's container (cap_seg_format_of) */
+    uint64_t first;        /* the first segment's first tick; 0 default */
+    bool hashes;           /* every segment must have its hash list (join --hashes) */
+} cap_seg_want;
+
+/* Checks each segment against its manifest (CAP_ERR_SEG_*, in the order
+ * the header of cap_seg.c lists) and all of them together: contiguous
+ * ticks from want->first, one size, one set of codec parameters (the
+ * majority's; the others are bad).  Calls bad(ctx, index, err) once for
+ * each bad segment, in order; returns how many were bad. */
+int cap_seg_verify(cap_seg *segs, int n, const cap_seg_want *want,
+                   void (*bad)(void *ctx, int index, const rs_err *err), void *ctx);
+
+typedef struct cap_join cap_join;
+
+typedef struct cap_join_desc {
+    const char *out;       /* required: .mp4 (faststart), .mkv or .webm; its directory must exist */
+    const char *hashes;    /* optional: the segments' hash lists, concatenated */
+    void (*progress)(void *ctx, uint64_t done, uint64_t total); /* optional: after every packet */
+    void *ctx;
+    const volatile sig_atomic_t *stop; /* optional: set (by a signal) to give up */
+} cap_join_desc;
+
+/* Creates OUT.part (and HASHES.part): fails with CAP_ERR_CREATE when the
+ * output directory is gone or not writable, before any segment is read. */
+cap_join *cap_join_open(const cap_join_desc *d, rs_err *err);
+/* Stream-copies the verified segments in order: pts continue from one
+ * segment to the next (the video starts at pts 0, as any render does),
+ * dts = position - the largest B-frame delay, so they rise by one a
+ * packet across the joins.  A segment that changed since cap_seg_verify
+ * fails with a CAP_ERR_SEG_* id and *bad_index set to its index (-1 for
+ * the other failures, which are the output's). */
+bool cap_join_copy(cap_join *j, const cap_seg *segs, int n, int *bad_index, rs_err *err);
+/* ok: trailer (MP4: index moved to the front), fsync, hash list then
+ * video renamed into place; !ok or any failure: both temporaries
+ * removed, nothing left.  Always frees j. */
+bool cap_join_close(cap_join *j, bool ok, rs_err *err);
+
+#endif
