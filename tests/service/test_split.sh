@@ -93,7 +93,7 @@ t_segment_out_of_attempts_fails_the_job() {
     svc_field "$id" error | grep -q "^gave up after 1 attempt: segment 0 (ticks 0-60): the render process was killed by signal 9" ||
         { svc_field "$id" error; return 1; }
     [ "$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/$id/video")" = 404 ] || return 1
-    svc_no_leftovers "$id"
+    svc_no_leftovers "$id" || return 1
     svc_stop
 }
 
@@ -113,7 +113,7 @@ t_cancel_cancels_every_segment() {
     cat units.txt
     [ "$(awk '$2 != "done" && $2 != "cancelled"' units.txt | wc -l)" = 0 ] || return 1
     [ "$(svc_field "$id" state)" = cancelled ] || return 1
-    svc_no_leftovers "$id"
+    svc_no_leftovers "$id" || return 1
     svc_stop
 }
 
@@ -123,7 +123,8 @@ t_killed_at_random() {
     dojo 8 11 eight.rsr || return 1
     seed=$(od -An -N2 -tu2 /dev/urandom | tr -d ' ')
     echo "random seed $seed"
-    rnd() { seed=$(( (seed * 1103515245 + 12345) % 2147483648 )); echo $(( seed / 65536 % $1 )); }
+    # R = a number below $1 (not in $(...): the seed must advance here)
+    rnd() { seed=$(( (seed * 1103515245 + 12345) % 2147483648 )); R=$(( seed / 65536 % $1 )); }
     # enough attempts that the kills cannot run a segment out of them
     opts="$SVC_FAST --workers 2 --segment-seconds 1 --max-attempts 20"
     svc_start d $opts || return 1
@@ -131,9 +132,11 @@ t_killed_at_random() {
     kills=0 daemon_kills=0 round=0
     while [ $round -lt 6 ] && [ "$(svc_field "$id" state)" != done ]; do
         round=$((round + 1))
-        sleep "$(rnd 2).$(rnd 10)"
+        rnd 2; s=$R; rnd 10
+        sleep "$s.$R"
         # children in the first round and the daemon by the second, at least
-        if [ $round != 1 ] && { [ "$(rnd 3)" = 0 ] || [ $daemon_kills = 0 ]; }; then
+        rnd 3
+        if [ $round != 1 ] && { [ $R = 0 ] || [ $daemon_kills = 0 ]; }; then
             echo "round $round: daemon killed"
             kill -KILL "$SVC_PID"
             wait "$SVC_PID" 2>/dev/null
@@ -143,7 +146,8 @@ t_killed_at_random() {
             n=0
             for c in $(pgrep -P "$SVC_PID"); do
                 n=$((n + 1))
-                [ "$(rnd 2)" = 0 ] && [ $n -gt 1 ] && continue # the first always, the others by chance
+                rnd 2
+                [ $R = 0 ] && [ $n -gt 1 ] && continue # the first always, the others by chance
                 echo "round $round: child $c killed: $(tr '\0' ' ' <"/proc/$c/cmdline" 2>/dev/null | cut -c1-100)"
                 kill -KILL "$c" 2>/dev/null && kills=$((kills + 1))
             done
