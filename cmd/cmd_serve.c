@@ -21,7 +21,10 @@ static void help(void)
            "with a PostgreSQL URI any number of daemons on any number of machines share\n"
            "one queue (give them a shared --output directory).  A render that crashes or\n"
            "stalls is retried up to max_attempts; SIGTERM or Ctrl-C stops taking jobs, lets\n"
-           "running ones finish for 'grace' seconds, re-queues the rest and exits 0.\n\n"
+           "running ones finish for 'grace' seconds, re-queues the rest and exits 0.\n"
+           "A job longer than segment_seconds is split into segments that any free worker\n"
+           "of any daemon renders ('ringside render --segment'), then joined ('ringside join');\n"
+           "a daemon that dies loses only the segments it was rendering.\n\n"
            "  --config FILE    settings file: 'name = value' lines, # comments; the options\n"
            "                   below override it\n"
            "  --print-config   print every setting's value after the file and options, and exit\n"
@@ -41,6 +44,7 @@ int cmd_serve(int argc, char **argv)
         {"max-upload", required_argument, 0, 1}, {"max_upload", required_argument, 0, 1},
         {"max-attempts", required_argument, 0, 1}, {"max_attempts", required_argument, 0, 1},
         {"lease", required_argument, 0, 1}, {"watchdog", required_argument, 0, 1}, {"grace", required_argument, 0, 1},
+        {"segment-seconds", required_argument, 0, 1}, {"segment_seconds", required_argument, 0, 1},
         {"size", required_argument, 0, 1}, {"max-size", required_argument, 0, 1}, {"max_size", required_argument, 0, 1},
         {"render-size", required_argument, 0, 1}, {"render_size", required_argument, 0, 1},
         {"format", required_argument, 0, 1}, {"backend", required_argument, 0, 1},

@@ -43,6 +43,9 @@ static const c_row rows[] = {
      "seconds a render may go without progress before it is killed and retried"},
     {"grace", C_INT, OFF(grace), 0, 0, 3600, "30", NULL,
      "seconds running jobs get to finish after SIGTERM before they are re-queued"},
+    {"segment_seconds", C_INT, OFF(segment_seconds), 0, 0, 3600, "30", NULL,
+     "split a longer job into segments of this many seconds of game time, rendered by any free worker of any "
+     "daemon and then joined (0: never split)"},
     {"size", C_SIZE, OFF(width), OFF(height), 16, 8192, "640x360", NULL, "a job's video size unless it asks"},
     {"max_size", C_SIZE, OFF(max_width), OFF(max_height), 16, 8192, "1920x1080", NULL,
      "the largest video size a job may ask for"},
@@ -251,7 +254,7 @@ bool svc_config_finish(svc_config *c, rs_err *err)
 void svc_config_print_table(FILE *f)
 {
     for (size_t i = 0; i < NROWS; i++)
-        fprintf(f, "  %-13s %-16s %s\n", rows[i].name, rows[i].def[0] ? rows[i].def : "(see text)", rows[i].help);
+        fprintf(f, "  %-15s %-16s %s\n", rows[i].name, rows[i].def[0] ? rows[i].def : "(see text)", rows[i].help);
 }
 
 void svc_config_dump(const svc_config *c, FILE *f)
@@ -260,9 +263,10 @@ void svc_config_dump(const svc_config *c, FILE *f)
     fprintf(f,
             "listen = %s\nworkers = %d\ndata = %s\nqueue = %s\noutput = %s\nmax_upload = %ld\nmax_seconds = %d\n"
             "max_attempts = %d\n"
-            "lease = %d\nwatchdog = %d\ngrace = %d\nsize = %dx%d\nmax_size = %dx%d\nrender_size = %dx%d\n"
+            "lease = %d\nwatchdog = %d\ngrace = %d\nsegment_seconds = %d\nsize = %dx%d\nmax_size = %dx%d\n"
+            "render_size = %dx%d\n"
             "format = %s\nbackend = %s\nlog_level = %s\n",
             c->listen, c->workers, c->data, c->queue, c->output, c->max_upload, c->max_seconds, c->max_attempts, c->lease, c->watchdog,
-            c->grace, c->width, c->height, c->max_width, c->max_height, c->render_width, c->render_height, c->format,
+            c->grace, c->segment_seconds, c->width, c->height, c->max_width, c->max_height, c->render_width, c->render_height, c->format,
             c->backend, levels[c->log_level & 3]);
 }

@@ -25,6 +25,7 @@ typedef struct svc_config {
     int lease;            /* seconds a claim lasts without a heartbeat */
     int watchdog;         /* seconds without progress before a render is killed */
     int grace;            /* seconds running jobs get to finish on SIGTERM */
+    int segment_seconds;  /* split a job into segments of this much game time (0: never) */
     int width, height;    /* a job's output size unless it asks for one */
     int max_width, max_height; /* the largest output a job may ask for */
     int render_width, render_height; /* the size the game is drawn at */

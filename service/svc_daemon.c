@@ -2,24 +2,34 @@
  *
  * DESIGN: one thread (main) owns the workers and every child process; see
  * svc_local.h for what the HTTP threads share.  Each worker slot runs one
- * `ringside render` child at a time:
+ * child at a time for the unit of work it claimed (svc_store.h, "Units"):
+ * `ringside render` for a whole job or a segment of one, `ringside join`
+ * for a split job's join (svc_files.c: the files and the command line):
  *
- *   claim (store) -> write the replay to DATA/work -> fork+exec render
- *     fd 3: "frames DONE TOTAL" / "desync TICK" lines (--progress-fd 3)
- *     fd 2: its messages; the last line is the job's error if it fails
+ *   claim a unit (store) -> write the replay to DATA/work -> fork+exec
+ *     fd 3: "frames DONE TOTAL" / "desync TICK" / "bad INDEX REASON" lines
+ *     fd 2: its messages; the last line is the unit's error if it fails
  *   every lease/6 s: heartbeat (progress + lease); "not ours" -> SIGTERM it
  *   no new frame for `watchdog` s -> SIGKILL, retried like a crash
- *   exit 0 -> rename the output into place, finish(done)
+ *   exit 0 -> a whole job or a join: rename the output into place,
+ *     finish(done); a segment: its files stay where they are (the queue
+ *     records which attempt made them), finish(done)
  *   desync -> finish(failed) with the tick: a replay that desyncs once
  *     desyncs every time, so it is not retried
- *   anything else (crash, signal, exit 1) -> release: re-queued until
- *     max_attempts, then failed with every attempt's reason counted
+ *   the join's exit 3 (bad segments) -> those segments are deleted and
+ *     rendered again, the join waits for them (rejoin); its exit 1 (disk
+ *     full, directory gone) -> a local problem, no attempt counted
+ *   anything else (crash, signal, exit 1) -> release: the unit re-queued
+ *     until max_attempts, then its job failed with its reason
  *
- * The render writes "<output>/.jobN-PID-aK.fmt" (its own .part first), and
- * only a finished one is renamed to "<output>/N.fmt": a render killed at
- * any point leaves no file that looks finished, and two daemons that both
- * think they own a job (a lease lost to a network partition) write
- * different temporary names and the same final bytes.
+ * An unsplit render writes "<output>/.jobN-PID-aK.fmt" (its own .part
+ * first), and only a finished one is renamed to "<output>/N.fmt": a render
+ * killed at any point leaves no file that looks finished, and two daemons
+ * that both think they own a job (a lease lost to a network partition)
+ * write different temporary names and the same final bytes.  Segments and
+ * joins keep the same rules (svc_files.c).  What a crash leaves behind is
+ * removed when the unit ends, and the sweep (svc_sweep, every 10 s)
+ * removes what belongs to jobs that are over.
  *
  * Children get PR_SET_PDEATHSIG: a daemon killed with SIGKILL takes its
  * renders with it, so a restarted daemon never races an orphan. */
@@ -44,22 +54,27 @@
 
 typedef struct worker {
     int slot;
-    char owner[SVC_OWNER_MAX]; /* "host:pid-nonce/slot": a lease belongs to one slot, so a job re-claimed
-                                  by another slot of this daemon is no longer the old render's */
+    char owner[SVC_OWNER_MAX]; /* "host:pid-nonce/slot": a lease belongs to one slot, so a unit re-claimed
+                                  by another slot of this daemon is no longer the old child's */
     bool busy;
     pid_t pid;
-    svc_job job;
+    svc_job job;                /* job.unit: the unit this slot holds */
+    svc_unit_files f;           /* its files */
+    svc_unit *units;            /* the join: the job's units when it started (segment files by done_attempt) */
+    int nunits;
+    int *bad, nbad;             /* the join: segments it found bad ("bad INDEX REASON") */
+    char bad_why[SVC_ERROR_MAX];
+    bool keep;                  /* a segment the queue recorded: its files stay */
     int prog_fd, err_fd;        /* read ends, non-blocking; -1 closed */
-    char prog_buf[256], err_buf[1024];
+    char prog_buf[1024], err_buf[1024];
     size_t prog_len, err_len;
-    char last_err[SVC_ERROR_MAX]; /* the render's last message line */
+    char last_err[SVC_ERROR_MAX]; /* the child's last message line */
     int64_t done, total, desync;
     double spawned, last_frame, last_beat, fps_t0;
-    int64_t fps_d0;
-    double fps;
+    int64_t fps_d0, beat_done;
+    double fps, beat_fps;
     enum { K_NONE, K_WATCHDOG, K_CANCEL, K_SHUTDOWN } killed;
     double killed_at;
-    char out_tmp[1024], hashes_tmp[1024], replay_path[1024];
 } worker;
 
 static double now_s(void)
@@ -81,10 +96,23 @@ static void publish(svc_daemon *d, const worker *w)
     svc_live *l = &d->live[w->slot];
     l->job = w->busy ? w->job.id : 0;
     l->pid = w->busy ? w->pid : 0;
+    l->kind = w->job.unit.kind;
+    l->index = w->job.unit.index;
     l->done = w->done;
     l->total = w->total;
     l->fps = w->fps;
+    l->beat_done = w->beat_done;
+    l->beat_fps = w->beat_fps;
     pthread_mutex_unlock(&d->mu);
+}
+
+/* What a unit's log lines start with after "job N: ": "" for a whole job,
+ * "segment 2 (ticks 120-180): " or "join: " */
+static const char *ctx(const worker *w)
+{
+    static char buf[96];
+    svc_unit_context(buf, sizeof buf, &w->job.unit);
+    return buf;
 }
 
 static void close_fd(int *fd)
@@ -98,18 +126,29 @@ static void worker_clear(svc_daemon *d, worker *w)
 {
     close_fd(&w->prog_fd);
     close_fd(&w->err_fd);
-    if (w->replay_path[0])
-        unlink(w->replay_path);
-    /* a render killed with SIGKILL could not remove its own ".part" files */
-    char part[1100];
-    const char *tmps[] = {w->out_tmp, w->hashes_tmp};
-    for (int i = 0; i < 2; i++)
+    if (w->f.replay[0])
+        unlink(w->f.replay);
+    /* a child killed with SIGKILL could not remove its own ".part" files */
+    char part[1200];
+    const char *tmps[] = {w->f.out, w->f.hashes};
+    for (int i = 0; i < 2 && w->job.unit.kind != SVC_UNIT_SEGMENT; i++)
         if (tmps[i][0]) {
             unlink(tmps[i]);
             snprintf(part, sizeof part, "%s.part", tmps[i]);
             unlink(part);
         }
+    if (w->job.unit.kind == SVC_UNIT_SEGMENT && !w->keep)
+        svc_segment_remove(w->f.segdir, w->job.unit.index, w->job.unit.attempts);
+    /* the job is over (failed, cancelled, done): its segments go too, and
+     * whatever crashed attempts (of any daemon) left */
+    svc_job cur;
+    rs_err err = {0};
+    if (w->busy && d->store->ops->get(d->store, w->job.id, &cur, &err) == 1 && cur.state != SVC_QUEUED &&
+        cur.state != SVC_RUNNING)
+        svc_remove_job_files(&d->cfg, w->job.id);
     svc_job_free(&w->job);
+    free(w->units);
+    free(w->bad);
     int slot = w->slot;
     char owner[SVC_OWNER_MAX];
     memcpy(owner, w->owner, sizeof owner);
@@ -120,36 +159,43 @@ static void worker_clear(svc_daemon *d, worker *w)
     publish(d, w);
 }
 
-/* Starts the render of w->job.  False: the job could not even start
+/* Starts the child for w->job's unit.  False: it could not even start
  * (a local problem such as a full disk); the caller releases it. */
 static bool spawn(svc_daemon *d, worker *w, rs_err *err)
 {
-    const svc_job *j = &w->job;
-    pid_t me = getpid();
-    snprintf(w->replay_path, sizeof w->replay_path, "%s/work/job%" PRId64 "-%d.rsr", d->cfg.data, j->id, (int)me);
-    snprintf(w->out_tmp, sizeof w->out_tmp, "%s/.job%" PRId64 "-%d-a%d.%s", d->cfg.output, j->id, (int)me, j->attempts,
-             j->format);
-    snprintf(w->hashes_tmp, sizeof w->hashes_tmp, "%s/.job%" PRId64 "-%d-a%d.hashes", d->cfg.output, j->id, (int)me,
-             j->attempts);
-    if (!rs_mkdirs_for(w->replay_path, err) || !rs_write_part(w->replay_path, j->replay, j->replay_len, err) ||
-        !rs_commit_file(w->replay_path, err))
+    svc_job *j = &w->job;
+    svc_unit_paths(&d->cfg, j, w->slot, &w->f);
+    if (j->unit.kind == SVC_UNIT_JOIN) {
+        w->units = calloc((size_t)j->segments + 1, sizeof *w->units);
+        w->bad = calloc((size_t)j->segments + 1, sizeof *w->bad);
+        if (!w->units || !w->bad)
+            return rs_fail(err, 1, "out of memory");
+        w->nunits = d->store->ops->units(d->store, j->id, w->units, j->segments + 1, err);
+        if (w->nunits < 0)
+            return false;
+    } else if (!rs_mkdirs_for(w->f.replay, err) || !rs_write_part(w->f.replay, j->replay, j->replay_len, err) ||
+               !rs_commit_file(w->f.replay, err))
         return false;
-    char size[32], rsize[32];
-    snprintf(size, sizeof size, "%dx%d", j->width, j->height);
-    snprintf(rsize, sizeof rsize, "%dx%d", d->cfg.render_width, d->cfg.render_height);
-    char *argv[] = {"ringside", "render", w->replay_path, "-o", w->out_tmp, "--size", size, "--render-size", rsize,
-                    "--hashes", w->hashes_tmp, "--progress-fd", "3", "--quiet", "--backend", d->cfg.backend, NULL};
+    if (j->unit.kind == SVC_UNIT_SEGMENT && !rs_mkdirs_for(w->f.out, err))
+        return false;
+    char **argv = svc_unit_argv(&d->cfg, j, &w->f, w->units, w->nunits, err);
+    if (!argv)
+        return false;
     int prog[2], errp[2];
-    if (pipe2(prog, O_CLOEXEC) != 0)
+    if (pipe2(prog, O_CLOEXEC) != 0) {
+        svc_argv_free(argv);
         return rs_fail(err, 1, "pipe: %s", strerror(errno));
+    }
     if (pipe2(errp, O_CLOEXEC) != 0) {
         close(prog[0]), close(prog[1]);
+        svc_argv_free(argv);
         return rs_fail(err, 1, "pipe: %s", strerror(errno));
     }
     pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         close(prog[0]), close(prog[1]), close(errp[0]), close(errp[1]);
+        svc_argv_free(argv);
         return rs_fail(err, 1, "fork: %s", strerror(errno));
     }
     if (pid == 0) {
@@ -181,6 +227,7 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
         (void)r;
         _exit(127);
     }
+    svc_argv_free(argv);
     close(prog[1]);
     close(errp[1]);
     w->prog_fd = prog[0];
@@ -189,11 +236,20 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
     fcntl(w->err_fd, F_SETFL, O_NONBLOCK);
     w->pid = pid;
     w->busy = true;
-    w->total = j->frames_total;
+    w->total = j->unit.kind == SVC_UNIT_SEGMENT ? j->unit.end_tick - j->unit.first_tick : j->frames_total;
     w->desync = -1;
     w->spawned = w->last_frame = w->last_beat = w->fps_t0 = now_s();
-    svc_log(SVC_LOG_INFO, j->id, "rendering %s (%" PRId64 " frames, %dx%d %s, attempt %d of %d) in process %d",
-            j->name, j->frames_total, j->width, j->height, j->format, j->attempts, d->cfg.max_attempts, (int)pid);
+    if (j->unit.kind == SVC_UNIT_WHOLE)
+        svc_log(SVC_LOG_INFO, j->id, "rendering %s (%" PRId64 " frames, %dx%d %s, attempt %d of %d) in process %d",
+                j->name, j->frames_total, j->width, j->height, j->format, j->unit.attempts, d->cfg.max_attempts,
+                (int)pid);
+    else if (j->unit.kind == SVC_UNIT_SEGMENT)
+        svc_log(SVC_LOG_INFO, j->id, "%srendering %s (%" PRId64 " frames, %dx%d %s, attempt %d of %d) in process %d",
+                ctx(w), j->name, w->total, j->width, j->height, j->format, j->unit.attempts, d->cfg.max_attempts,
+                (int)pid);
+    else
+        svc_log(SVC_LOG_INFO, j->id, "joining %d segments of %s (%" PRId64 " frames, attempt %d) in process %d",
+                j->segments, j->name, j->frames_total, j->unit.attempts, (int)pid);
     publish(d, w);
     return true;
 }
@@ -201,6 +257,7 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
 static void on_prog_line(worker *w, char *line)
 {
     long long a, b;
+    int idx, off = 0;
     if (sscanf(line, "frames %lld %lld", &a, &b) == 2) {
         if (a != w->done)
             w->last_frame = now_s();
@@ -208,23 +265,35 @@ static void on_prog_line(worker *w, char *line)
         w->total = b;
     } else if (sscanf(line, "desync %lld", &a) == 1)
         w->desync = a;
+    else if (w->bad && sscanf(line, "bad %d %n", &idx, &off) == 1 && off > 0 && idx >= 0 && idx < w->job.segments) {
+        /* the join: segment idx failed its checks; keep the first reasons */
+        bool seen = false;
+        for (int i = 0; i < w->nbad; i++)
+            seen |= w->bad[i] == idx;
+        if (!seen)
+            w->bad[w->nbad++] = idx;
+        size_t n = strlen(w->bad_why);
+        if (n + 8 < sizeof w->bad_why)
+            snprintf(w->bad_why + n, sizeof w->bad_why - n, "%ssegment %d: %s", n ? "; " : "", idx, line + off);
+    }
 }
 
 static void on_err_line(svc_daemon *d, worker *w, char *line)
 {
-    if (!*line)
+    /* a usage error's second line says where help is: the first says why */
+    if (!*line || (strstr(line, "see 'ringside ") && strstr(line, "--help'")))
         return;
     /* "ringside render: x.rsr: desync ..." -> the part after "render: " */
     const char *m = strstr(line, "ringside render: ");
-    m = m ? m + strlen("ringside render: ") : line;
+    m = m ? m + strlen("ringside render: ") : (m = strstr(line, "ringside join: ")) ? m + strlen("ringside join: ") : line;
     /* the render knows the replay by its work-file name; people know it
      * by the name it was uploaded under */
-    size_t rl = strlen(w->replay_path);
-    if (rl && !strncmp(m, w->replay_path, rl))
+    size_t rl = strlen(w->f.replay);
+    if (rl && !strncmp(m, w->f.replay, rl))
         snprintf(w->last_err, sizeof w->last_err, "%s%s", w->job.name, m + rl);
     else
         snprintf(w->last_err, sizeof w->last_err, "%s", m);
-    svc_log(SVC_LOG_DEBUG, w->job.id, "render says: %s", m);
+    svc_log(SVC_LOG_DEBUG, w->job.id, "%s%s says: %s", ctx(w), w->job.unit.kind == SVC_UNIT_JOIN ? "join" : "render", m);
     (void)d;
 }
 
@@ -286,58 +355,133 @@ static void local_failure(double now)
     claim_after = now + local_backoff;
 }
 
-/* A render process ended: decide what its job becomes. */
+static void count(svc_daemon *d, uint64_t *what)
+{
+    pthread_mutex_lock(&d->mu);
+    (*what)++;
+    pthread_mutex_unlock(&d->mu);
+}
+
+/* A local problem (full disk, output directory gone): the unit goes back
+ * without an attempt counted, and this daemon pauses its claims. */
+static void give_back_local(svc_daemon *d, worker *w, const char *why)
+{
+    rs_err err = {0};
+    if (d->store->ops->release(d->store, w->job.id, w->owner, why, false, d->cfg.max_attempts, &err) < 0)
+        svc_log(SVC_LOG_ERROR, w->job.id, "could not re-queue: %s", err.msg);
+    local_failure(now_s());
+    svc_log(SVC_LOG_ERROR, w->job.id, "%s%s; re-queued, no new jobs for %.0f s", ctx(w), why, local_backoff);
+}
+
+/* A whole job or a join that exited 0: its output moves into place. */
+static void finished_video(svc_daemon *d, worker *w, double secs)
+{
+    svc_job *j = &w->job;
+    rs_err err = {0};
+    char video[1100], hashes[1100], why[SVC_ERROR_MAX];
+    final_paths(d, j, video, sizeof video, hashes, sizeof hashes);
+    if (rename(w->f.hashes, hashes) != 0 || rename(w->f.out, video) != 0) {
+        /* this machine's problem (disk, a vanished directory), not the job's */
+        snprintf(why, sizeof why, "the %s finished but its output could not be moved to %s: %s",
+                 j->unit.kind == SVC_UNIT_JOIN ? "join" : "render", video, strerror(errno));
+        give_back_local(d, w, why);
+        return;
+    }
+    int64_t frames = j->unit.kind == SVC_UNIT_JOIN ? j->frames_total : w->total;
+    int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, frames, &err);
+    if (r == 1) {
+        if (j->unit.kind == SVC_UNIT_JOIN)
+            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames from %d segments (joined in %.1f s)", video,
+                    frames, j->segments, secs);
+        else
+            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames in %.1f s (%.1f fps)", video, frames, secs,
+                    secs > 0 ? (double)frames / secs : 0.0);
+        count(d, &d->jobs_done);
+    } else if (r == 0) {
+        /* cancelled meanwhile: its files go; finished by another daemon
+         * (a lease lost and re-claimed): the same bytes, keep them */
+        svc_job cur;
+        if (d->store->ops->get(d->store, j->id, &cur, &err) == 1 && cur.state == SVC_CANCELLED) {
+            unlink(video);
+            unlink(hashes);
+            svc_log(SVC_LOG_INFO, j->id, "finished just after it was cancelled: video removed");
+        } else
+            svc_log(SVC_LOG_WARN, j->id, "finished, but the job is no longer ours (re-claimed elsewhere)");
+    } else
+        svc_log(SVC_LOG_ERROR, j->id, "finished, but recording it failed: %s (the lease will expire and the "
+                                      "job will run again)", err.msg);
+}
+
+/* A segment that exited 0: the queue records which attempt made it. */
+static bool finished_segment(svc_daemon *d, worker *w, double secs)
+{
+    svc_job *j = &w->job;
+    rs_err err = {0};
+    char manifest[1200];
+    snprintf(manifest, sizeof manifest, "%s.seg", w->f.out);
+    if (access(manifest, F_OK) != 0) {
+        snprintf(w->last_err, sizeof w->last_err, "the segment render exited 0 but left no manifest (%s)", manifest);
+        return false; /* retried like a crash */
+    }
+    int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
+    if (r == 1) {
+        w->keep = true;
+        svc_log(SVC_LOG_INFO, j->id, "%sdone, %" PRId64 " frames in %.1f s (%.1f fps)", ctx(w), w->total, secs,
+                secs > 0 ? (double)w->total / secs : 0.0);
+    } else if (r == 0)
+        svc_log(SVC_LOG_WARN, j->id, "%sfinished, but it is no longer ours (cancelled or re-claimed)", ctx(w));
+    else
+        svc_log(SVC_LOG_ERROR, j->id, "%sfinished, but recording it failed: %s (the lease will expire and it will "
+                                      "run again)", ctx(w), err.msg);
+    return true;
+}
+
+/* The join found bad segments: they are deleted and rendered again. */
+static void bad_segments(svc_daemon *d, worker *w)
+{
+    svc_job *j = &w->job;
+    rs_err err = {0};
+    char why[SVC_ERROR_MAX];
+    snprintf(why, sizeof why, "the join found bad segment files: %s", w->bad_why);
+    for (int i = 0; i < w->nbad; i++)
+        for (int k = 0; k < w->nunits; k++)
+            if (w->units[k].kind == SVC_UNIT_SEGMENT && w->units[k].index == w->bad[i])
+                svc_segment_remove(w->f.segdir, w->bad[i], w->units[k].done_attempt);
+    int r = d->store->ops->rejoin(d->store, j->id, w->owner, w->bad, w->nbad, why, d->cfg.max_attempts, &err);
+    if (r < 0)
+        svc_log(SVC_LOG_ERROR, j->id, "join: could not send the bad segments back: %s", err.msg);
+    else if (r == 0)
+        svc_log(SVC_LOG_WARN, j->id, "join: %s; the join is no longer ours", why);
+    else
+        svc_log(SVC_LOG_WARN, j->id, "join: %s; %d segment%s to render again", why, w->nbad, w->nbad == 1 ? "" : "s");
+    count(d, &d->jobs_retried);
+}
+
+/* A child ended: decide what its unit (and so its job) becomes. */
 static void on_exit_status(svc_daemon *d, worker *w, int status)
 {
     drain(d, w, &w->prog_fd, w->prog_buf, sizeof w->prog_buf, &w->prog_len, true);
     drain(d, w, &w->err_fd, w->err_buf, sizeof w->err_buf, &w->err_len, false);
     svc_job *j = &w->job;
+    int kind = j->unit.kind;
     rs_err err = {0};
     char how[128], why[SVC_ERROR_MAX + 160];
     describe_status(status, how, sizeof how);
     double secs = now_s() - w->spawned;
+    int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 
-    bool exited_ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-    if (w->killed == K_CANCEL && !exited_ok) {
-        svc_log(SVC_LOG_INFO, j->id, "cancelled; render process stopped after %.1f s", secs);
+    if (w->killed == K_CANCEL && code != 0) {
+        svc_log(SVC_LOG_INFO, j->id, "%scancelled; %s process stopped after %.1f s", ctx(w),
+                kind == SVC_UNIT_JOIN ? "join" : "render", secs);
         goto out;
     }
-    /* a finished render counts even if a stop signal came just too late */
-    if (exited_ok) {
-        char video[1100], hashes[1100];
-        final_paths(d, j, video, sizeof video, hashes, sizeof hashes);
-        if (rename(w->hashes_tmp, hashes) != 0 || rename(w->out_tmp, video) != 0) {
-            /* this machine's problem (disk, a vanished directory), not the job's */
-            snprintf(why, sizeof why, "the render finished but its output could not be moved to %s: %s", video,
-                     strerror(errno));
-            if (d->store->ops->release(d->store, j->id, w->owner, why, false, d->cfg.max_attempts, &err) < 0)
-                svc_log(SVC_LOG_ERROR, j->id, "could not re-queue: %s", err.msg);
-            local_failure(now_s());
-            svc_log(SVC_LOG_ERROR, j->id, "%s; re-queued, no new jobs for %.0f s", why, local_backoff);
-            goto out;
-        }
-        int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
-        if (r == 1) {
-            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames in %.1f s (%.1f fps)", video, w->total, secs,
-                    secs > 0 ? (double)w->total / secs : 0.0);
-            pthread_mutex_lock(&d->mu);
-            d->jobs_done++;
-            pthread_mutex_unlock(&d->mu);
-        } else if (r == 0) {
-            /* cancelled meanwhile: its files go; finished by another daemon
-             * (a lease lost and re-claimed): the same bytes, keep them */
-            svc_job cur;
-            if (d->store->ops->get(d->store, j->id, &cur, &err) == 1 && cur.state == SVC_CANCELLED) {
-                unlink(video);
-                unlink(hashes);
-                svc_log(SVC_LOG_INFO, j->id, "finished just after it was cancelled: video removed");
-            } else
-                svc_log(SVC_LOG_WARN, j->id, "finished, but the job is no longer ours (re-claimed elsewhere)");
-        } else
-            svc_log(SVC_LOG_ERROR, j->id, "finished, but recording it failed: %s (the lease will expire and the "
-                                          "job will run again)", err.msg);
+    /* a finished child counts even if a stop signal came just too late */
+    if (code == 0 && kind != SVC_UNIT_SEGMENT) {
+        finished_video(d, w, secs);
         goto out;
     }
+    if (code == 0 && finished_segment(d, w, secs))
+        goto out;
     if (w->killed == K_SHUTDOWN || (d->stop && w->killed == K_NONE)) {
         /* stopped for the daemon's shutdown (by us after the grace period,
          * or by a signal to the whole service): not the job's fault */
@@ -345,49 +489,55 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
                                    d->cfg.max_attempts, &err) < 0)
             svc_log(SVC_LOG_ERROR, j->id, "could not re-queue: %s", err.msg);
         else
-            svc_log(SVC_LOG_INFO, j->id, "re-queued: the daemon is shutting down (%" PRId64 " of %" PRId64 " frames done)",
-                    w->done, w->total);
+            svc_log(SVC_LOG_INFO, j->id, "%sre-queued: the daemon is shutting down (%" PRId64 " of %" PRId64 " frames done)",
+                    ctx(w), w->done, w->total);
         goto out;
     }
-    if (w->desync >= 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 2)) {
+    if (kind == SVC_UNIT_JOIN && code == 3 && w->nbad > 0) {
+        bad_segments(d, w);
+        goto out;
+    }
+    if (kind == SVC_UNIT_JOIN && code == 1 && w->killed == K_NONE) {
+        /* the join says its output could not be written (disk full, the
+         * directory gone): this machine, not the segments */
+        snprintf(why, sizeof why, "the join could not write the video: %s", w->last_err[0] ? w->last_err : how);
+        give_back_local(d, w, why);
+        goto out;
+    }
+    if (w->desync >= 0 || code == 2) {
         /* the replay's own fault (or a usage error of ours): retrying
          * cannot help */
         snprintf(why, sizeof why, "%s", w->last_err[0] ? w->last_err : how);
         if (d->store->ops->finish(d->store, j->id, w->owner, SVC_FAILED, why, w->desync, w->done, &err) < 0)
             svc_log(SVC_LOG_ERROR, j->id, "could not record the failure: %s", err.msg);
-        svc_log(SVC_LOG_WARN, j->id, "failed: %s", why);
-        pthread_mutex_lock(&d->mu);
-        d->jobs_failed++;
-        pthread_mutex_unlock(&d->mu);
+        svc_log(SVC_LOG_WARN, j->id, "%sfailed: %s", ctx(w), why);
+        count(d, &d->jobs_failed);
         goto out;
     }
+    const char *what = kind == SVC_UNIT_JOIN ? "join" : "render";
     if (w->killed == K_WATCHDOG)
-        snprintf(why, sizeof why, "the render made no progress for %d s at frame %" PRId64 " of %" PRId64
+        snprintf(why, sizeof why, "the %s made no progress for %d s at frame %" PRId64 " of %" PRId64
                                   " and was killed (watchdog)",
-                 d->cfg.watchdog, w->done, w->total);
+                 what, d->cfg.watchdog, w->done, w->total);
     else if (WIFSIGNALED(status))
-        snprintf(why, sizeof why, "the render process was %s at frame %" PRId64 " of %" PRId64, how, w->done, w->total);
+        snprintf(why, sizeof why, "the %s process was %s at frame %" PRId64 " of %" PRId64, what, how, w->done, w->total);
     else
-        snprintf(why, sizeof why, "%s (%s)", w->last_err[0] ? w->last_err : "the render failed", how);
-    pthread_mutex_lock(&d->mu);
-    d->worker_crashes++;
-    pthread_mutex_unlock(&d->mu);
+        snprintf(why, sizeof why, "%s (%s)", w->last_err[0] ? w->last_err : code == 0 ? "no manifest" : "the render failed",
+                 how);
+    count(d, &d->worker_crashes);
     {
         int r = d->store->ops->release(d->store, j->id, w->owner, why, true, d->cfg.max_attempts, &err);
         if (r < 0)
             svc_log(SVC_LOG_ERROR, j->id, "could not re-queue after \"%s\": %s", why, err.msg);
         else if (r == 0)
-            svc_log(SVC_LOG_WARN, j->id, "%s; the job is no longer ours", why);
-        else if (j->attempts >= d->cfg.max_attempts) {
-            svc_log(SVC_LOG_WARN, j->id, "failed for good after %d attempts: %s", j->attempts, why);
-            pthread_mutex_lock(&d->mu);
-            d->jobs_failed++;
-            pthread_mutex_unlock(&d->mu);
+            svc_log(SVC_LOG_WARN, j->id, "%s%s; the job is no longer ours", ctx(w), why);
+        else if (j->unit.attempts >= d->cfg.max_attempts) {
+            svc_log(SVC_LOG_WARN, j->id, "%sfailed for good after %d attempts: %s", ctx(w), j->unit.attempts, why);
+            count(d, &d->jobs_failed);
         } else {
-            svc_log(SVC_LOG_WARN, j->id, "%s; re-queued (attempt %d of %d)", why, j->attempts, d->cfg.max_attempts);
-            pthread_mutex_lock(&d->mu);
-            d->jobs_retried++;
-            pthread_mutex_unlock(&d->mu);
+            svc_log(SVC_LOG_WARN, j->id, "%s%s; re-queued (attempt %d of %d)", ctx(w), why, j->unit.attempts,
+                    d->cfg.max_attempts);
+            count(d, &d->jobs_retried);
         }
     }
 out:
@@ -400,7 +550,7 @@ static void tend(svc_daemon *d, worker *w, double now)
     int64_t before = w->done;
     drain(d, w, &w->prog_fd, w->prog_buf, sizeof w->prog_buf, &w->prog_len, true);
     drain(d, w, &w->err_fd, w->err_buf, sizeof w->err_buf, &w->err_len, false);
-    if (w->done > before) {
+    if (w->done > before && w->job.unit.kind != SVC_UNIT_JOIN) { /* a join copies frames, it draws none */
         pthread_mutex_lock(&d->mu);
         d->frames_rendered += (uint64_t)(w->done - before);
         pthread_mutex_unlock(&d->mu);
@@ -424,12 +574,21 @@ static void tend(svc_daemon *d, worker *w, double now)
     if (now - w->last_beat >= beat) {
         rs_err err = {0};
         w->last_beat = now;
-        int r = d->store->ops->heartbeat(d->store, w->job.id, w->owner, d->cfg.lease, w->done, w->total, w->fps, &err);
+        /* a join's speed is packets copied, not frames drawn: not the job's fps */
+        double fps = w->job.unit.kind == SVC_UNIT_JOIN ? 0 : w->fps;
+        int64_t done = w->done;
+        int r = d->store->ops->heartbeat(d->store, w->job.id, w->owner, d->cfg.lease, done, w->total, fps, &err);
+        if (r == 1) {
+            w->beat_done = done;
+            w->beat_fps = fps;
+            publish(d, w);
+        }
         if (r == 0) {
             /* cancelled by DELETE (or, after a long stall, re-claimed) */
             svc_job cur;
             bool cancelled = d->store->ops->get(d->store, w->job.id, &cur, &err) == 1 && cur.state == SVC_CANCELLED;
-            svc_log(SVC_LOG_INFO, w->job.id, "%s: stopping its render", cancelled ? "cancelled" : "no longer ours");
+            svc_log(SVC_LOG_INFO, w->job.id, "%s%s: stopping its %s", ctx(w), cancelled ? "cancelled" : "no longer ours",
+                    w->job.unit.kind == SVC_UNIT_JOIN ? "join" : "render");
             w->killed = K_CANCEL;
             w->killed_at = now;
             kill(w->pid, SIGTERM);
@@ -439,8 +598,8 @@ static void tend(svc_daemon *d, worker *w, double now)
             svc_log(SVC_LOG_WARN, w->job.id, "heartbeat failed: %s", err.msg);
     }
     if (now - w->last_frame > d->cfg.watchdog) {
-        svc_log(SVC_LOG_WARN, w->job.id, "no progress for %d s (frame %" PRId64 " of %" PRId64 "): killing process %d",
-                d->cfg.watchdog, w->done, w->total, (int)w->pid);
+        svc_log(SVC_LOG_WARN, w->job.id, "%sno progress for %d s (frame %" PRId64 " of %" PRId64 "): killing process %d",
+                ctx(w), d->cfg.watchdog, w->done, w->total, (int)w->pid);
         w->killed = K_WATCHDOG;
         w->killed_at = now;
         kill(w->pid, SIGKILL);
@@ -463,7 +622,8 @@ static void start_job(svc_daemon *d, worker *w)
     }
     if (!spawn(d, w, &err)) {
         char why[SVC_ERROR_MAX];
-        snprintf(why, sizeof why, "could not start the render: %s", err.msg);
+        snprintf(why, sizeof why, "could not start the %s: %s", w->job.unit.kind == SVC_UNIT_JOIN ? "join" : "render",
+                 err.msg);
         svc_log(SVC_LOG_ERROR, w->job.id, "%s", why);
         rs_err e2 = {0};
         if (d->store->ops->release(d->store, w->job.id, w->owner, why, false, d->cfg.max_attempts, &e2) < 0)
@@ -489,7 +649,8 @@ int svc_run(svc_daemon *d)
         ws[i].prog_fd = ws[i].err_fd = -1;
         snprintf(ws[i].owner, sizeof ws[i].owner, "%s/%d", d->owner, i);
     }
-    double last_reap = 0, drain_start = 0;
+    double last_reap = 0, drain_start = 0, last_sweep = now_s();
+    svc_sweep(d); /* what the last run (or a crash) left */
     bool draining = false;
     for (;;) {
         double now = now_s();
@@ -541,6 +702,10 @@ int svc_run(svc_daemon *d)
             else if (r < 0)
                 svc_log(SVC_LOG_ERROR, -1, "reaping expired leases failed: %s", err.msg);
             last_reap = now;
+        }
+        if (!draining && now - last_sweep >= 10.0) {
+            svc_sweep(d);
+            last_sweep = now;
         }
         for (int i = 0; i < n && !draining; i++)
             if (!ws[i].busy)

@@ -338,12 +338,17 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         return reject(d, c, err.code, "%s", err.msg);
     j.replay = q->body;
     j.replay_len = q->len;
+    j.segment_ticks = d->cfg.segment_seconds * 60; /* the store splits it if it is longer */
     if (!d->http_store->ops->submit(d->http_store, &j, &err)) {
         svc_log(SVC_LOG_ERROR, -1, "could not queue an upload: %s", err.msg);
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     }
-    svc_log(SVC_LOG_INFO, j.id, "queued %s (%zu bytes, %" PRId64 " frames, %dx%d %s)", j.name, q->len, j.frames_total,
-            j.width, j.height, j.format);
+    if (j.segments > 0)
+        svc_log(SVC_LOG_INFO, j.id, "queued %s (%zu bytes, %" PRId64 " frames, %dx%d %s) as %d segments of %d s",
+                j.name, q->len, j.frames_total, j.width, j.height, j.format, j.segments, d->cfg.segment_seconds);
+    else
+        svc_log(SVC_LOG_INFO, j.id, "queued %s (%zu bytes, %" PRId64 " frames, %dx%d %s)", j.name, q->len,
+                j.frames_total, j.width, j.height, j.format);
     svc_buf b = {0};
     svc_buf_printf(&b, "{\"id\":%" PRId64 ",\"state\":\"queued\",\"url\":\"/jobs/%" PRId64 "\",\"frames_total\":%" PRId64
                        "}\n",
@@ -362,19 +367,41 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
 }
 
 /* A running job's live numbers come from the daemon that runs it (when
- * that is us): fresher than the last heartbeat. */
-static void overlay_live(svc_daemon *d, svc_job *j)
+ * that is us): fresher than the last heartbeat.  A whole job's are the
+ * render's own; a split job's row sums its units as of their heartbeats,
+ * so what our renders did since theirs is added. */
+static void overlay_live(svc_daemon *d, svc_job *j, svc_unit *units, int n)
 {
     if (j->state != SVC_RUNNING)
         return;
     pthread_mutex_lock(&d->mu);
-    for (int i = 0; i < d->cfg.workers; i++)
-        if (d->live[i].job == j->id) {
-            j->frames_done = d->live[i].done;
-            j->frames_total = d->live[i].total;
-            j->fps = d->live[i].fps;
+    for (int i = 0; i < d->cfg.workers; i++) {
+        const svc_live *l = &d->live[i];
+        if (l->job != j->id)
+            continue;
+        if (l->kind == SVC_UNIT_WHOLE) {
+            j->frames_done = l->done;
+            j->frames_total = l->total;
+            j->fps = l->fps;
+            continue;
         }
+        if (l->kind == SVC_UNIT_SEGMENT) {
+            j->frames_done += l->done - l->beat_done;
+            j->fps += l->fps - l->beat_fps;
+        }
+        for (int k = 0; k < n; k++)
+            if (units[k].kind == l->kind && units[k].index == l->index && units[k].state == SVC_RUNNING) {
+                units[k].frames_done = l->done;
+                units[k].fps = l->fps;
+            }
+    }
     pthread_mutex_unlock(&d->mu);
+    if (j->frames_done > j->frames_total)
+        j->frames_done = j->frames_total;
+    if (j->frames_done < 0)
+        j->frames_done = 0;
+    if (j->fps < 0)
+        j->fps = 0;
 }
 
 static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, int64_t id)
@@ -386,10 +413,24 @@ static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, int64
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     if (r == 0)
         return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
-    overlay_live(d, &j);
+    /* a split job shows its segments: who rendered each, how often */
+    svc_unit *units = NULL;
+    int n = 0;
+    if (j.segments > 0) {
+        units = calloc((size_t)j.segments + 1, sizeof *units);
+        if (!units)
+            return reply_error(c, SVC_ERR_NOMEM, "out of memory");
+        n = d->http_store->ops->units(d->http_store, id, units, j.segments + 1, &err);
+        if (n < 0) {
+            free(units);
+            return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+        }
+    }
+    overlay_live(d, &j, units, n);
     svc_buf b = {0};
-    svc_json_job(&b, &j, d->cfg.max_attempts);
+    svc_json_job(&b, &j, d->cfg.max_attempts, units, n);
     svc_buf_add(&b, "\n", 1);
+    free(units);
     return reply_json(c, 200, &b);
 }
 
@@ -417,10 +458,10 @@ static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
     svc_buf b = {0};
     svc_buf_add(&b, "{\"jobs\":[", 9);
     for (int i = 0; i < n; i++) {
-        overlay_live(d, &jobs[i]);
+        overlay_live(d, &jobs[i], NULL, 0);
         if (i)
             svc_buf_add(&b, ",", 1);
-        svc_json_job(&b, &jobs[i], d->cfg.max_attempts);
+        svc_json_job(&b, &jobs[i], d->cfg.max_attempts, NULL, 0);
     }
     if (n == limit && n > 0)
         svc_buf_printf(&b, "],\"next\":\"/jobs?before=%" PRId64 "&limit=%ld\"}\n", jobs[n - 1].id, limit);
@@ -556,7 +597,7 @@ static enum MHD_Result do_metrics(svc_daemon *d, struct MHD_Connection *c)
     for (int i = 0; i < d->cfg.workers; i++)
         if (d->live[i].job) {
             busy++;
-            fps += d->live[i].fps;
+            fps += d->live[i].kind == SVC_UNIT_JOIN ? 0 : d->live[i].fps;
         }
     uint64_t frames = d->frames_rendered, done = d->jobs_done, failed = d->jobs_failed, retried = d->jobs_retried;
     uint64_t crashes = d->worker_crashes, wd = d->watchdog_kills, rejected = d->uploads_rejected;

@@ -113,7 +113,29 @@ static void json_time(svc_buf *b, const char *key, int64_t t)
     svc_buf_printf(b, ",\"%s\":\"%s\"", key, s);
 }
 
-void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts)
+/* One unit: what it is, where it stands, who rendered it. */
+static void json_unit(svc_buf *b, const svc_unit *u)
+{
+    svc_buf_printf(b, "{");
+    if (u->kind == SVC_UNIT_SEGMENT)
+        svc_buf_printf(b, "\"index\":%d,\"ticks\":[%lld,%lld],", u->index, (long long)u->first_tick,
+                       (long long)u->end_tick);
+    svc_buf_printf(b, "\"state\":\"%s\",\"attempts\":%d,\"renders\":%d,\"frames_done\":%lld,\"worker\":",
+                   svc_state_name(u->state), u->attempts, u->renders, (long long)u->frames_done);
+    const char *who = u->state == SVC_RUNNING ? u->owner : u->done_by;
+    if (who[0])
+        svc_json_str(b, who);
+    else
+        svc_buf_add(b, "null", 4);
+    svc_buf_add(b, ",\"error\":", 9);
+    if (u->error[0])
+        svc_json_str(b, u->error);
+    else
+        svc_buf_add(b, "null", 4);
+    svc_buf_add(b, "}", 1);
+}
+
+void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit *units, int n)
 {
     svc_buf_printf(b, "{\"id\":%lld,\"state\":\"%s\",\"name\":", (long long)j->id, svc_state_name(j->state));
     svc_json_str(b, j->name);
@@ -143,6 +165,25 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts)
     json_time(b, "created", j->created);
     json_time(b, "started", j->started);
     json_time(b, "finished", j->finished);
+    if (j->segments > 0) {
+        svc_buf_printf(b, ",\"segment_seconds\":%g,\"segment_count\":%d", j->segment_ticks / 60.0, j->segments);
+        int k = 0;
+        for (int i = 0; i < n; i++)
+            if (units[i].kind == SVC_UNIT_SEGMENT) {
+                if (k++)
+                    svc_buf_add(b, ",", 1);
+                else
+                    svc_buf_add(b, ",\"segments\":[", 13);
+                json_unit(b, &units[i]);
+            }
+        if (k)
+            svc_buf_add(b, "]", 1);
+        for (int i = 0; i < n; i++)
+            if (units[i].kind == SVC_UNIT_JOIN) {
+                svc_buf_add(b, ",\"join\":", 8);
+                json_unit(b, &units[i]);
+            }
+    }
     svc_buf_printf(b, ",\"url\":\"/jobs/%lld\"", (long long)j->id);
     if (j->state == SVC_DONE)
         svc_buf_printf(b, ",\"video\":\"/jobs/%lld/video\",\"hashes\":\"/jobs/%lld/hashes\"", (long long)j->id,

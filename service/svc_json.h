@@ -22,8 +22,11 @@ void svc_buf_printf(svc_buf *b, const char *fmt, ...) RS_PRINTF(2, 3);
 /* A JSON string literal: quotes, escapes, control characters as \u00XX;
  * invalid UTF-8 bytes become U+FFFD so the output is always valid JSON. */
 void svc_json_str(svc_buf *b, const char *s);
-/* The job object of GET /jobs/N.  max_attempts comes from the config. */
-void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts);
+/* The job object of GET /jobs/N.  max_attempts comes from the config.  A
+ * split job adds segment_seconds and segment_count, and with its units
+ * (n > 0; GET /jobs/N, not the list) "segments" (each segment's ticks,
+ * state, attempts, renders, frames and worker) and "join". */
+void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit *units, int n);
 /* {"error":"msg"} */
 void svc_json_error(svc_buf *b, const char *msg);
 

@@ -26,8 +26,13 @@
 typedef struct svc_live {
     int64_t job;     /* 0: idle */
     pid_t pid;
-    int64_t done, total;
+    int kind, index; /* the unit (svc_unit_kind, its index) */
+    int64_t done, total; /* frames of the unit */
     double fps;
+    /* what the last heartbeat stored: the job's row holds the units' sums
+     * as of their heartbeats, so a reader adds done - beat_done */
+    int64_t beat_done;
+    double beat_fps;
 } svc_live;
 
 typedef struct svc_daemon {
@@ -91,5 +96,33 @@ int svc_parse_range(const char *h, uint64_t len, uint64_t *first, uint64_t *last
 
 /* svc_daemon.c */
 int svc_run(svc_daemon *d);
+
+/* svc_files.c: a unit's files and the command that makes them, cleaning
+ * up (the layout is described there). */
+typedef struct svc_unit_files {
+    char replay[1024];  /* DATA/work/jobN-PID-SLOT.rsr: the child's copy of the replay */
+    char out[1100];     /* what the child writes (-o) */
+    char hashes[1100];  /* its --hashes */
+    char segdir[1100];  /* a split job's segment directory ("" unsplit) */
+} svc_unit_files;
+void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_files *f);
+/* The child's argv: `ringside render` for a WHOLE unit or a SEGMENT,
+ * `ringside join` for the JOIN, whose segment files come from units (the
+ * job's, with each segment's done_attempt).  NULL with err filled when a
+ * segment is not done.  Free with svc_argv_free. */
+char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_files *f, const svc_unit *units, int n,
+                     rs_err *err);
+void svc_argv_free(char **argv);
+/* "SEGDIR/sI-aK.ext" */
+void svc_segment_path(char *out, size_t n, const char *segdir, int index, int attempt, const char *ext);
+/* Segment I's files as attempt K wrote them (video, hashes, manifest, temporaries). */
+void svc_segment_remove(const char *segdir, int index, int attempt);
+/* A directory and what is in it. */
+void svc_remove_dir(const char *path);
+/* Everything hidden of job id in the output directory (".jobN-..."): its
+ * segments, temporaries of crashed renders and joins.  For a job that is over. */
+void svc_remove_job_files(const svc_config *cfg, int64_t id);
+/* Leftovers of jobs that are over or unknown, and of dead daemons' work files. */
+void svc_sweep(svc_daemon *d);
 
 #endif

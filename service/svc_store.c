@@ -61,3 +61,23 @@ svc_store *svc_store_open(const char *spec, rs_err *err)
     }
     return svc_store_sqlite_open(spec, err);
 }
+
+const char *svc_unit_kind_name(int kind)
+{
+    static const char *const names[] = {
+#define X(id, s) s,
+        SVC_UNIT_KINDS(X)
+#undef X
+    };
+    return kind >= 0 && kind < (int)(sizeof names / sizeof names[0]) ? names[kind] : "unknown";
+}
+
+void svc_unit_context(char *out, size_t n, const svc_unit *u)
+{
+    if (u->kind == SVC_UNIT_SEGMENT)
+        snprintf(out, n, "segment %d (ticks %lld-%lld): ", u->index, (long long)u->first_tick, (long long)u->end_tick);
+    else if (u->kind == SVC_UNIT_JOIN)
+        snprintf(out, n, "join: ");
+    else if (n)
+        out[0] = 0;
+}

@@ -21,6 +21,32 @@
  *  - times are Unix seconds from the database's clock, so machines with
  *    skewed clocks still agree on leases.
  *
+ * Units (the segments of issue 18).  What a worker claims is a unit of a
+ * job, not the job: an unsplit job (segment_ticks 0, or a replay no longer
+ * than one segment) is one WHOLE unit, a split job is `segments` SEGMENT
+ * units of segment_ticks ticks each (the last shorter) plus one JOIN unit.
+ * Each unit has its own lease, heartbeat, attempts and error, and the rules
+ * above hold per unit:
+ *  - claim hands out the queued unit of the oldest job that has one, the
+ *    lowest index first; a JOIN only once every SEGMENT of its job is done;
+ *  - heartbeat, finish, release and rejoin name the job and the owner: an
+ *    owner (one worker slot) holds at most one unit at a time, so (job,
+ *    owner, running) is that unit;
+ *  - finish(DONE) of a SEGMENT marks it done (its attempt's files are the
+ *    ones to join: done_attempt) and counts one more render (renders: a
+ *    segment finished twice shows 2); finish(DONE) of the WHOLE or the
+ *    JOIN unit makes the job done; finish(FAILED) of any unit fails the job;
+ *  - a unit that runs out of attempts fails the whole job with its own
+ *    reason ("gave up after N attempts: segment K (ticks A-B): why");
+ *  - when a job ends (failed, cancelled) its units still queued or running
+ *    are cancelled: their owners' heartbeats answer "not ours";
+ *  - the job row is the units summed: state (running while any unit runs),
+ *    attempts (the most any unit took), frames_done (the frames of its
+ *    segments), fps (of its running units), owner and claimed_until (of a
+ *    running unit).
+ * Lock order (PostgreSQL): a job's row, then its units; every change holds
+ * the job's row, so two daemons never see a job half-changed.
+ *
  * Threads: a store handle is one database connection guarded by its own
  * mutex; any thread may call it.  The daemon opens one handle for its
  * supervisor loop and one for the HTTP threads. */
@@ -70,6 +96,36 @@ const char *svc_store_error_text(int code);
 #define SVC_ERROR_MAX 512
 #define SVC_OWNER_MAX 128
 
+/* A claimable piece of a job.  Zero is the default: the WHOLE job. */
+#define SVC_UNIT_KINDS(X) X(WHOLE, "whole") X(SEGMENT, "segment") X(JOIN, "join")
+typedef enum {
+#define X(id, s) SVC_UNIT_##id,
+    SVC_UNIT_KINDS(X)
+#undef X
+} svc_unit_kind;
+const char *svc_unit_kind_name(int kind);
+
+typedef struct svc_unit {
+    int kind;                    /* svc_unit_kind */
+    int index;                   /* SEGMENT: 0-based position; JOIN: the segment count; WHOLE: 0 */
+    int64_t first_tick, end_tick; /* ticks first..end-1 (the JOIN and WHOLE: the whole replay) */
+    int state;                   /* svc_state */
+    int attempts;                /* claims of this unit so far */
+    char owner[SVC_OWNER_MAX];   /* the worker slot holding it while running */
+    int64_t claimed_until, started, finished;
+    int64_t frames_done;
+    double fps;
+    char error[SVC_ERROR_MAX];   /* why its last attempt ended */
+    int renders;                 /* times it was finished done: 1 = rendered once */
+    char done_by[SVC_OWNER_MAX]; /* the worker slot that finished it */
+    int done_attempt;            /* the attempt whose files are its output (0: not done) */
+} svc_unit;
+
+/* The identity a split job's segment files carry (render --segment KEY):
+ * "job<id>-<nonce>", a new nonce per job, so files of another job or of a
+ * reused job id (a new queue, the same output directory) are never joined. */
+#define SVC_KEY_MAX 48
+
 typedef struct svc_job {
     int64_t id;
     int state;                   /* svc_state */
@@ -83,6 +139,10 @@ typedef struct svc_job {
     char error[SVC_ERROR_MAX];   /* why it failed (or why the last attempt did) */
     char owner[SVC_OWNER_MAX];   /* "host:pid" of the daemon running it */
     int64_t created, started, finished, claimed_until; /* Unix seconds; 0: not yet */
+    int segment_ticks;           /* submit: split into segments this long (0: unsplit) */
+    int segments;                /* how many it was split into (0: unsplit, one WHOLE unit) */
+    char key[SVC_KEY_MAX];       /* "job<id>-<nonce>" */
+    svc_unit unit;               /* claim: the unit handed out (the rest leave it zero) */
     /* the replay: submit reads it, claim fills it (malloc'd; svc_job_free) */
     uint8_t *replay;
     size_t replay_len;
@@ -94,33 +154,47 @@ typedef struct svc_store svc_store;
 
 typedef struct svc_store_ops {
     const char *name; /* "sqlite", "postgres" */
-    /* j: name, width, height, format, frames_total, replay, replay_len.
-     * Fills j->id and j->created; committed before it returns. */
+    /* j: name, width, height, format, frames_total, segment_ticks, replay,
+     * replay_len.  Fills j->id, j->created, j->segments and j->key, with
+     * the job's units; committed before it returns. */
     bool (*submit)(svc_store *s, svc_job *j, rs_err *err);
-    /* 1: claimed the oldest queued job into out (replay included);
-     * 0: nothing queued; -1: error. */
+    /* 1: claimed the next queued unit (see above) into out->unit, with its
+     * job and replay in out; 0: nothing to claim; -1: error. */
     int (*claim)(svc_store *s, const char *owner, int lease_s, svc_job *out, rs_err *err);
-    /* Extends the lease and records progress.  1: still ours; 0: not ours
-     * any more (cancelled, reaped, finished elsewhere): stop the worker;
-     * -1: error (keep going; the lease may still be valid). */
+    /* Extends the lease of owner's unit of job id and records its progress
+     * (frames of the unit).  1: still ours; 0: not ours any more (cancelled,
+     * reaped, finished elsewhere, the job failed): stop the worker; -1:
+     * error (keep going; the lease may still be valid). */
     int (*heartbeat)(svc_store *s, int64_t id, const char *owner, int lease_s, int64_t frames_done,
                      int64_t frames_total, double fps, rs_err *err);
-    /* The end of an attempt: state SVC_DONE or SVC_FAILED (no retry: a
-     * desync, say), with error and desync_tick (-1: none).  1: recorded;
-     * 0: not ours any more (nothing changed); -1: error. */
+    /* The end of an attempt of owner's unit: state SVC_DONE (see above) or
+     * SVC_FAILED (no retry: a desync, say; the job fails), with error and
+     * desync_tick (-1: none).  1: recorded; 0: not ours any more (nothing
+     * changed); -1: error. */
     int (*finish)(svc_store *s, int64_t id, const char *owner, int state, const char *error, int64_t desync_tick,
                   int64_t frames_done, rs_err *err);
-    /* An attempt that did not finish: back to queued with error as the
-     * reason, or failed ("gave up after N attempts: error") when attempts
-     * has reached max_attempts.  count_attempt false (a clean shutdown)
-     * gives the attempt back.  1: released; 0: not ours; -1: error. */
+    /* An attempt that did not finish: the unit back to queued with error as
+     * the reason, or the job failed ("gave up after N attempts: error")
+     * when the unit's attempts have reached max_attempts.  count_attempt
+     * false (a clean shutdown, a full disk) gives the attempt back.
+     * 1: released; 0: not ours; -1: error. */
     int (*release)(svc_store *s, int64_t id, const char *owner, const char *error, bool count_attempt,
                    int max_attempts, rs_err *err);
-    /* Running jobs whose lease has expired (all running jobs when all is
+    /* Running units whose lease has expired (all running units when all is
      * true: the single daemon of an SQLite file starting up) are released
      * as above with error "lease expired (worker or daemon lost)".
      * Returns how many, or -1. */
     int (*reap)(svc_store *s, int max_attempts, bool all, rs_err *err);
+    /* The join found bad segments (missing, truncated, not matching their
+     * manifests): owner's JOIN unit goes back to waiting, its attempt given
+     * back, and the segments bad[0..nbad-1] back to queued with why (their
+     * files are the caller's to delete), or the job fails when one of them
+     * has used max_attempts.  1: done; 0: not ours (or not a join); -1. */
+    int (*rejoin)(svc_store *s, int64_t id, const char *owner, const int *bad, int nbad, const char *why,
+                  int max_attempts, rs_err *err);
+    /* The units of job id by index (segments, then the join; or the one
+     * WHOLE unit), up to max into out.  Returns the count, or -1. */
+    int (*units)(svc_store *s, int64_t id, svc_unit *out, int max, rs_err *err);
     /* 1: found; 0: no such job; -1: error.  out->replay stays NULL. */
     int (*get)(svc_store *s, int64_t id, svc_job *out, rs_err *err);
     /* Newest first, ids below before_id (0: from the newest); up to limit
@@ -140,7 +214,9 @@ struct svc_store {
 
 /* "sqlite:PATH" or a bare path ending in .db: SQLite (WAL);
  * "postgres://..." or "postgresql://...": PostgreSQL (libpq conninfo URI).
- * Creates the schema if it is missing.  NULL with err filled on failure. */
+ * Creates the schema if it is missing, and brings a queue made before
+ * units existed up to date (its queued and running jobs become WHOLE
+ * units).  NULL with err filled on failure. */
 svc_store *svc_store_open(const char *spec, rs_err *err);
 svc_store *svc_store_sqlite_open(const char *path, rs_err *err);
 svc_store *svc_store_pg_open(const char *conninfo, rs_err *err);
@@ -149,5 +225,8 @@ svc_store *svc_store_pg_open(const char *conninfo, rs_err *err);
 #define SVC_LEASE_EXPIRED "lease expired (worker or daemon lost)"
 /* "gave up after N attempts: why" into out. */
 void svc_dead_letter(char *out, size_t n, int attempts, const char *why);
+/* What a unit's messages start with in its job's error: "" (WHOLE),
+ * "segment K (ticks A-B): " or "join: ". */
+void svc_unit_context(char *out, size_t n, const svc_unit *u);
 
 #endif

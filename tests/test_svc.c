@@ -38,6 +38,7 @@ static void t_config_defaults(void)
     T_ASSERT(c.workers == 1 && c.max_upload == 1 << 20 && c.max_attempts == 3);
     T_ASSERT(c.lease == 30 && c.watchdog == 120 && c.grace == 30);
     T_ASSERT(c.width == 640 && c.height == 360 && c.max_width == 1920 && c.max_height == 1080);
+    T_EQ(c.segment_seconds, 30);
     T_ASSERT(c.render_width == 1280 && c.render_height == 720);
     T_EQ(c.log_level, SVC_LOG_INFO);
 }
@@ -53,6 +54,8 @@ typedef struct set_case {
 static const set_case set_cases[] = {
     {"workers", "1", 1, "workers = 1"}, {"workers", "64", 1, "workers = 64"},
     {"grace", "0", 1, "grace = 0"}, {"watchdog", "86400", 1, "watchdog = 86400"},
+    {"segment_seconds", "0", 1, "segment_seconds = 0"}, {"segment_seconds", "3600", 1, "segment_seconds = 3600"},
+    {"segment_seconds", "-1", 0, "segment_seconds: -1 is out of range (expected 0..3600)"},
     {"workers", "0", 0, "workers: 0 is out of range (expected 1..64)"},
     {"workers", "65", 0, "workers: 65 is out of range (expected 1..64)"},
     {"workers", "4294967297", 0, "out of range"}, /* wraps to 1 if narrowed before the check */
@@ -98,7 +101,7 @@ static const set_case set_cases[] = {
     {"listen", "host:", 0, "the port must be 0..65535"}, {"listen", "host:-1", 0, "the port must be 0..65535"},
     {"listen", "host:80x", 0, "the port must be 0..65535"}, {"listen", "[::1]", 0, "an IPv6 address goes in brackets"},
     {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
-                        "max_seconds, max_attempts, lease, watchdog, grace, size, max_size, render_size, format, backend, log_level)"},
+                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, format, backend, log_level)"},
     {"", "1", 0, "unknown setting ''"},
 };
 
@@ -213,7 +216,7 @@ static void t_config_load_errors(void)
     LOAD_BAD("# c\n\nworkers = 0\n", ":3: workers: 0 is out of range (expected 1..64)");
     LOAD_BAD("workers = 2\ngarbage here\n", ":2: expected 'name = value', got 'garbage here'");
     LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, "
-                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, size, max_size, render_size, "
+                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, "
                                    "format, backend, log_level)");
     LOAD_BAD("size = 640x360\r\nsize = 640\r\n", ":2: size: '640' is not a size (expected WxH, such as 640x360)");
     LOAD_BAD("workers = # nothing left\n", ":1: workers: '' is not a whole number");
@@ -271,6 +274,7 @@ static void config_same(const svc_config *a, const svc_config *b)
     T_ASSERT(!strcmp(a->output, b->output) && !strcmp(a->format, b->format) && !strcmp(a->backend, b->backend));
     T_ASSERT(a->workers == b->workers && a->max_upload == b->max_upload && a->max_attempts == b->max_attempts);
     T_ASSERT(a->lease == b->lease && a->watchdog == b->watchdog && a->grace == b->grace);
+    T_ASSERT(a->segment_seconds == b->segment_seconds);
     T_ASSERT(a->width == b->width && a->height == b->height && a->max_width == b->max_width);
     T_ASSERT(a->max_height == b->max_height && a->render_width == b->render_width);
     T_ASSERT(a->render_height == b->render_height && a->log_level == b->log_level);
@@ -298,7 +302,7 @@ static void t_config_dump_roundtrip(void)
     const char *kv[][2] = {{"listen", "[::1]:9000"}, {"workers", "8"}, {"data", "/srv/ring side"},
                            {"queue", "postgres://u@db:5432/ring?sslmode=require"}, {"output", "/mnt/videos"},
                            {"max_upload", "3M"}, {"max_attempts", "5"}, {"lease", "60"}, {"watchdog", "300"},
-                           {"grace", "0"}, {"size", "1280x720"}, {"max_size", "3840x2160"},
+                           {"grace", "0"}, {"segment_seconds", "0"}, {"size", "1280x720"}, {"max_size", "3840x2160"},
                            {"render_size", "2560x1440"}, {"format", "mkv"}, {"backend", "osmesa"},
                            {"log_level", "debug"}};
     for (size_t i = 0; i < sizeof kv / sizeof *kv; i++)
@@ -510,7 +514,7 @@ static svc_job job(int state)
 static void job_is(const svc_job *j, const char *want, bool exact)
 {
     svc_buf b = {0};
-    svc_json_job(&b, j, 3);
+    svc_json_job(&b, j, 3, NULL, 0);
     T_ASSERT(b.p && !b.oom);
     if (exact)
         T_ASSERTF(!strcmp(b.p, want), "\ngot  %s\nwant %s", b.p, want);
@@ -561,6 +565,42 @@ static void t_json_job(void)
     j = job(SVC_CANCELLED);
     j.frames_total = 0; /* no division by zero */
     job_is(&j, JOB_HEAD "\"cancelled\"," JOB_NAME "\"frames_done\":0,\"frames_total\":0,\"progress\":0.0000,", false);
+}
+
+/* A split job: its segment count, and with its units who rendered what. */
+static void t_json_split_job(void)
+{
+    svc_job j = job(SVC_RUNNING);
+    j.segments = 2, j.segment_ticks = 60, j.frames_total = 120, j.frames_done = 90, j.fps = 20;
+    job_is(&j, "\"segment_seconds\":1,\"segment_count\":2,\"url\":", false);
+    svc_unit u[3] = {
+        {.kind = SVC_UNIT_SEGMENT, .index = 0, .first_tick = 0, .end_tick = 60, .state = SVC_DONE, .attempts = 2,
+         .renders = 1, .frames_done = 60},
+        {.kind = SVC_UNIT_SEGMENT, .index = 1, .first_tick = 60, .end_tick = 120, .state = SVC_RUNNING, .attempts = 1,
+         .frames_done = 30},
+        {.kind = SVC_UNIT_JOIN, .index = 2, .end_tick = 120},
+    };
+    snprintf(u[0].done_by, sizeof u[0].done_by, "box:1-ab/0");
+    snprintf(u[0].owner, sizeof u[0].owner, "stale"); /* a done unit names who finished it */
+    snprintf(u[0].error, sizeof u[0].error, "lease expired");
+    snprintf(u[1].owner, sizeof u[1].owner, "box:1-ab/1");
+    svc_buf b = {0};
+    svc_json_job(&b, &j, 3, u, 3);
+    T_ASSERT(b.p && !b.oom);
+    T_CONTAINS(b.p, "\"segment_seconds\":1,\"segment_count\":2,\"segments\":["
+                    "{\"index\":0,\"ticks\":[0,60],\"state\":\"done\",\"attempts\":2,\"renders\":1,"
+                    "\"frames_done\":60,\"worker\":\"box:1-ab/0\",\"error\":\"lease expired\"},"
+                    "{\"index\":1,\"ticks\":[60,120],\"state\":\"running\",\"attempts\":1,\"renders\":0,"
+                    "\"frames_done\":30,\"worker\":\"box:1-ab/1\",\"error\":null}],"
+                    "\"join\":{\"state\":\"queued\",\"attempts\":0,\"renders\":0,\"frames_done\":0,"
+                    "\"worker\":null,\"error\":null},\"url\":\"/jobs/42\"}");
+    T_CONTAINS(b.p, "\"progress\":0.7500,\"fps\":20.00,\"eta_s\":1.5,");
+    svc_buf_free(&b);
+    /* unsplit: not a word more than before */
+    j = job(SVC_RUNNING);
+    svc_json_job(&b, &j, 3, u, 3);
+    T_ASSERT(!strstr(b.p, "segment"));
+    svc_buf_free(&b);
 }
 
 static void t_json_buf_growth(void)
@@ -843,7 +883,7 @@ T_MAIN({"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"c
        {"config_load_errors", t_config_load_errors}, {"config_finish", t_config_finish},
        {"config_dump_roundtrip", t_config_dump_roundtrip}, {"config_dump_hash", t_config_dump_hash},
        {"json_str_fixed", t_json_str_fixed}, {"json_str_f5_lead", t_json_str_f5_lead},
-       {"json_str_random", t_json_str_random}, {"json_job", t_json_job}, {"json_buf_growth", t_json_buf_growth},
+       {"json_str_random", t_json_str_random}, {"json_job", t_json_job}, {"json_split_job", t_json_split_job}, {"json_buf_growth", t_json_buf_growth},
        {"range_cases", t_range_cases}, {"range_random", t_range_random}, {"upload_refusals", t_upload_refusals},
        {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},

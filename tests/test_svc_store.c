@@ -125,7 +125,8 @@ static svc_job claim_ok(svc_store *s, const char *owner, int lease_s)
     int r = s->ops->claim(s, owner, lease_s, &j, &e);
     T_ASSERTF(r == 1, "claim by %s: %d %s", owner, r, e.msg);
     T_EQ(j.state, SVC_RUNNING);
-    T_ASSERT(strcmp(j.owner, owner) == 0);
+    T_ASSERT(strcmp(j.unit.owner, owner) == 0);
+    T_ASSERT(j.unit.kind != SVC_UNIT_WHOLE || strcmp(j.owner, owner) == 0);
     return j;
 }
 
@@ -689,6 +690,462 @@ static void open_race(const char *spec)
     s->ops->close(s);
 }
 
+/* --- units: split jobs (svc_store.h, "Units") --- */
+
+static int64_t submit_split(svc_store *s, int64_t frames, int seg_ticks, svc_job *out)
+{
+    rs_err e = {0};
+    svc_job j = {.width = 160, .height = 90, .frames_total = frames, .segment_ticks = seg_ticks,
+                 .replay = (uint8_t *)"r", .replay_len = 1};
+    snprintf(j.name, sizeof j.name, "split.rsr");
+    snprintf(j.format, sizeof j.format, "mp4");
+    T_ASSERTF(s->ops->submit(s, &j, &e), "submit: %s", e.msg);
+    if (out)
+        *out = j;
+    return j.id;
+}
+
+static int units_of(svc_store *s, int64_t id, svc_unit *u, int max)
+{
+    rs_err e = {0};
+    int n = s->ops->units(s, id, u, max, &e);
+    T_ASSERTF(n >= 0, "units of %lld: %s", (long long)id, e.msg);
+    return n;
+}
+
+/* claims the next unit and checks it is (kind, index) of job id */
+static svc_job claim_unit(svc_store *s, const char *owner, int64_t id, int kind, int index)
+{
+    svc_job j = claim_ok(s, owner, 60);
+    T_ASSERTF(j.id == id && j.unit.kind == kind && j.unit.index == index, "claimed job %lld %s %d, want job %lld %s %d",
+              (long long)j.id, svc_unit_kind_name(j.unit.kind), j.unit.index, (long long)id, svc_unit_kind_name(kind),
+              index);
+    T_EQ(j.unit.state, SVC_RUNNING);
+    T_ASSERT(!strcmp(j.unit.owner, owner));
+    svc_job_free(&j);
+    return j;
+}
+
+static void split_plan(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    svc_job a, b;
+    int64_t id = submit_split(s, 250, 60, &a);
+    T_EQ(a.segments, 5);
+    T_EQ(a.segment_ticks, 60);
+    svc_unit u[8];
+    T_EQ(units_of(s, id, u, 8), 6);
+    static const int64_t first[] = {0, 60, 120, 180, 240}, end[] = {60, 120, 180, 240, 250};
+    for (int i = 0; i < 5; i++) {
+        T_EQ(u[i].kind, SVC_UNIT_SEGMENT);
+        T_EQ(u[i].index, i);
+        T_EQ(u[i].first_tick, first[i]);
+        T_EQ(u[i].end_tick, end[i]);
+        T_ASSERT(u[i].state == SVC_QUEUED && u[i].attempts == 0 && u[i].renders == 0 && !u[i].done_attempt);
+    }
+    T_EQ(u[5].kind, SVC_UNIT_JOIN);
+    T_EQ(u[5].index, 5);
+    T_EQ(u[5].end_tick, 250);
+    T_EQ(units_of(s, id, u, 2), 2);
+    /* the key: the job's id and a nonce of its own */
+    char want[32];
+    snprintf(want, sizeof want, "job%lld-", (long long)id);
+    T_ASSERTF(!strncmp(a.key, want, strlen(want)) && strlen(a.key) == strlen(want) + 16, "key '%s'", a.key);
+    svc_job g = get_ok(s, id);
+    T_ASSERT(!strcmp(g.key, a.key) && g.segments == 5 && g.segment_ticks == 60);
+    submit_split(s, 250, 60, &b);
+    T_ASSERT(strcmp(a.key + strlen(want), b.key + strlen(want) + (b.id >= 10)));
+    /* no longer than one segment, or no segment length: one WHOLE unit */
+    const int64_t whole[][2] = {{60, 60}, {59, 60}, {250, 0}};
+    for (int i = 0; i < 3; i++) {
+        int64_t w = submit_split(s, whole[i][0], (int)whole[i][1], &a);
+        T_EQ(a.segments, 0);
+        T_EQ(units_of(s, w, u, 8), 1);
+        T_ASSERT(u[0].kind == SVC_UNIT_WHOLE && u[0].first_tick == 0 && u[0].end_tick == whole[i][0]);
+    }
+    s->ops->close(s);
+}
+
+static void split_run(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t id = submit_split(s, 150, 60, NULL), after = submit(s, "after", "a", 1);
+    /* segments in order, to any owner; the join waits for all of them */
+    claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, 0);
+    claim_unit(s, "b:2", id, SVC_UNIT_SEGMENT, 1);
+    claim_unit(s, "c:3", id, SVC_UNIT_SEGMENT, 2);
+    svc_job g = get_ok(s, id);
+    T_EQ(g.state, SVC_RUNNING);
+    T_EQ(g.attempts, 1);
+    /* progress: the frames of every segment, the fps of the running ones */
+    T_EQ(s->ops->heartbeat(s, id, "a:1", 60, 30, 60, 10.0, &e), 1);
+    T_EQ(s->ops->heartbeat(s, id, "b:2", 60, 20, 60, 5.5, &e), 1);
+    T_EQ(s->ops->heartbeat(s, id, "z:9", 60, 20, 60, 5.5, &e), 0);
+    g = get_ok(s, id);
+    T_EQ(g.frames_done, 50);
+    T_EQ(g.frames_total, 150);
+    T_ASSERTF(g.fps == 15.5, "fps %g", g.fps);
+    T_ASSERT(g.owner[0]);
+    T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+    T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 0); /* once */
+    T_EQ(get_ok(s, id).state, SVC_RUNNING);
+    T_EQ(s->ops->finish(s, id, "b:2", SVC_DONE, NULL, -1, 60, &e), 1);
+    /* the join is not claimable yet: the other job comes first */
+    claim_unit(s, "a:1", after, SVC_UNIT_WHOLE, 0);
+    claim_none(s);
+    T_EQ(s->ops->finish(s, id, "c:3", SVC_DONE, NULL, -1, 30, &e), 1);
+    g = get_ok(s, id);
+    T_EQ(g.frames_done, 150);
+    T_EQ(g.state, SVC_QUEUED); /* nothing of it runs, nothing is over */
+    claim_unit(s, "b:2", id, SVC_UNIT_JOIN, 3);
+    T_EQ(get_ok(s, id).state, SVC_RUNNING);
+    T_EQ(s->ops->heartbeat(s, id, "b:2", 60, 150, 150, 0, &e), 1);
+    T_EQ(get_ok(s, id).frames_done, 150); /* the join's own count is not the job's frames */
+    T_EQ(s->ops->finish(s, id, "b:2", SVC_DONE, NULL, -1, 150, &e), 1);
+    g = get_ok(s, id);
+    T_EQ(g.state, SVC_DONE);
+    T_EQ(g.frames_done, 150);
+    T_ASSERT(g.finished > 0 && g.claimed_until == 0 && g.fps == 0);
+    svc_unit u[4];
+    T_EQ(units_of(s, id, u, 4), 4);
+    const char *by[] = {"a:1", "b:2", "c:3", "b:2"};
+    for (int i = 0; i < 4; i++) {
+        T_EQ(u[i].state, SVC_DONE);
+        T_EQ(u[i].renders, 1);
+        T_EQ(u[i].done_attempt, 1);
+        T_ASSERTF(!strcmp(u[i].done_by, by[i]), "unit %d done by '%s'", i, u[i].done_by);
+        T_ASSERT(!u[i].owner[0] || u[i].claimed_until == 0);
+    }
+    T_EQ(u[2].frames_done, 30);
+    claim_none(s);
+    s->ops->close(s);
+}
+
+static void split_retry(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t id = submit_split(s, 180, 60, NULL);
+    claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, 0);
+    claim_unit(s, "b:2", id, SVC_UNIT_SEGMENT, 1);
+    T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+    T_EQ(s->ops->heartbeat(s, id, "b:2", 60, 40, 60, 3, &e), 1);
+    /* segment 1 crashes: it alone goes back, its progress with it */
+    T_EQ(s->ops->release(s, id, "b:2", "worker crashed", true, 2, &e), 1);
+    svc_job g = get_ok(s, id);
+    T_EQ(g.state, SVC_QUEUED);
+    T_EQ(g.frames_done, 60);
+    T_CONTAINS(g.error, "segment 1 (ticks 60-120): worker crashed");
+    svc_unit u[4];
+    units_of(s, id, u, 4);
+    T_ASSERT(u[0].state == SVC_DONE && u[0].renders == 1);
+    T_ASSERT(u[1].state == SVC_QUEUED && u[1].attempts == 1 && !strcmp(u[1].error, "worker crashed"));
+    /* a clean shutdown gives the attempt back */
+    claim_unit(s, "c:3", id, SVC_UNIT_SEGMENT, 1);
+    T_EQ(s->ops->release(s, id, "c:3", "daemon stopping", false, 2, &e), 1);
+    units_of(s, id, u, 4);
+    T_EQ(u[1].attempts, 1);
+    /* the cap is per segment: segment 2 has its own attempts */
+    claim_unit(s, "c:3", id, SVC_UNIT_SEGMENT, 1);
+    claim_unit(s, "d:4", id, SVC_UNIT_SEGMENT, 2);
+    T_EQ(get_ok(s, id).attempts, 2);
+    /* segment 1 runs out: the job fails with its reason, and the others
+     * stop (their heartbeats are answered "not ours") */
+    T_EQ(s->ops->release(s, id, "c:3", "the render process was killed by signal 9", true, 2, &e), 1);
+    g = get_ok(s, id);
+    T_EQ(g.state, SVC_FAILED);
+    T_ASSERTF(!strcmp(g.error, "gave up after 2 attempts: segment 1 (ticks 60-120): the render process was killed by "
+                               "signal 9"),
+              "error '%s'", g.error);
+    T_ASSERT(g.finished > 0);
+    T_EQ(s->ops->heartbeat(s, id, "d:4", 60, 1, 60, 1, &e), 0);
+    T_EQ(s->ops->finish(s, id, "d:4", SVC_DONE, NULL, -1, 60, &e), 0);
+    units_of(s, id, u, 4);
+    T_ASSERT(u[0].state == SVC_DONE && u[1].state == SVC_FAILED && u[2].state == SVC_CANCELLED &&
+             u[3].state == SVC_CANCELLED);
+    claim_none(s);
+    s->ops->close(s);
+}
+
+static void split_cancel_and_desync(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t a = submit_split(s, 120, 60, NULL), b = submit_split(s, 180, 60, NULL);
+    claim_unit(s, "a:1", a, SVC_UNIT_SEGMENT, 0);
+    T_EQ(s->ops->cancel(s, a, &e), 1);
+    T_EQ(s->ops->heartbeat(s, a, "a:1", 60, 1, 60, 1, &e), 0);
+    T_EQ(s->ops->release(s, a, "a:1", "x", true, 3, &e), 0);
+    svc_unit u[4];
+    T_EQ(units_of(s, a, u, 4), 3);
+    for (int i = 0; i < 3; i++)
+        T_EQ(u[i].state, SVC_CANCELLED);
+    T_EQ(s->ops->cancel(s, a, &e), 2);
+    /* a segment that desyncs fails the job with the tick, not retried */
+    claim_unit(s, "a:1", b, SVC_UNIT_SEGMENT, 0);
+    claim_unit(s, "b:2", b, SVC_UNIT_SEGMENT, 1);
+    T_EQ(s->ops->finish(s, b, "b:2", SVC_FAILED, "b.rsr: desync at tick 120", 120, 40, &e), 1);
+    svc_job g = get_ok(s, b);
+    T_EQ(g.state, SVC_FAILED);
+    T_EQ(g.desync_tick, 120);
+    T_ASSERTF(!strcmp(g.error, "segment 1 (ticks 60-120): b.rsr: desync at tick 120"), "error '%s'", g.error);
+    T_EQ(s->ops->heartbeat(s, b, "a:1", 60, 1, 60, 1, &e), 0);
+    claim_none(s);
+    s->ops->close(s);
+}
+
+/* A daemon dies: its running segments come back, finished ones stay. */
+static void split_reap_resumes(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t id = submit_split(s, 240, 60, NULL);
+    claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, 0);
+    T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+    svc_job j = claim_ok(s, "a:1", -5); /* expired */
+    T_EQ(j.unit.index, 1);
+    svc_job_free(&j);
+    claim_unit(s, "b:2", id, SVC_UNIT_SEGMENT, 2);
+    T_EQ(s->ops->reap(s, 3, false, &e), 1);
+    svc_unit u[5];
+    units_of(s, id, u, 5);
+    T_ASSERT(u[0].state == SVC_DONE && u[1].state == SVC_QUEUED && u[2].state == SVC_RUNNING);
+    T_ASSERT(!strcmp(u[1].error, SVC_LEASE_EXPIRED));
+    T_EQ(s->ops->reap(s, 3, true, &e), 1); /* start-up of the one SQLite daemon */
+    units_of(s, id, u, 5);
+    T_ASSERT(u[0].state == SVC_DONE && u[0].renders == 1 && u[2].state == SVC_QUEUED);
+    T_EQ(get_ok(s, id).state, SVC_QUEUED);
+    T_EQ(get_ok(s, id).frames_done, 60);
+    /* the rest, then the join: segment 0 is never handed out again */
+    for (int i = 1; i < 4; i++) {
+        char owner[16];
+        snprintf(owner, sizeof owner, "c:%d", i);
+        claim_unit(s, owner, id, SVC_UNIT_SEGMENT, i);
+        T_EQ(s->ops->finish(s, id, owner, SVC_DONE, NULL, -1, 60, &e), 1);
+    }
+    claim_unit(s, "c:1", id, SVC_UNIT_JOIN, 4);
+    units_of(s, id, u, 5);
+    for (int i = 0; i < 4; i++)
+        T_EQ(u[i].renders, 1);
+    T_EQ(u[1].done_attempt, 2);
+    T_EQ(u[2].done_attempt, 2);
+    s->ops->close(s);
+}
+
+static void split_rejoin(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t id = submit_split(s, 240, 60, NULL);
+    for (int i = 0; i < 4; i++) {
+        claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, i);
+        T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+    }
+    int bad[] = {1, 3};
+    T_EQ(s->ops->rejoin(s, id, "a:1", bad, 2, "not a join", 3, &e), 0); /* a:1 holds nothing */
+    claim_unit(s, "a:1", id, SVC_UNIT_JOIN, 4);
+    T_EQ(s->ops->rejoin(s, id, "b:2", bad, 2, "not ours", 3, &e), 0);
+    T_EQ(s->ops->rejoin(s, id, "a:1", bad, 2, "s1.mp4: truncated", 3, &e), 1);
+    svc_unit u[5];
+    units_of(s, id, u, 5);
+    T_ASSERT(u[0].state == SVC_DONE && u[2].state == SVC_DONE);
+    T_ASSERT(u[1].state == SVC_QUEUED && u[1].done_attempt == 0 && !strcmp(u[1].error, "s1.mp4: truncated"));
+    T_ASSERT(u[3].state == SVC_QUEUED);
+    T_ASSERT(u[4].state == SVC_QUEUED && u[4].attempts == 0); /* the join's attempt was given back */
+    svc_job g = get_ok(s, id);
+    T_EQ(g.frames_done, 120);
+    T_CONTAINS(g.error, "join: s1.mp4: truncated");
+    /* those two again, and then the join */
+    claim_unit(s, "b:2", id, SVC_UNIT_SEGMENT, 1);
+    claim_unit(s, "c:3", id, SVC_UNIT_SEGMENT, 3);
+    claim_none(s);
+    T_EQ(s->ops->finish(s, id, "b:2", SVC_DONE, NULL, -1, 60, &e), 1);
+    T_EQ(s->ops->finish(s, id, "c:3", SVC_DONE, NULL, -1, 60, &e), 1);
+    units_of(s, id, u, 5);
+    T_ASSERT(u[1].renders == 2 && u[1].done_attempt == 2 && u[0].renders == 1);
+    /* bad again and again: at the cap the job fails with the segment's reason */
+    int one[] = {1};
+    for (int k = 0; k < 2; k++) {
+        claim_unit(s, "a:1", id, SVC_UNIT_JOIN, 4);
+        T_EQ(s->ops->rejoin(s, id, "a:1", one, 1, "s1.mp4: wrong size", 3, &e), 1);
+        if (k == 0) {
+            claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, 1);
+            T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+        }
+    }
+    g = get_ok(s, id);
+    T_EQ(g.state, SVC_FAILED);
+    T_ASSERTF(!strcmp(g.error, "gave up after 3 attempts: segment 1 (ticks 60-120): s1.mp4: wrong size"), "error '%s'",
+              g.error);
+    claim_none(s);
+    s->ops->close(s);
+}
+
+/* Four processes (four daemons) render three split jobs: every unit is
+ * claimed once, every segment finished once, every join after its
+ * segments. */
+static void split_concurrent(const char *spec)
+{
+    enum { JOBS = 3, W = 4 };
+    svc_store *s = open_ok(spec);
+    int64_t ids[JOBS];
+    for (int i = 0; i < JOBS; i++)
+        ids[i] = submit_split(s, 600, 60, NULL); /* 10 segments and a join each */
+    pid_t kid[W];
+    for (int k = 0; k < W; k++) {
+        kid[k] = fork();
+        T_ASSERT(kid[k] >= 0);
+        if (kid[k] == 0) {
+            rs_err e = {0};
+            svc_store *w = svc_store_open(spec, &e);
+            if (!w)
+                _exit(2);
+            char owner[32];
+            snprintf(owner, sizeof owner, "w%d:%d", k, (int)getpid());
+            int idle = 0;
+            while (idle < 20) {
+                svc_job j;
+                int r = w->ops->claim(w, owner, 60, &j, &e);
+                if (r < 0) {
+                    fprintf(stderr, "    worker %d: claim: %s\n", k, e.msg);
+                    _exit(3);
+                }
+                if (r == 0) { /* a join may be waiting for another worker's segment */
+                    idle++;
+                    nanosleep(&(struct timespec){0, 20 * 1000 * 1000}, NULL);
+                    continue;
+                }
+                idle = 0;
+                nanosleep(&(struct timespec){0, 5 * 1000 * 1000}, NULL); /* "rendering" */
+                if (j.unit.kind == SVC_UNIT_JOIN) {
+                    svc_unit u[16];
+                    int n = w->ops->units(w, j.id, u, 16, &e);
+                    for (int i = 0; i < n - 1; i++)
+                        if (u[i].state != SVC_DONE)
+                            _exit(4); /* a join before all its segments */
+                }
+                if (w->ops->finish(w, j.id, owner, SVC_DONE, NULL, -1, 60, &e) != 1)
+                    _exit(5);
+                svc_job_free(&j);
+            }
+            w->ops->close(w);
+            _exit(0);
+        }
+    }
+    for (int k = 0; k < W; k++) {
+        int st = 0;
+        T_ASSERT(waitpid(kid[k], &st, 0) == kid[k]);
+        T_ASSERTF(WIFEXITED(st) && WEXITSTATUS(st) == 0, "worker %d ended with status %#x", k, st);
+    }
+    int owners_seen = 0;
+    char first_owner[64] = "";
+    for (int i = 0; i < JOBS; i++) {
+        T_EQ(get_ok(s, ids[i]).state, SVC_DONE);
+        svc_unit u[16];
+        T_EQ(units_of(s, ids[i], u, 16), 11);
+        for (int k = 0; k < 11; k++) {
+            T_ASSERTF(u[k].renders == 1 && u[k].attempts == 1, "job %lld unit %d: %d renders, %d attempts",
+                      (long long)ids[i], k, u[k].renders, u[k].attempts);
+            if (!first_owner[0])
+                snprintf(first_owner, sizeof first_owner, "%s", u[k].done_by);
+            else if (strcmp(first_owner, u[k].done_by))
+                owners_seen = 1;
+        }
+    }
+    T_ASSERTF(owners_seen, "every unit went to %s", first_owner);
+    s->ops->close(s);
+}
+
+/* A queue made before units: it opens, its jobs become WHOLE units. */
+static void migrate_v1(const char *spec, void (*sql)(const char *spec, const char *stmt))
+{
+    sql(spec, "CREATE TABLE jobs (id " "%ID%" ", state INTEGER NOT NULL DEFAULT 0, name TEXT NOT NULL DEFAULT '',"
+              " width INTEGER NOT NULL, height INTEGER NOT NULL, format TEXT NOT NULL,"
+              " frames_done BIGINT NOT NULL DEFAULT 0, frames_total BIGINT NOT NULL DEFAULT 0,"
+              " fps DOUBLE PRECISION NOT NULL DEFAULT 0, attempts INTEGER NOT NULL DEFAULT 0,"
+              " desync_tick BIGINT NOT NULL DEFAULT -1, error TEXT NOT NULL DEFAULT '', owner TEXT NOT NULL DEFAULT '',"
+              " created BIGINT NOT NULL DEFAULT 0, started BIGINT NOT NULL DEFAULT 0, finished BIGINT NOT NULL DEFAULT 0,"
+              " claimed_until BIGINT NOT NULL DEFAULT 0, replay %BLOB% NOT NULL)");
+    sql(spec, "INSERT INTO jobs (state, width, height, format, frames_total, replay, name) VALUES"
+              " (2, 64, 36, 'mp4', 60, %X%, 'done'), (1, 64, 36, 'mp4', 60, %X%, 'running'),"
+              " (0, 64, 36, 'mp4', 60, %X%, 'queued')");
+    sql(spec, "UPDATE jobs SET owner = 'old:1', attempts = 1, claimed_until = 1 WHERE state = 1");
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    svc_unit u[2];
+    T_EQ(units_of(s, 1, u, 2), 0);
+    T_EQ(units_of(s, 2, u, 2), 1);
+    T_ASSERT(u[0].kind == SVC_UNIT_WHOLE && u[0].state == SVC_RUNNING && !strcmp(u[0].owner, "old:1"));
+    T_EQ(s->ops->reap(s, 3, false, &e), 1); /* its lease ran out long ago */
+    svc_job j = claim_unit(s, "new:1", 2, SVC_UNIT_WHOLE, 0);
+    T_EQ(j.attempts, 2);
+    T_EQ(j.segments, 0);
+    claim_unit(s, "new:2", 3, SVC_UNIT_WHOLE, 0);
+    T_EQ(s->ops->finish(s, 3, "new:2", SVC_DONE, NULL, -1, 60, &e), 1);
+    T_EQ(get_ok(s, 3).state, SVC_DONE);
+    T_EQ(get_ok(s, 1).state, SVC_DONE);
+    s->ops->close(s);
+    s = open_ok(spec); /* and again: nothing more to migrate */
+    T_EQ(units_of(s, 3, u, 2), 1);
+    s->ops->close(s);
+}
+
+/* stmt with %ID%, %BLOB% and %X% in the backend's words */
+static void spell_admin(char *out, size_t n, const char *stmt, const char *id, const char *blob, const char *x)
+{
+    size_t k = 0;
+    for (const char *p = stmt; *p && k + 64 < n;) {
+        const char *put = NULL;
+        if (!strncmp(p, "%ID%", 4))
+            put = id, p += 4;
+        else if (!strncmp(p, "%BLOB%", 6))
+            put = blob, p += 6;
+        else if (!strncmp(p, "%X%", 3))
+            put = x, p += 3;
+        if (put) {
+            k += (size_t)snprintf(out + k, n - k, "%s", put);
+            continue;
+        }
+        out[k++] = *p++;
+    }
+    out[k] = 0;
+}
+
+static void sqlite_admin(const char *spec, const char *stmt)
+{
+#if defined(RS_HAVE_SQLITE)
+    char sql[2048];
+    spell_admin(sql, sizeof sql, stmt, "INTEGER PRIMARY KEY AUTOINCREMENT", "BLOB", "x'00'");
+    sqlite3 *db = NULL;
+    T_ASSERT(sqlite3_open(spec + strlen("sqlite:"), &db) == SQLITE_OK);
+    char *msg = NULL;
+    T_ASSERTF(sqlite3_exec(db, sql, NULL, NULL, &msg) == SQLITE_OK, "%s: %s", sql, msg ? msg : "?");
+    sqlite3_close(db);
+#else
+    (void)spec, (void)stmt;
+#endif
+}
+
+static void pg_admin_in_schema(const char *spec, const char *stmt)
+{
+    (void)spec;
+    char sql[2048], full[2100];
+    spell_admin(sql, sizeof sql, stmt, "BIGSERIAL PRIMARY KEY", "BYTEA", "'\\x00'::bytea");
+    snprintf(full, sizeof full, "SET search_path = " PG_SCHEMA "; %s", sql);
+    pg_admin(full);
+}
+
+static void t_sqlite_migrate_v1(void)
+{
+    migrate_v1(sqlite_spec(), sqlite_admin);
+}
+
+static void t_pg_migrate_v1(void)
+{
+    migrate_v1(pg_spec(), pg_admin_in_schema);
+}
+
 #define BOTH(fn)                                                                                                      \
     static void t_sqlite_##fn(void) { fn(sqlite_spec()); }                                                            \
     static void t_pg_##fn(void) { fn(pg_spec()); }
@@ -709,6 +1166,13 @@ BOTH(persistence)
 BOTH(concurrent_claim)
 BOTH(shared_handle)
 BOTH(open_race)
+BOTH(split_plan)
+BOTH(split_run)
+BOTH(split_retry)
+BOTH(split_cancel_and_desync)
+BOTH(split_reap_resumes)
+BOTH(split_rejoin)
+BOTH(split_concurrent)
 
 /* --- what each backend refuses, and how it says so --- */
 
@@ -844,6 +1308,8 @@ static void t_pg_reconnect(void)
 
 T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), CASES(finish), CASES(cancel),
        CASES(dead_letter), CASES(give_back), CASES(reap), CASES(list_paging), CASES(counts), CASES(persistence),
-       CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), {"sqlite_bad_files", t_sqlite_bad_files},
+       CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), CASES(split_plan), CASES(split_run),
+       CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin),
+       CASES(split_concurrent), CASES(migrate_v1), {"sqlite_bad_files", t_sqlite_bad_files},
        {"pg_unreachable", t_pg_unreachable}, {"pg_foreign_table", t_pg_foreign_table},
        {"pg_reconnect", t_pg_reconnect}, {"error_ids_have_texts", t_error_ids_have_texts})

@@ -111,3 +111,26 @@ svc_replays() { # DIR N SECONDS
 
 # ffprobe's count of decoded frames
 frames_of() { ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 "$1"; }
+
+# a split job's units, one line each: INDEX STATE ATTEMPTS RENDERS WORKER
+# (INDEX "join" for the join; WORKER the slot that rendered it, or "-")
+svc_units() { # ID
+    curl -sf "$SVC_URL/jobs/$1" | python3 -c 'import json,sys
+j = json.load(sys.stdin)
+for s in j.get("segments", []):
+    print(s["index"], s["state"], s["attempts"], s["renders"], s["worker"] or "-")
+u = j.get("join")
+if u:
+    print("join", u["state"], u["attempts"], u["renders"], u["worker"] or "-")'
+}
+
+# nothing of job ID is left in the output directory but ID.fmt and
+# ID.hashes (the sweep runs every 10 s: waits up to 15 s)
+svc_no_leftovers() { # ID [OUTPUT_DIR]
+    out=${2:-d/videos}
+    i=0
+    while ls -A "$out" | grep -q "^\.job$1-"; do
+        sleep 0.5; i=$((i + 1))
+        [ $i -lt 30 ] || { echo "job $1 left files:"; ls -laR "$out"; return 1; }
+    done
+}

@@ -82,5 +82,51 @@ t_lease_of_a_dead_daemon_expires() {
     svc_stop
 }
 
-t_run two_daemons_share_one_queue lease_of_a_dead_daemon_expires
+# One split job, two daemons: each renders some of its segments; then one
+# dies mid-job and the other finishes it without redoing finished segments.
+t_segments_of_one_job_on_both_daemons() {
+    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
+    SVC_ON_EXIT=pg_stop
+    trap svc_cleanup EXIT
+    pg_start "$pgdir"
+    rc=$?
+    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
+    [ "$rc" = 0 ] || return 1
+    "$RS_BIN" record --ai --quiet --stage dojo --seconds 6 --seed 21 -o six.rsr || return 1
+    "$RS_BIN" render six.rsr -o direct.mp4 --render-size 160x90 --size 160x90 --hashes direct.hashes --quiet || return 1
+    mkdir -p shared
+    svc_start a $SVC_FAST --queue "$PG_URI" --output shared --segment-seconds 1 || return 1
+    url_a=$SVC_URL pid_a=$SVC_PID
+    svc_start b $SVC_FAST --queue "$PG_URI" --output shared --segment-seconds 1 || return 1
+    url_b=$SVC_URL
+    id=$(svc_submit six.rsr) || return 1
+    svc_wait_state "$id" done 300 || return 1
+    svc_units "$id" >units.txt
+    cat units.txt
+    # segments finished by both daemons (owner host:pid-nonce/slot), each once
+    [ "$(awk '$1 != "join" {sub(/\/[0-9]+$/, "", $5); print $5}' units.txt | sort -u | wc -l)" = 2 ] ||
+        { echo "one daemon rendered every segment"; return 1; }
+    [ "$(awk '$4 != 1' units.txt | wc -l)" = 0 ] || { echo "a unit was rendered twice"; return 1; }
+    curl -sf -o v.hashes "$url_b/jobs/$id/hashes" && cmp v.hashes direct.hashes || { echo "hashes differ"; return 1; }
+    # daemon a dies in the middle of a second one: b takes over its segment
+    # once the lease expires, and nothing finished is rendered again
+    SVC_URL=$url_a
+    id2=$(svc_submit six.rsr) || return 1
+    i=0
+    until [ "$(svc_units "$id2" | awk '$2 == "done"' | wc -l)" -ge 2 ] && svc_worker_pid "$pid_a" "$id2" >/dev/null; do
+        sleep 0.2; i=$((i + 1)); [ $i -lt 600 ] || { svc_units "$id2"; return 1; }
+    done
+    kill -KILL "$pid_a"
+    SVC_URL=$url_b
+    svc_wait_state "$id2" done 300 || return 1
+    svc_units "$id2" >units2.txt
+    cat units2.txt
+    grep -q "with an expired lease re-queued" b.log || { echo "b never reaped a's segment"; return 1; }
+    [ "$(awk '$4 != 1' units2.txt | wc -l)" = 0 ] || { echo "a unit was rendered twice"; return 1; }
+    curl -sf -o v2.hashes "$url_b/jobs/$id2/hashes" && cmp v2.hashes direct.hashes || { echo "hashes differ"; return 1; }
+    svc_no_leftovers "$id2" shared || return 1
+    svc_stop
+}
+
+t_run two_daemons_share_one_queue lease_of_a_dead_daemon_expires segments_of_one_job_on_both_daemons
 t_done

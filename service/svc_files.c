@@ -1,0 +1,284 @@
+/* svc_files: where a unit's files go, the command that makes them, and
+ * cleaning up what crashed renders, cancelled jobs and other queues leave.
+ *
+ * DESIGN: called from the supervisor thread only (svc_daemon.c); nothing
+ * here keeps state.  The layout under the output directory:
+ *
+ *   N.fmt, N.hashes                 a finished job (the only names clients see)
+ *   .jobN-PID-aK.fmt / .hashes      an unsplit job's render, attempt K, by daemon PID
+ *   .jobN-PID-jK.fmt / .hashes      a split job's join, attempt K
+ *   .jobN-NONCE/                    a split job's segments: the directory is
+ *                                   named by the job's key (svc_store.h), so a
+ *                                   reused job id (a new queue, the same output
+ *                                   directory) never meets the old files
+ *       sI-aK.fmt, sI-aK.hashes,    segment I as attempt K rendered it (its
+ *       sI-aK.fmt.seg               manifest last: a manifest means complete)
+ *
+ * Each attempt writes names of its own, and the join is given the names of
+ * the attempt the queue recorded (done_attempt), so a stale render of an
+ * earlier attempt (a daemon cut off by a network partition) can never put
+ * its file under the join.  Everything hidden (".job...") belongs to a job;
+ * the sweep removes it once its job is over or unknown to the queue, and
+ * leaves every other name alone (the directory may be shared). */
+#include <dirent.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "svc_local.h"
+#include "svc_log.h"
+
+void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_files *f)
+{
+    memset(f, 0, sizeof *f);
+    int pid = (int)getpid();
+    snprintf(f->replay, sizeof f->replay, "%s/work/job%" PRId64 "-%d-%d.rsr", cfg->data, j->id, pid, slot);
+    if (j->segments > 0)
+        snprintf(f->segdir, sizeof f->segdir, "%s/.%s", cfg->output, j->key);
+    switch (j->unit.kind) {
+    case SVC_UNIT_SEGMENT:
+        svc_segment_path(f->out, sizeof f->out, f->segdir, j->unit.index, j->unit.attempts, j->format);
+        svc_segment_path(f->hashes, sizeof f->hashes, f->segdir, j->unit.index, j->unit.attempts, "hashes");
+        break;
+    case SVC_UNIT_JOIN:
+        snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-j%d.%s", cfg->output, j->id, pid, j->unit.attempts,
+                 j->format);
+        snprintf(f->hashes, sizeof f->hashes, "%s/.job%" PRId64 "-%d-j%d.hashes", cfg->output, j->id, pid,
+                 j->unit.attempts);
+        break;
+    default:
+        snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-a%d.%s", cfg->output, j->id, pid, j->unit.attempts,
+                 j->format);
+        snprintf(f->hashes, sizeof f->hashes, "%s/.job%" PRId64 "-%d-a%d.hashes", cfg->output, j->id, pid,
+                 j->unit.attempts);
+    }
+}
+
+void svc_segment_path(char *out, size_t n, const char *segdir, int index, int attempt, const char *ext)
+{
+    snprintf(out, n, "%s/s%d-a%d.%s", segdir, index, attempt, ext);
+}
+
+void svc_argv_free(char **argv)
+{
+    for (char **a = argv; a && *a; a++)
+        free(*a);
+    free(argv);
+}
+
+/* a growing argv of copies */
+typedef struct av {
+    char **v;
+    int n, cap;
+    bool oom;
+} av;
+
+static void add(av *a, const char *s)
+{
+    if (a->oom)
+        return;
+    if (a->n + 2 > a->cap) {
+        int cap = a->cap ? a->cap * 2 : 32;
+        char **v = realloc(a->v, (size_t)cap * sizeof *v);
+        if (!v) {
+            a->oom = true;
+            return;
+        }
+        a->v = v, a->cap = cap;
+    }
+    if (!(a->v[a->n] = strdup(s))) {
+        a->oom = true;
+        return;
+    }
+    a->v[++a->n] = NULL;
+}
+
+char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_files *f, const svc_unit *units, int n,
+                     rs_err *err)
+{
+    av a = {0};
+    char size[32], rsize[32], ticks[64];
+    snprintf(size, sizeof size, "%dx%d", j->width, j->height);
+    snprintf(rsize, sizeof rsize, "%dx%d", cfg->render_width, cfg->render_height);
+    add(&a, "ringside");
+    if (j->unit.kind == SVC_UNIT_JOIN) {
+        /* the segments in order, each as the attempt the queue recorded */
+        const char *const head[] = {"join", "--segment", j->key, "-o", f->out, "--hashes", f->hashes,
+                                    "--progress-fd", "3", "--quiet"};
+        for (size_t i = 0; i < sizeof head / sizeof *head; i++)
+            add(&a, head[i]);
+        int k = 0;
+        for (int i = 0; i < n; i++) {
+            if (units[i].kind != SVC_UNIT_SEGMENT)
+                continue;
+            if (units[i].index != k || units[i].state != SVC_DONE || units[i].done_attempt <= 0) {
+                svc_argv_free(a.v);
+                rs_fail(err, 1, "job %" PRId64 ": segment %d is not done (%s): nothing to join yet", j->id, k,
+                        svc_state_name(units[i].state));
+                return NULL;
+            }
+            char seg[1200];
+            svc_segment_path(seg, sizeof seg, f->segdir, units[i].index, units[i].done_attempt, j->format);
+            add(&a, seg);
+            k++;
+        }
+        if (k != j->segments) {
+            svc_argv_free(a.v);
+            rs_fail(err, 1, "job %" PRId64 ": %d of %d segments found", j->id, k, j->segments);
+            return NULL;
+        }
+    } else {
+        add(&a, "render");
+        add(&a, f->replay);
+        if (j->unit.kind == SVC_UNIT_SEGMENT) {
+            snprintf(ticks, sizeof ticks, "%" PRId64 ":%" PRId64, j->unit.first_tick, j->unit.end_tick);
+            add(&a, "--ticks");
+            add(&a, ticks);
+            add(&a, "--segment");
+            add(&a, j->key);
+        }
+        const char *const tail[] = {"-o", f->out, "--size", size, "--render-size", rsize, "--hashes", f->hashes,
+                                    "--progress-fd", "3", "--quiet", "--backend", cfg->backend};
+        for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
+            add(&a, tail[i]);
+    }
+    if (a.oom) {
+        svc_argv_free(a.v);
+        rs_fail(err, 1, "out of memory");
+        return NULL;
+    }
+    return a.v;
+}
+
+/* name is "sI-aK." something, or a temporary of one (".sI-aK..."). */
+static bool of_segment(const char *name, const char *prefix)
+{
+    if (name[0] == '.')
+        name++;
+    return !strncmp(name, prefix, strlen(prefix));
+}
+
+void svc_segment_remove(const char *segdir, int index, int attempt)
+{
+    char prefix[64], path[1400];
+    snprintf(prefix, sizeof prefix, "s%d-a%d.", index, attempt);
+    DIR *dir = opendir(segdir);
+    if (!dir)
+        return;
+    struct dirent *e;
+    while ((e = readdir(dir)))
+        if (of_segment(e->d_name, prefix)) {
+            snprintf(path, sizeof path, "%s/%s", segdir, e->d_name);
+            unlink(path);
+        }
+    closedir(dir);
+}
+
+void svc_remove_dir(const char *path)
+{
+    DIR *dir = opendir(path);
+    if (!dir) {
+        if (errno == ENOTDIR)
+            unlink(path);
+        return;
+    }
+    struct dirent *e;
+    char p[1400];
+    while ((e = readdir(dir))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        snprintf(p, sizeof p, "%s/%s", path, e->d_name);
+        if (unlink(p) != 0 && errno == EISDIR)
+            svc_remove_dir(p); /* nothing of ours nests, but a stray directory must not keep its parent */
+    }
+    closedir(dir);
+    rmdir(path);
+}
+
+void svc_remove_job_files(const svc_config *cfg, int64_t id)
+{
+    char prefix[48], path[1400];
+    snprintf(prefix, sizeof prefix, ".job%" PRId64 "-", id);
+    DIR *dir = opendir(cfg->output);
+    struct dirent *e;
+    while (dir && (e = readdir(dir)))
+        if (!strncmp(e->d_name, prefix, strlen(prefix))) {
+            snprintf(path, sizeof path, "%s/%s", cfg->output, e->d_name);
+            if (unlink(path) != 0 && (errno == EISDIR || errno == EPERM))
+                svc_remove_dir(path);
+        }
+    if (dir)
+        closedir(dir);
+}
+
+/* ".jobN-..." -> N; 0 when the name is not one of ours. */
+static int64_t job_of(const char *name)
+{
+    if (strncmp(name, ".job", 4) != 0)
+        return 0;
+    char *end;
+    long long id = strtoll(name + 4, &end, 10);
+    return end > name + 4 && *end == '-' && id > 0 ? id : 0;
+}
+
+/* The output directory: what belongs to a job that is over or that this
+ * queue never had goes; so does a segment directory named by another key
+ * than its job's (an older queue's job of the same id).  The work
+ * directory: replay copies of daemons that are gone. */
+void svc_sweep(svc_daemon *d)
+{
+    DIR *dir = opendir(d->cfg.output);
+    char path[1400];
+    int removed = 0;
+    struct dirent *e;
+    while (dir && (e = readdir(dir))) {
+        int64_t id = job_of(e->d_name);
+        if (!id)
+            continue;
+        svc_job j;
+        rs_err err = {0};
+        int r = d->store->ops->get(d->store, id, &j, &err);
+        if (r < 0)
+            break; /* the queue is down: keep everything, look again later */
+        snprintf(path, sizeof path, "%s/%s", d->cfg.output, e->d_name);
+        struct stat st;
+        if (lstat(path, &st) != 0)
+            continue;
+        bool over = r == 0 || j.state == SVC_DONE || j.state == SVC_FAILED || j.state == SVC_CANCELLED;
+        bool stale_dir = !over && S_ISDIR(st.st_mode) && (j.segments == 0 || strcmp(e->d_name + 1, j.key) != 0);
+        if (!over && !stale_dir)
+            continue;
+        if (S_ISDIR(st.st_mode))
+            svc_remove_dir(path);
+        else
+            unlink(path);
+        removed++;
+        svc_log(SVC_LOG_DEBUG, id, "removed %s (%s)", path,
+                r == 0 ? "no such job in this queue" : stale_dir ? "another key's segments" : "the job is over");
+    }
+    if (dir)
+        closedir(dir);
+    char work[1100];
+    snprintf(work, sizeof work, "%s/work", d->cfg.data);
+    dir = opendir(work);
+    while (dir && (e = readdir(dir))) {
+        long long id;
+        int pid;
+        if (sscanf(e->d_name, "job%lld-%d", &id, &pid) != 2 || pid == (int)getpid())
+            continue;
+        if (kill(pid, 0) == 0 || errno != ESRCH)
+            continue; /* a daemon still running (sharing the data directory) */
+        snprintf(path, sizeof path, "%s/%s", work, e->d_name);
+        if (unlink(path) == 0)
+            removed++;
+    }
+    if (dir)
+        closedir(dir);
+    if (removed)
+        svc_log(SVC_LOG_INFO, -1, "removed %d leftover file%s of jobs that are over", removed, removed == 1 ? "" : "s");
+}
