@@ -38,7 +38,7 @@ cleanup() {
 trap cleanup EXIT INT TERM
 # shellcheck disable=SC2086 # extra is a list of options
 "$BIN" serve --listen 127.0.0.1:0 --data "$dir/data" --workers "$workers" --segment-seconds "$seg" \
-    --log-level warn $extra >"$dir/serve.log" 2>&1 &
+    $extra >"$dir/serve.log" 2>&1 &
 pid=$!
 url=""
 for _ in $(seq 200); do
@@ -76,6 +76,8 @@ frames = int(frames)
 print(f"{replay}: {frames} frames, {workers} worker(s), segment_seconds {seg}: {wall:.1f} s from upload to done, "
       f"{frames / wall:.1f} fps, {frames / 60 / wall:.2f}x real time")
 j = json.load(open(job))
-for u in j.get("segments") or j.get("units") or []:
-    print("  " + json.dumps(u, sort_keys=True))
+for u in j.get("segments") or []:
+    print("  segment " + json.dumps(u, sort_keys=True))
+if j.get("join"):
+    print("  join " + json.dumps(j["join"], sort_keys=True))
 EOF
