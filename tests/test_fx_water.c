@@ -4,7 +4,8 @@
  *     default Courant number, and blows up above the cap when the cap is
  *     bypassed (the cap is what keeps it stable);
  *   - splats: strength proportional to speed, none without motion;
- *   - the GPU automaton matches the CPU reference, splats included;
+ *   - the GPU automaton matches the CPU reference, splats included, and
+ *     both read and write heights under R_WATER_H_TINY as exactly 0;
  *   - on the shallows stage the water changes the picture, a moving fighter
  *     makes waves, standing still makes (almost) none, and a stage without
  *     water runs none of the water passes;
@@ -168,6 +169,53 @@ static void t_gpu_matches_cpu(void)
     fprintf(stderr, "    200 steps at 256x256: max |gpu - cpu| %.3g m, max |h| %.4g m (tolerance %.3g)\n", worst, scale, tol);
     T_ASSERTF(scale > 1e-3, "the splats made no waves (max |h| %g)", scale);
     T_ASSERTF(worst <= tol, "GPU and CPU differ by %g (max |h| %g)", worst, scale);
+    r_game_destroy(r);
+    plat_destroy(p);
+}
+
+/* Heights under R_WATER_H_TINY read and write as 0 on both sides: a lone
+ * 1e-25 m bump, a denormal and a splat too weak to matter leave exactly
+ * zero, while a real wave far away survives.  Without the flush a dying
+ * ripple reaches the denormal range, which llvmpipe's threads flush and
+ * other paths do not: a render started mid-way then differed from the
+ * full one (docs/effects.md, History). */
+static void t_tiny_heights_are_zero(void)
+{
+    plat *p = t_context("egl");
+    r_game *r = game_new();
+    const fx_water_sim_params *prm = fx_water_params(r);
+    T_ASSERT(prm);
+    static float in[NN], cpu[NN], gpu[NN];
+    memset(in, 0, sizeof in);
+    float denormal = 1e-39f;
+    T_ASSERT(denormal > 0 && denormal < 1.17549435e-38f);
+#define AT(i, j) (((size_t)(j) * R_WATER_N + (i)) * 2)
+    in[AT(50, 50)] = 1e-25f;        /* a height */
+    in[AT(80, 50) + 1] = -3e-21f;   /* a previous height */
+    in[AT(110, 50)] = denormal;
+    in[AT(200, 200)] = 1e-3f;       /* a real wave */
+    /* a splat whose whole bump is under the threshold */
+    fx_water_sim_splat weak = {50.5f, 120.5f, 3.0f, -5e-21f};
+    T_ASSERT(fx_water_write(r, in));
+    T_ASSERT(fx_water_gpu_steps(r, &weak, 1, 1));
+    T_ASSERT(fx_water_read(r, gpu));
+    fx_water_sim_step(prm, R_WATER_N, in, cpu);
+    fx_water_sim_add_splat(R_WATER_N, cpu, &weak);
+    int nonzero_cpu = 0, nonzero_gpu = 0;
+    for (int j = 40; j < 130; j++)
+        for (int i = 40; i < 120; i++)
+            for (int c = 0; c < 2; c++) {
+                nonzero_cpu += cpu[AT(i, j) + c] != 0.0f;
+                nonzero_gpu += gpu[AT(i, j) + c] != 0.0f;
+            }
+    fprintf(stderr, "    cells (and previous heights) not exactly 0 around the tiny values: cpu %d, gpu %d; "
+                    "the real wave: cpu %.4g, gpu %.4g\n",
+            nonzero_cpu, nonzero_gpu, cpu[AT(200, 200)], gpu[AT(200, 200)]);
+    T_EQ(nonzero_cpu, 0);
+    T_EQ(nonzero_gpu, 0);
+    T_ASSERT(cpu[AT(200, 200)] > 1e-4f && cpu[AT(201, 200)] > 1e-5f);
+    T_ASSERT(gpu[AT(200, 200)] == cpu[AT(200, 200)] && gpu[AT(201, 200)] == cpu[AT(201, 200)]);
+#undef AT
     r_game_destroy(r);
     plat_destroy(p);
 }
@@ -339,5 +387,6 @@ T_MAIN({"cpu_bounded_for_a_million_steps", t_cpu_bounded_for_a_million_steps},
        {"cpu_over_the_cap_blows_up", t_cpu_over_the_cap_blows_up},
        {"splats_follow_speed", t_splats_follow_speed},
        {"gpu_matches_cpu", t_gpu_matches_cpu},
+       {"tiny_heights_are_zero", t_tiny_heights_are_zero},
        {"shallows_waves_and_picture", t_shallows_waves_and_picture},
        {"no_nan_or_inf", t_no_nan_or_inf})

@@ -38,8 +38,14 @@ void fx_water_sim_params_fix(fx_water_sim_params *p)
 /* h' = damping * ((2 h - h_prev) + C^2 * laplacian), clamped; a NaN
  * becomes 0, so nothing that is not finite survives one step.  Selects,
  * not branches, so a vectorising build can vectorise the inner loop. */
+static inline float flush(float v)
+{
+    return fabsf(v) < R_WATER_H_TINY ? 0.0f : v;
+}
+
 static inline float safe(float v, float h_max)
 {
+    v = flush(v);
     v = v < -h_max ? -h_max : v;
     v = v > h_max ? h_max : v;
     return v == v ? v : 0.0f;
@@ -47,6 +53,7 @@ static inline float safe(float v, float h_max)
 
 static inline float cell(float c2, float damping, float h_max, float h, float hp, float l, float r, float d, float u)
 {
+    h = flush(h), hp = flush(hp), l = flush(l), r = flush(r), d = flush(d), u = flush(u);
     float lap = ((l + r) + (d + u)) - 4.0f * h;
     return safe(damping * ((2.0f * h - hp) + c2 * lap), h_max);
 }
@@ -123,7 +130,7 @@ void fx_water_sim_add_splat(int n, float *grid, const fx_water_sim_splat *s)
             float dx = ((float)i + 0.5f) - s->x, dy = ((float)j + 0.5f) - s->y;
             float d = sqrtf(dx * dx + dy * dy);
             if (d < s->radius)
-                grid[((size_t)j * n + i) * 2] += s->amp * fx_water_sim_splat_weight(d, s->radius);
+                grid[((size_t)j * n + i) * 2] += flush(s->amp * fx_water_sim_splat_weight(d, s->radius));
         }
 }
 

@@ -13,6 +13,15 @@
  * Laplacian in space), damped as a whole:
  *     h' = damping * ((2 h - h_prev) + C^2 * (hL + hR + hD + hU - 4 h))
  * then h' is clamped to +-h_max (NaN -> 0) and the pair becomes (h', h).
+ *
+ * Heights under R_WATER_H_TINY are zero, wherever they are read or
+ * written (the splat's bump too).  Without that a dying ripple reaches the
+ * denormal range, where the answer depends on the thread that computes it:
+ * llvmpipe's threads flush denormals to zero, not every path does, and a
+ * GPU usually flushes them.  With every stored height 0 or above 1e-20 m,
+ * no sum, difference or product in a step comes near that range, so a
+ * step gives the same bits on any of them (and a render started mid-way,
+ * whose warm-up runs the steps without drawing, matches a full render).
  * C = c dt / dx is the Courant number.  The scheme is stable for
  * C <= 1/sqrt(2) (the CFL limit in 2D; at the limit the checkerboard mode
  * only just does not grow), and damping the whole update keeps that limit
@@ -34,6 +43,7 @@
 #define R_WATER_CFL 0.70710678f    /* 1/sqrt(2) */
 #define R_WATER_COURANT_MAX 0.706f /* the cap, just below the CFL limit (margin 1.0016) */
 #define R_WATER_MAX_STEPS 8        /* steps one frame runs at most (more ticks: the rest are dropped) */
+#define R_WATER_H_TINY 1e-20f      /* |height| below this is 0 (water_common.glsl WATER_H_TINY) */
 
 typedef struct fx_water_sim_params {
     /* zero (or NaN) means the default; fx_water_sim_params_fix applies them */
