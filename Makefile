@@ -12,7 +12,8 @@
 #   make clean
 #
 # Variables: BUILD (output dir), OPT, SAN=1, DEBUG=1, WERROR=1 (on when CI=true),
-# T=name (make test T=shader runs tests/test_shader only).
+# T=name (make test T=shader runs tests/test_shader only), ONLY="egl ffmpeg"
+# (configure only those backends; a new BUILD dir, as tools/gpu-bundle.sh does).
 
 BUILD   ?= build
 # One spelling per directory: BUILD=$(CURDIR)/build (tests/test_cli.sh's
@@ -108,7 +109,7 @@ deps: $(STAMPS)/build $(STAMPS)/test
 
 $(BUILD)/config.mk: tools/configure.sh $(STAMPS)/build
 	@mkdir -p $(BUILD)
-	@tools/configure.sh > $@.tmp && mv $@.tmp $@
+	@RS_ONLY='$(ONLY)' tools/configure.sh > $@.tmp && mv $@.tmp $@
 
 # --- build ---
 $(BUILD)/obj/%.o: %.c $(BUILD)/config.mk $(BUILD)/flags

@@ -2,9 +2,16 @@
 # Writes the make fragment that says which GL backends this machine can
 # build (pkg-config), so a machine without OSMesa or GLFW still builds the
 # rest.  Usage: tools/configure.sh > build/config.mk
+# (RS_ONLY below limits it to the backends named.)
 set -eu
 cflags="" libs="" have=""
+# RS_ONLY="egl ffmpeg" (make ONLY=...): probe only these backends, for a
+# build with fewer libraries (tools/gpu-bundle.sh)
+only=${RS_ONLY:-}
 probe() { # name pkg-config-module define
+    if [ -n "$only" ]; then
+        case " $only " in *" $1 "*) ;; *) return 0 ;; esac
+    fi
     # shellcheck disable=SC2086
     if pkg-config --exists $2 2>/dev/null; then
         cflags="$cflags -D$3=1 $(pkg-config --cflags $2)"
