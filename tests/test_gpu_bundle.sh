@@ -69,7 +69,7 @@ t_runs_with_system_libraries_hidden() {
     build_bundle || return 1
     unshare -m true 2>/dev/null || t_skip_case "no mount namespaces here (unshare -m): cannot hide the system's libraries"
     make_driver_dir "$T_TMP/drv" || return 1
-    export RINGSIDE_BUNDLE_CACHE=$T_TMP/cache
+    export RINGSIDE_BUNDLE_CACHE="$T_TMP/cache"
     "$B/run" version >ver.txt 2>err.txt || { cat err.txt; return 1; } # unpacks, outside the namespace
     # the hiding works: a system tool that needs more than libc fails inside
     if hidden ls / >/dev/null 2>&1; then
@@ -96,7 +96,7 @@ t_runs_with_system_libraries_hidden() {
 # elsewhere.
 t_loads_only_bundle_libraries() {
     build_bundle || return 1
-    export RINGSIDE_BUNDLE_CACHE=$T_TMP/cache
+    export RINGSIDE_BUNDLE_CACHE="$T_TMP/cache"
     LD_DEBUG=libs "$B/run" render "$B/demos/dojo.rsr" --ticks 0:2 --size 64x36 --render-size 64x36 --quiet \
         -o "$T_TMP/t.mp4" 2>trace.txt || { tail -20 trace.txt; return 1; }
     # the launcher's shell and its tools trace too: keep the process that

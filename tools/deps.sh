@@ -19,8 +19,9 @@ group_pkgs() {
     build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev libsqlite3-dev libpq-dev libmicrohttpd-dev" ;;
     # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
     # presses keys in that window to prove a person can play; ffprobe (in
-    # ffmpeg) is the independent player that checks our videos
-    test) echo "xvfb xauth xdotool ffmpeg" ;;
+    # ffmpeg) is the independent player that checks our videos; xz packs the
+    # GPU bundle (tools/gpu-bundle.sh, tests/test_gpu_bundle.sh)
+    test) echo "xvfb xauth xdotool ffmpeg xz-utils" ;;
     # make test-service: a real PostgreSQL server for the two-daemon test,
     # Debian's Chromium for the dashboard test (driven by playwright-core from npm)
     service) echo "postgresql chromium" ;;
