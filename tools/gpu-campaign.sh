@@ -2,10 +2,14 @@
 # tools/gpu-campaign.sh REPORTDIR [--quick]
 #
 # Everything worth measuring on a GPU machine lent for a few minutes, in one
-# command with a deadline, without network: the device, the smoke scene,
-# the renderer's golden frames, capture (async vs sequential) at three
-# sizes, replay-to-video speed per stage, one full demo to .mp4, per-pass
-# timings, the fp16 stress looks, one demo per encoder, movie upload.
+# command with a deadline, without network, most valuable first: the
+# device, the smoke scene, the renderer's golden frames (PSNR), capture
+# (async vs sequential) at three sizes, replay-to-video speed per stage,
+# per-pass timings, the fp16 stress looks, movie upload, one full demo to
+# .mp4, one demo per encoder.  Each step may use a share of the budget
+# (what an earlier step leaves over goes on to the later ones), so a slow
+# step cannot starve the rest; a render cut by its time limit still
+# reports its speed over the frames it did.
 # docs/benchmarks.md ("On a real GPU") says how to run it and what it gave.
 #
 #   tools/gpu-campaign.sh "$OUT"              on the GPU machine, from the repo root
@@ -46,7 +50,7 @@ for a in "$@"; do
     case "$a" in
     --quick) quick=1 ;;
     -h | --help)
-        sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'
+        sed -n '2,35p' "$0" | sed 's/^# \{0,1\}//'
         exit 0
         ;;
     -*) echo "gpu-campaign: unknown option '$a'" >&2; usage ;;
@@ -140,16 +144,27 @@ log_output() {
 }
 now() { printf '%s' "${EPOCHREALTIME:-$(date +%s.%N)}"; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }'; }
-left() { echo $((BUDGET - SECONDS - RESERVE)); }
+# seconds left: to the campaign's deadline, or to the running step's
+# share of the budget (so that no step can starve the ones after it)
+STEP_END=0
+left() {
+    local l=$((BUDGET - SECONDS - RESERVE))
+    [ "$STEP_END" -le 0 ] || [ $((STEP_END - SECONDS)) -ge "$l" ] || l=$((STEP_END - SECONDS))
+    echo "$l"
+}
+# a fair share of what the step has left for each of N items still to run
+share() { local l; l=$(left); echo $((l / ($1 > 0 ? $1 : 1))); }
 
-# run_timed MIN LIMIT OUT ERR CMD...: CMD with a timeout of LIMIT seconds,
-# cut to what the deadline leaves; not started when that is under MIN.
+# run_timed MIN LIMIT OUT ERR CMD...: CMD with a timeout of LIMIT seconds
+# (at least MIN), cut to what the deadline leaves; not started when that
+# is under MIN.
 # Sets RC (124: timed out, 125: not started) and WALL (seconds).
 RC=0 WALL=0
 run_timed() {
     local min=$1 limit=$2 out=$3 err=$4 l t0
     shift 4
     l=$(left)
+    [ "$limit" -ge "$min" ] || limit=$min
     [ "$limit" -le "$l" ] || limit=$l
     if [ "$limit" -lt "$min" ]; then
         RC=125 WALL=0
@@ -159,7 +174,12 @@ run_timed() {
     fi
     log "\$ $* (timeout ${limit} s)"
     t0=$(now)
-    timeout -k 5 "$limit" "$@" >"$out" 2>"$err"
+    # fd 3: render's --progress-fd, so a run cut short still says how far it got
+    # (in a subshell whose stderr is dropped: bash's "Killed" notice when -k fires)
+    (
+        timeout -k 5 "$limit" "$@" >"$out" 2>"$err" 3>"$tmp/progress"
+        exit $?
+    ) 2>/dev/null
     RC=$?
     WALL=$(since "$t0")
     [ "$RC" -ne 137 ] || RC=124
@@ -180,13 +200,16 @@ first_error() { grep -v '^$' "$1" | tail -n 1 | cut -c1-200 | tr ',' ';'; }
 # Step bookkeeping: every step ends up in the final table.
 STEP_LINES=()
 STEP_T0=0 STEP_NAME=""
-step_begin() { # NAME MIN_SECONDS: 1 (skip) when fewer seconds are left
+step_begin() { # NAME MIN_SECONDS SHARE_PERCENT: 1 (skip) when fewer seconds are left
     STEP_NAME=$1 current=$1
-    STEP_T0=$SECONDS
+    STEP_T0=$SECONDS STEP_END=0
+    STEP_END=$((BUDGET * $3 / 100))
+    [ "$STEP_END" -ge "$2" ] || STEP_END=$2
+    STEP_END=$((SECONDS + STEP_END))
     say ""
     say "== $1"
     if [ "$(left)" -lt "$2" ]; then
-        say "SKIPPED: the deadline is near ($(left) s left of ${BUDGET} s, this step needs about $2 s)"
+        say "SKIPPED: the deadline is near ($(left) s usable of the ${BUDGET} s budget, ${RESERVE} s kept for the report; this step needs about $2 s)"
         STEP_LINES+=("$(printf '%-22s skipped (deadline)' "$1")")
         log "step $1 skipped: deadline"
         return 1
@@ -196,6 +219,7 @@ step_begin() { # NAME MIN_SECONDS: 1 (skip) when fewer seconds are left
 }
 step_end() { # VERDICT
     STEP_LINES+=("$(printf '%-22s %-40s %4d s' "$STEP_NAME" "$1" $((SECONDS - STEP_T0)))")
+    STEP_END=0
 }
 
 # frames and fps from render's last line ("wrote X: N frames ... in S s, F fps")
@@ -307,8 +331,8 @@ y4m_band() {
 # ---- sizes and lengths: the campaign, and its dry run ----
 if [ "$quick" -eq 1 ]; then
     MODE="quick (dry-run sizes: small frames, few ticks)"
-    CAP_CASES="512x288:256x144 512x288:512x288 768x432:384x216"
-    CAP_FRAMES=10 CAP_RUNS=1
+    CAP_CASES="512x288:256x144:10 512x288:512x288:10 768x432:384x216:10" # drawn:written:frames
+    CAP_RUNS=1
     SPEED_ARGS=(--ticks 0:30 --render-size 640x360 --size 320x180)
     FULL_ARGS=(--ticks 0:60 --render-size 640x360 --size 320x180)
     PASS_TICKS=120:130 PASS_SIZE=(--render-size 640x360 --size 320x180)
@@ -318,8 +342,8 @@ if [ "$quick" -eq 1 ]; then
     SMOKE_ARGS=(--size 320x180)
 else
     MODE="full"
-    CAP_CASES="1280x720:640x360 1920x1080:1920x1080 3840x2160:1920x1080"
-    CAP_FRAMES=120 CAP_RUNS=3
+    CAP_CASES="1280x720:640x360:120 1920x1080:1920x1080:90 3840x2160:1920x1080:60"
+    CAP_RUNS=3
     SPEED_ARGS=()
     FULL_ARGS=()
     PASS_TICKS=1200:1320 PASS_SIZE=()
@@ -368,8 +392,8 @@ if [ -s "$tmp/info" ]; then sed 's/^/  /' "$tmp/info" >>"$SUM"; else say "  (no 
 STEP_LINES+=("$(printf '%-22s %-40s %4d s' info "$(rc_word "$INFO_RC") ($IS_GPU GPU)" "$SECONDS")")
 
 # ==== 2. the smoke scene (exact on any conforming rasteriser) ====
-if step_begin smoke 5; then
-    run_timed 3 60 "$tmp/o" "$tmp/e" "$RS" smoke -o "$tmp/smoke.ppm" "${SMOKE_ARGS[@]}"
+if step_begin smoke 5 3; then
+    run_timed 3 "$(left)" "$tmp/o" "$tmp/e" "$RS" smoke -o "$tmp/smoke.ppm" "${SMOKE_ARGS[@]}"
     say "smoke: $(rc_word "$RC") in ${WALL} s: $(first_error "$tmp/e")"
     step_end "$(rc_word "$RC")"
 fi
@@ -386,7 +410,7 @@ fi
 # effects' history up from tick 0 (their own rule), the test from T-120.
 G=$report/golden.csv
 echo "stage,tick,render_ticks,status,wall_s,psnr_y,psnr_cb,psnr_cr,psnr_all,luma_off24_pct,max_dy,verdict,ref_psnr_y,ref_psnr_all,ref_max_dy,ref_identical" >"$G"
-if step_begin golden 10; then
+if step_begin golden 10 8; then
     say "Each golden frame drawn again by this binary, 320x180 (docs/testing.md); PSNR per plane after BT.709"
     say "4:2:0 conversion of the golden (exact, as capture does it); verdict = the test's tolerance read on luma"
     say "(PSNR >= 30 dB and <= 1% of pixels more than 24 off)."
@@ -405,7 +429,7 @@ if step_begin golden 10; then
         fi
         dims=$(head -c 40 "$g" | tr -c '0-9P' ' ' | awk '{ print $2 "x" $3 }')
         fr=$tmp/g_${st}_$tick.y4m
-        run_timed 5 60 "$tmp/o" "$tmp/e" "$RS" render "$demo" --ticks $((tick - 1)):"$tick" --render-size "$dims" \
+        run_timed 5 "$(left)" "$tmp/o" "$tmp/e" "$RS" render "$demo" --ticks $((tick - 1)):"$tick" --render-size "$dims" \
             --size "$dims" --capture sequential --downscale cpu --quiet -o "$fr"
         if [ "$RC" -ne 0 ]; then
             [ "$RC" -eq 125 ] && nskip=$((nskip + 1)) || nbad=$((nbad + 1))
@@ -446,8 +470,8 @@ fi
 
 # ==== 4. capture: async vs sequential at three sizes ====
 C=$report/capture.csv
-if step_begin capture 15; then
-    say "bench capture, $CAP_FRAMES frames x $CAP_RUNS runs per configuration, sink $SINK (docs/capture.md)."
+if step_begin capture 15 28; then
+    say "bench capture, $CAP_RUNS runs per configuration (medians), sink $SINK (docs/capture.md)."
     # bench capture reads $RINGSIDE_DATA/demos/dojo.rsr; the bundle keeps
     # its demos beside share/ringside, not in it: lend it a data folder
     data=${RINGSIDE_DATA:-}
@@ -461,17 +485,18 @@ if step_begin capture 15; then
         log "RINGSIDE_DATA=$data for bench capture ($abs has no demos/; demos from $DEMOS)"
     fi
     ratios=""
-    hdr=0
+    hdr=0 todo=3
     for c in $CAP_CASES; do
-        src=${c%%:*} dst=${c##*:}
-        run_timed 10 "$([ "$src" = 3840x2160 ] && echo 150 || echo 100)" "$tmp/o" "$tmp/e" \
+        IFS=: read -r src dst frames <<<"$c"
+        run_timed 10 "$(share "$todo")" "$tmp/o" "$tmp/e" \
             env ${data:+RINGSIDE_DATA="$data"} "$RS" bench capture \
-            --frames "$CAP_FRAMES" --runs "$CAP_RUNS" --render-size "$src" --size "$dst" --sink "$SINK" \
+            --frames "$frames" --runs "$CAP_RUNS" --render-size "$src" --size "$dst" --sink "$SINK" \
             --csv "$tmp/cap.csv" --chart "" --quiet
         if [ "$RC" -ne 0 ] || [ ! -s "$tmp/cap.csv" ]; then
             say "$src -> $dst: $(rc_word "$RC") after ${WALL} s: $(first_error "$tmp/e")"
             ratios="$ratios $src->$dst:$(rc_word "$RC")"
             rm -f "$tmp/cap.csv"
+            todo=$((todo - 1))
             continue
         fi
         if [ "$hdr" -eq 0 ]; then echo "case,$(head -n 1 "$tmp/cap.csv")" >"$C"; hdr=1; fi
@@ -480,28 +505,48 @@ if step_begin capture 15; then
             END { if (s > 0) printf "%.2f %.2f %s", a / s, best / s, bn; else print "- - -" }' "$tmp/cap.csv")
         read -r rd rb bn <<<"$r"
         say ""
-        say "$src -> $dst (${WALL} s): async (pbo 2, queue 120) / sequential = ${rd}x; best async ($bn) / sequential = ${rb}x"
+        say "$src -> $dst, $frames frames (${WALL} s): async (pbo 2, queue 120) / sequential = ${rd}x; best async ($bn) / sequential = ${rb}x"
         sed 's/^/  /' "$tmp/o" >>"$SUM"
         ratios="$ratios $src->$dst:${rd}x"
         rm -f "$tmp/cap.csv"
+        todo=$((todo - 1))
     done
     step_end "async/seq$ratios"
 fi
 
 # ==== 5. replay-to-video speed per stage ====
 S=$report/stages.csv
-echo "kind,stage,ticks,video_s,output,args,status,wall_s,frames,render_fps,x_realtime,bytes" >"$S"
+echo "kind,stage,ticks,video_s,output,args,status,wall_s,frames,fps,x_realtime,bytes,note" >"$S"
+# What a render run gave (after run_timed): R_FRAMES R_FPS R_X (x real
+# time) R_BYTES R_NOTE.  A run cut by its timeout still has a speed: the
+# frames its --progress-fd said were done, over its wall time.
+render_result() { # TICKS OUTFILE
+    local done_
+    R_FRAMES="" R_FPS="" R_X="-" R_BYTES="" R_NOTE=""
+    [ ! -f "$2" ] || R_BYTES=$(wc -c <"$2")
+    if [ "$RC" -eq 0 ]; then
+        R_FRAMES=$(render_frames "$tmp/e") R_FPS=$(render_fps "$tmp/e")
+        [ -n "$R_FRAMES" ] || R_FRAMES=$1
+        R_X=$(xrt "$R_FRAMES" "$WALL")
+    elif [ "$RC" -eq 124 ]; then
+        done_=$(sed -n 's/^frames \([0-9][0-9]*\) .*/\1/p' "$tmp/progress" | tail -n 1)
+        if [ -n "$done_" ] && [ "$done_" -gt 0 ]; then
+            R_FRAMES=$done_ R_X=$(xrt "$done_" "$WALL")
+            R_FPS=$(awk -v f="$done_" -v s="$WALL" 'BEGIN { printf "%.1f", f / s }')
+            R_NOTE="cut by the time limit after $done_ of $1 frames: speed of the part done, start-up included"
+        else
+            R_X="<$(xrt "$1" "$WALL")"
+            R_NOTE="cut by the time limit before the first frame"
+        fi
+    elif [ "$RC" -ne 125 ]; then
+        R_NOTE=$(first_error "$tmp/e")
+    fi
+}
 speed_row() { # KIND STAGE TICKS OUTPUT ARGS OUTFILE
-    local frames fps x bytes=""
-    frames=$(render_frames "$tmp/e") fps=$(render_fps "$tmp/e")
-    [ -n "$frames" ] || frames=$3
-    x=$(xrt "$frames" "$WALL")
-    if [ "$RC" -eq 124 ]; then x="<$(xrt "$3" "$WALL")"; fi
-    [ "$RC" -eq 0 ] || frames="" fps=""
-    [ ! -f "$6" ] || bytes=$(wc -c <"$6")
-    echo "$1,$2,$3,$(awk -v t="$3" 'BEGIN { printf "%.2f", t / 60 }'),$4,$5,$(rc_word "$RC"),$WALL,$frames,$fps,$x,$bytes" >>"$S"
+    render_result "$3" "$6"
+    echo "$1,$2,$3,$(awk -v t="$3" 'BEGIN { printf "%.2f", t / 60 }'),$4,$5,$(rc_word "$RC"),$WALL,$R_FRAMES,$R_FPS,$R_X,$R_BYTES,$R_NOTE" >>"$S"
     printf '  %-10s %6s ticks %-9s %-16s %7s s %8s fps  %7s x real time%s\n' "$2" "$3" "$4" "$(rc_word "$RC")" "$WALL" \
-        "${fps:--}" "$x" "$([ "$RC" -eq 0 ] || echo ": $(first_error "$tmp/e")")" >>"$SUM"
+        "${R_FPS:--}" "$R_X" "${R_NOTE:+ ($R_NOTE)}" >>"$SUM"
 }
 # the ticks a run renders: the demo's length, or B-A of --ticks A:B
 run_ticks() { # DEMO ARGS...
@@ -513,16 +558,22 @@ run_ticks() { # DEMO ARGS...
     done
     ticks_of "$demo"
 }
-if step_begin stages 10; then
+if step_begin stages 10 28; then
     say "Each demo, default options unless listed, to /dev/null (render + GPU downscale + async capture, no"
     say "encoder); wall time of the whole command (start-up, shader compile, lighting prefilter included)."
     say "args: ${SPEED_ARGS[*]:-(defaults: 1280x720 drawn, 640x360 written)}"
-    n=0 nok=0
+    n=0 nok=0 todo=0
+    for demo in "$DEMOS"/*.rsr; do
+        [ ! -f "$demo" ] || todo=$((todo + $(run_ticks "$demo" "${SPEED_ARGS[@]}")))
+    done
     for demo in "$DEMOS"/*.rsr; do
         [ -f "$demo" ] || continue
         st=$(basename "$demo" .rsr)
         t=$(run_ticks "$demo" "${SPEED_ARGS[@]}")
-        run_timed 5 90 "$tmp/o" "$tmp/e" "$RS" render "$demo" -o /dev/null "${SPEED_ARGS[@]}"
+        # the step's time left shared by length: a demo twice as long may take twice as long
+        run_timed 5 "$(awk -v l="$(left)" -v t="$t" -v all="$todo" 'BEGIN { print int(all > 0 ? l * t / all : l) }')" \
+            "$tmp/o" "$tmp/e" "$RS" render "$demo" -o /dev/null --progress-fd 3 "${SPEED_ARGS[@]}"
+        todo=$((todo - t))
         speed_row speed "$st" "${t:-0}" /dev/null "${SPEED_ARGS[*]}" /nonexistent
         n=$((n + 1))
         [ "$RC" -ne 0 ] || nok=$((nok + 1))
@@ -533,14 +584,17 @@ fi
 # ==== 6. per-pass timings ====
 P=$report/passes.csv
 echo "stage,ticks,pass,runs,skipped,gpu_ms,gpu_max_ms,cpu_ms" >"$P"
-if step_begin passes 10; then
-    say "render --passes --ticks $PASS_TICKS ${PASS_SIZE[*]} per stage (docs/renderer.md): ms per frame, totals:"
+if step_begin passes 10 7; then
+    say "render --passes --ticks $PASS_TICKS ${PASS_SIZE[*]:-(default sizes)} per stage (docs/renderer.md): ms per frame:"
     n=0 nok=0
-    for demo in "$DEMOS"/*.rsr; do
+    set -- "$DEMOS"/*.rsr
+    todo=$#
+    for demo in "$@"; do
         [ -f "$demo" ] || continue
         st=$(basename "$demo" .rsr)
-        run_timed 5 60 "$tmp/o" "$tmp/e" "$RS" render "$demo" --passes --ticks "$PASS_TICKS" -o /dev/null \
+        run_timed 5 "$(share "$todo")" "$tmp/o" "$tmp/e" "$RS" render "$demo" --passes --ticks "$PASS_TICKS" -o /dev/null \
             "${PASS_SIZE[@]}"
+        todo=$((todo - 1))
         n=$((n + 1))
         if [ "$RC" -ne 0 ]; then
             say "  $st: $(rc_word "$RC") after ${WALL} s: $(first_error "$tmp/e")"
@@ -558,19 +612,7 @@ if step_begin passes 10; then
     step_end "$nok of $n stages"
 fi
 
-# ==== 7. one full demo to .mp4 ====
-if step_begin full-mp4 10; then
-    say "demos/dojo.rsr, default options, to .mp4 (H.264, libx264): the service's main job."
-    say "args: ${FULL_ARGS[*]:-(defaults)}"
-    demo=$DEMOS/dojo.rsr
-    t=$(run_ticks "$demo" "${FULL_ARGS[@]}")
-    run_timed 10 180 "$tmp/o" "$tmp/e" "$RS" render "$demo" -o "$tmp/dojo.mp4" "${FULL_ARGS[@]}"
-    speed_row full-mp4 dojo "${t:-0}" .mp4 "${FULL_ARGS[*]}" "$tmp/dojo.mp4"
-    rm -f "$tmp/dojo.mp4"
-    step_end "$(rc_word "$RC"), $(tail -n 1 "$S" | cut -d, -f11) x real time"
-fi
-
-# ==== 8. fp16 stress looks ====
+# ==== 7. fp16 stress looks ====
 # test_render/stress_no_nan_or_inf's cases (docs/accuracy.md), as stage
 # files on dojo@1200 (the sun on screen, every pass runs), in both HDR
 # formats.  The test also reads the HDR, bloom, shadow and silhouette
@@ -599,7 +641,7 @@ stress_stage() {
         print "gamma = " gam; print "saturation = " sat; print "exposure = " ex; print "bloom = " bl
     }' "$STAGES/dojo.stage" >"$tmp/$1.stage"
 }
-if step_begin fp16 10; then
+if step_begin fp16 10 6; then
     if [ -z "$STAGES" ]; then
         say "no stages/dojo.stage found (cwd, \$RINGSIDE_DATA, the bundle): cannot make the stress looks"
         step_end "no stage files"
@@ -620,7 +662,7 @@ exposure-0.001:-1:-1:2.2:1:0.001:0.35:black"
                 stress_stage "$name" "$sun" "$sky" "$gam" "$sat" "$ex" "$bl"
                 fr=$tmp/fp16.y4m
                 rm -f "$fr"
-                run_timed 4 40 "$tmp/o" "$tmp/e" "$RS" render "$DEMOS/dojo.rsr" --ticks 1199:1200 --stage-file "$tmp/$name.stage" \
+                run_timed 4 "$(share $((20 - n)))" "$tmp/o" "$tmp/e" "$RS" render "$DEMOS/dojo.rsr" --ticks 1199:1200 --stage-file "$tmp/$name.stage" \
                     --hdr-format "$fmt" "${FP16_SIZE[@]}" --quiet -o "$fr"
                 n=$((n + 1))
                 if [ "$RC" -ne 0 ]; then
@@ -641,10 +683,30 @@ exposure-0.001:-1:-1:2.2:1:0.001:0.35:black"
     fi
 fi
 
-# ==== 9. one demo per encoder / output ====
+# ==== 8. movie upload ====
+if step_begin upload 8 4; then
+    run_timed 5 "$(left)" "$tmp/o" "$tmp/e" "$RS" bench upload --quiet "${UPLOAD_ARGS[@]}"
+    say "bench upload ${UPLOAD_ARGS[*]} (docs/player.md): $(rc_word "$RC") in ${WALL} s"
+    if [ "$RC" -eq 0 ]; then sed 's/^/  /' "$tmp/o" >>"$SUM"; else say "  $(first_error "$tmp/e")"; fi
+    step_end "$(rc_word "$RC")"
+fi
+
+# ==== 9. one full demo to .mp4 ====
+if step_begin full-mp4 10 10; then
+    say "demos/dojo.rsr, default options, to .mp4 (H.264, libx264): the service's main job."
+    say "args: ${FULL_ARGS[*]:-(defaults)}"
+    demo=$DEMOS/dojo.rsr
+    t=$(run_ticks "$demo" "${FULL_ARGS[@]}")
+    run_timed 10 "$(left)" "$tmp/o" "$tmp/e" "$RS" render "$demo" -o "$tmp/dojo.mp4" --progress-fd 3 "${FULL_ARGS[@]}"
+    speed_row full-mp4 dojo "${t:-0}" .mp4 "${FULL_ARGS[*]}" "$tmp/dojo.mp4"
+    rm -f "$tmp/dojo.mp4"
+    step_end "$(rc_word "$RC"), $R_X x real time"
+fi
+
+# ==== 10. one demo per encoder / output ====
 E=$report/encoders.csv
-echo "output,encoder,stage,ticks,args,status,wall_s,frames,render_fps,x_realtime,bytes,note" >"$E"
-if step_begin encoders 10; then
+echo "output,encoder,stage,ticks,args,status,wall_s,frames,fps,x_realtime,bytes,note" >"$E"
+if step_begin encoders 10 8; then
     say "demos/temple.rsr (the shortest) per output, ${ENC_ARGS[*]:-default options}:"
     demo=$DEMOS/temple.rsr
     t=$(run_ticks "$demo" "${ENC_ARGS[@]}")
@@ -652,16 +714,11 @@ if step_begin encoders 10; then
     for spec in mp4:libx264 webm:libvpx-vp9 y4m:ringside; do
         ext=${spec%%:*} enc=${spec##*:}
         out=$tmp/enc.$ext
-        run_timed 5 120 "$tmp/o" "$tmp/e" "$RS" render "$demo" -o "$out" "${ENC_ARGS[@]}"
-        frames=$(render_frames "$tmp/e") fps=$(render_fps "$tmp/e") bytes=""
-        [ ! -f "$out" ] || bytes=$(wc -c <"$out")
-        x=$(xrt "${frames:-0}" "$WALL")
-        [ "$RC" -ne 124 ] || x="<$(xrt "${t:-0}" "$WALL")"
-        note=""
-        [ "$RC" -eq 0 ] || note=$(first_error "$tmp/e")
-        echo ".$ext,$enc,temple,${t:-},${ENC_ARGS[*]},$(rc_word "$RC"),$WALL,$frames,$fps,$x,$bytes,$note" >>"$E"
-        printf '  .%-5s %-12s %-16s %7s s %8s fps %7s x real time %10s bytes %s\n' "$ext" "$enc" "$(rc_word "$RC")" "$WALL" \
-            "${fps:--}" "$x" "${bytes:--}" "$note" >>"$SUM"
+        run_timed 5 "$(share $((3 - n)))" "$tmp/o" "$tmp/e" "$RS" render "$demo" -o "$out" --progress-fd 3 "${ENC_ARGS[@]}"
+        render_result "${t:-0}" "$out"
+        echo ".$ext,$enc,temple,${t:-},${ENC_ARGS[*]},$(rc_word "$RC"),$WALL,$R_FRAMES,$R_FPS,$R_X,$R_BYTES,$R_NOTE" >>"$E"
+        printf '  .%-5s %-12s %-16s %7s s %8s fps %7s x real time %10s bytes%s\n' "$ext" "$enc" "$(rc_word "$RC")" "$WALL" \
+            "${R_FPS:--}" "$R_X" "${R_BYTES:--}" "${R_NOTE:+ ($R_NOTE)}" >>"$SUM"
         rm -f "$out"
         n=$((n + 1))
         [ "$RC" -ne 0 ] || nok=$((nok + 1))
@@ -669,14 +726,6 @@ if step_begin encoders 10; then
     echo ".mp4,h264_nvenc,,,,not-possible,,,,,,the encoder is fixed in capture/cap_sink_ffmpeg.c (libx264); issue 22 adds encoder choice" >>"$E"
     say "  .mp4  h264_nvenc   not yet possible: the encoder is fixed in capture/cap_sink_ffmpeg.c (issue 22 adds the choice)"
     step_end "$nok of $n outputs; nvenc not possible yet"
-fi
-
-# ==== 10. movie upload ====
-if step_begin upload 8; then
-    run_timed 5 90 "$tmp/o" "$tmp/e" "$RS" bench upload --quiet "${UPLOAD_ARGS[@]}"
-    say "bench upload ${UPLOAD_ARGS[*]} (docs/player.md): $(rc_word "$RC") in ${WALL} s"
-    if [ "$RC" -eq 0 ]; then sed 's/^/  /' "$tmp/o" >>"$SUM"; else say "  $(first_error "$tmp/e")"; fi
-    step_end "$(rc_word "$RC")"
 fi
 
 # ==== the end ====
