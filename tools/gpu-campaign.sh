@@ -33,6 +33,9 @@
 # Exit status: 0 when the campaign ran (failed steps are in the report),
 # 1 when it could not run at all (no ringside, REPORTDIR not writable),
 # 2 bad usage.
+# The whole script is one { } block, read before it runs: a copy replaced
+# while a campaign runs (a new bundle, an edit) cannot change it midway.
+{
 set -u
 export LC_ALL=C
 
@@ -159,7 +162,7 @@ share() { local l; l=$(left); echo $((l / ($1 > 0 ? $1 : 1))); }
 # (at least MIN), cut to what the deadline leaves; not started when that
 # is under MIN.
 # Sets RC (124: timed out, 125: not started) and WALL (seconds).
-RC=0 WALL=0
+RC=0 WALL=0 SKIP_WHY=""
 run_timed() {
     local min=$1 limit=$2 out=$3 err=$4 l t0
     shift 4
@@ -168,7 +171,12 @@ run_timed() {
     [ "$limit" -le "$l" ] || limit=$l
     if [ "$limit" -lt "$min" ]; then
         RC=125 WALL=0
-        log "not started (deadline: ${l} s left, needs ${min}): $*"
+        if [ $((BUDGET - SECONDS - RESERVE)) -lt "$min" ]; then
+            SKIP_WHY="the campaign's deadline is near"
+        else
+            SKIP_WHY="the step's share of the budget is used up"
+        fi
+        log "not started ($SKIP_WHY: ${l} s left, needs ${min}): $*"
         : >"$out"; : >"$err"
         return
     fi
@@ -191,11 +199,16 @@ rc_word() {
     case "$1" in
     0) echo ok ;;
     124) echo timeout ;;
-    125) echo skipped-deadline ;;
+    125) echo skipped ;;
     *) echo "failed($1)" ;;
     esac
 }
-first_error() { grep -v '^$' "$1" | tail -n 1 | cut -c1-200 | tr ',' ';'; }
+first_error() { # the last line of an error output, for one-line reports and CSV cells
+    local m
+    [ "$RC" -ne 125 ] || { echo "not started: $SKIP_WHY"; return; }
+    m=$(grep -v '^$' "$1" | tail -n 1 | cut -c1-200 | tr ',' ';')
+    echo "${m:-no message}"
+}
 
 # Step bookkeeping: every step ends up in the final table.
 STEP_LINES=()
@@ -470,7 +483,7 @@ fi
 
 # ==== 4. capture: async vs sequential at three sizes ====
 C=$report/capture.csv
-if step_begin capture 15 28; then
+if step_begin capture 15 26; then
     say "bench capture, $CAP_RUNS runs per configuration (medians), sink $SINK (docs/capture.md)."
     # bench capture reads $RINGSIDE_DATA/demos/dojo.rsr; the bundle keeps
     # its demos beside share/ringside, not in it: lend it a data folder
@@ -538,7 +551,7 @@ render_result() { # TICKS OUTFILE
             R_X="<$(xrt "$1" "$WALL")"
             R_NOTE="cut by the time limit before the first frame"
         fi
-    elif [ "$RC" -ne 125 ]; then
+    else
         R_NOTE=$(first_error "$tmp/e")
     fi
 }
@@ -584,7 +597,7 @@ fi
 # ==== 6. per-pass timings ====
 P=$report/passes.csv
 echo "stage,ticks,pass,runs,skipped,gpu_ms,gpu_max_ms,cpu_ms" >"$P"
-if step_begin passes 10 7; then
+if step_begin passes 10 10; then
     say "render --passes --ticks $PASS_TICKS ${PASS_SIZE[*]:-(default sizes)} per stage (docs/renderer.md): ms per frame:"
     n=0 nok=0
     set -- "$DEMOS"/*.rsr
@@ -686,7 +699,7 @@ fi
 # ==== 8. movie upload ====
 if step_begin upload 8 4; then
     run_timed 5 "$(left)" "$tmp/o" "$tmp/e" "$RS" bench upload --quiet "${UPLOAD_ARGS[@]}"
-    say "bench upload ${UPLOAD_ARGS[*]} (docs/player.md): $(rc_word "$RC") in ${WALL} s"
+    say "bench upload ${UPLOAD_ARGS[*]:-(defaults)} (docs/player.md): $(rc_word "$RC") in ${WALL} s"
     if [ "$RC" -eq 0 ]; then sed 's/^/  /' "$tmp/o" >>"$SUM"; else say "  $(first_error "$tmp/e")"; fi
     step_end "$(rc_word "$RC")"
 fi
@@ -741,3 +754,4 @@ say "files:$files"
 log "campaign done in ${SECONDS} s"
 echo "gpu-campaign: done in ${SECONDS} s; report in $report/summary.txt" >&2
 exit 0
+}
