@@ -54,7 +54,7 @@ t_bundle_builds() {
     size=$(du -sb "$B" | cut -f1)
     echo "bundle: $size bytes"
     [ "$size" -le $((60 * 1048576)) ] || { echo "over 60 MiB"; return 1; }
-    for f in run payload.tar.xz MANIFEST.txt share/ringside/shaders share/ringside/stages demos/dojo.rsr; do
+    for f in run payload.tar.xz MANIFEST.txt share/ringside/shaders share/ringside/stages share/ringside/demos/dojo.rsr; do
         [ -e "$B/$f" ] || { echo "missing $f"; return 1; }
     done
     grep -q "^libEGL.so.1 libegl1 " "$B/MANIFEST.txt" || { echo "no glvnd libEGL in the manifest"; return 1; }
@@ -82,7 +82,7 @@ t_runs_with_system_libraries_hidden() {
     hidden "$B/run" smoke -o "$T_TMP/smoke.ppm" --size 160x90 >/dev/null 2>err.txt || { cat err.txt; return 1; }
     [ -s "$T_TMP/smoke.ppm" ] || { echo "smoke wrote nothing"; return 1; }
     # a short render through FFmpeg (x264) and the demos shipped in the bundle
-    hidden "$B/run" render "$B/demos/dojo.rsr" --ticks 0:30 --size 160x90 --render-size 160x90 --quiet \
+    hidden "$B/run" render "$B/share/ringside/demos/dojo.rsr" --ticks 0:30 --size 160x90 --render-size 160x90 --quiet \
         -o "$T_TMP/short.mp4" --hashes "$T_TMP/bundle.h" 2>err.txt || { cat err.txt; return 1; }
     [ -s "$T_TMP/short.mp4" ] || { echo "no video"; return 1; }
     # the same frames as the system's build
@@ -97,7 +97,7 @@ t_runs_with_system_libraries_hidden() {
 t_loads_only_bundle_libraries() {
     build_bundle || return 1
     export RINGSIDE_BUNDLE_CACHE="$T_TMP/cache"
-    LD_DEBUG=libs "$B/run" render "$B/demos/dojo.rsr" --ticks 0:2 --size 64x36 --render-size 64x36 --quiet \
+    LD_DEBUG=libs "$B/run" render "$B/share/ringside/demos/dojo.rsr" --ticks 0:2 --size 64x36 --render-size 64x36 --quiet \
         -o "$T_TMP/t.mp4" 2>trace.txt || { tail -20 trace.txt; return 1; }
     # the launcher's shell and its tools trace too: keep the process that
     # became ringside, from the libraries its loader started with on
@@ -127,10 +127,36 @@ t_loads_only_bundle_libraries() {
     [ "$bad" = 0 ]
 }
 
+# The campaign's dry run (tools/gpu-campaign.sh --quick, about 70 s here)
+# through the bundle, from the source tree as on the GPU machine: every step
+# runs and succeeds, and the report is what the device tool can bring back.
+t_campaign_dry_run() {
+    build_bundle || return 1
+    export RINGSIDE_BUNDLE_CACHE="$T_TMP/cache"
+    rep=$T_TMP/report
+    (cd "$SRC" && RINGSIDE=$B/run "$SRC/tools/gpu-campaign.sh" "$rep" --quick) >out.txt 2>err.txt ||
+        { tail -20 err.txt; return 1; }
+    head -n 2 "$rep/summary.txt" | grep -q "llvmpipe" || { head -3 "$rep/summary.txt"; return 1; }
+    n=$(find "$rep" -type f | wc -l)
+    [ "$n" -le 8 ] || { echo "$n files in the report"; return 1; }
+    for s in info smoke golden capture stages passes full-mp4 fp16 encoders upload; do
+        line=$(sed -n '/^== steps/,$p' "$rep/summary.txt" | grep "^  $s ") ||
+            { echo "step $s missing"; cat "$rep/summary.txt"; return 1; }
+        # not skipped, timed out or failed; "N of M" with N = M; no golden outside
+        if echo "$line" | grep -Eq "skipped \(deadline\)|timeout|failed\(|[1-9][0-9]* outside" ||
+            echo "$line" | awk '{ for (i = 2; i < NF - 1; i++) if ($(i + 1) == "of" && $i != $(i + 2)) bad = 1 } END { exit !bad }'; then
+            echo "step $s: $line"
+            sed -n '/^== steps/,$p' "$rep/summary.txt"
+            return 1
+        fi
+    done
+    grep -q "ringside $B/run" "$rep/log.txt" || { echo "the campaign did not run the bundle"; head -5 "$rep/log.txt"; return 1; }
+}
+
 t_bad_usage() {
     expect_fail 2 "usage: tools/gpu-bundle.sh OUTDIR" "$SRC/tools/gpu-bundle.sh" || return 1
     expect_fail 2 "unknown option '--nope'" "$SRC/tools/gpu-bundle.sh" x --nope || return 1
 }
 
-t_run bundle_builds runs_with_system_libraries_hidden loads_only_bundle_libraries bad_usage
+t_run bundle_builds runs_with_system_libraries_hidden loads_only_bundle_libraries campaign_dry_run bad_usage
 t_done

@@ -10,7 +10,7 @@
 #   OUTDIR/payload.tar.xz     bin/ringside and every shared library it needs,
 #                             glibc's loader included, from this machine's
 #                             Debian packages (MANIFEST.txt lists them)
-#   OUTDIR/share/ringside     shaders and stages;  OUTDIR/demos: the demos
+#   OUTDIR/share/ringside     shaders, stages and demos (RINGSIDE_DATA)
 #   OUTDIR/tools              gpu-campaign.sh
 #
 # The launcher unpacks the payload once into a private folder (never over
@@ -65,7 +65,9 @@ grep -q "RS_HAVE_FFMPEG" "$build/config.mk" || die "no FFmpeg libraries on this 
 # a make that runs this (make test) must not pass its variables (SAN=1, ...) on
 unset MAKEFLAGS MFLAGS MAKELEVEL
 say "building $build/ringside (EGL + FFmpeg)"
-make -C "$src" -s -j"$(nproc 2>/dev/null || echo 2)" BUILD="$build" ONLY="egl ffmpeg" "$build/ringside" >&2 ||
+# the Makefile names a BUILD inside the tree relatively: so must the target
+case "$build" in "$src"/*) target=${build#"$src"/}/ringside ;; *) target=$build/ringside ;; esac
+make -C "$src" -s -j"$(nproc 2>/dev/null || echo 2)" BUILD="$build" ONLY="egl ffmpeg" "$target" >&2 ||
     die "the build failed"
 
 # 2. stage the tree: bin/, lib/ (the loader and the closure of every NEEDED)
@@ -117,14 +119,16 @@ done
 [ -z "$missing" ] || die "libraries needed but not bundled:$missing"
 
 # 3. the payload and the rest
-rm -rf "$out/share" "$out/demos" "$out/tools"
+rm -rf "$out/share" "$out/tools"
 rm -f "$out/payload.tar.xz" "$out/run" "$out/MANIFEST.txt"
 say "compressing the payload (xz $level)"
 (cd "$stage" && tar -cf - bin lib) | xz "$level" -T0 >"$out/payload.tar.xz.part"
 mv "$out/payload.tar.xz.part" "$out/payload.tar.xz"
-mkdir -p "$out/share/ringside" "$out/demos" "$out/tools"
+# share/ringside is RINGSIDE_DATA, laid out as `make install` does (bench
+# capture finds its demo there)
+mkdir -p "$out/share/ringside/demos" "$out/tools"
 cp -r "$src/shaders" "$src/stages" "$out/share/ringside/"
-cp "$src/demos/"*.rsr "$out/demos/"
+cp "$src/demos/"*.rsr "$out/share/ringside/demos/"
 [ -f "$src/tools/gpu-campaign.sh" ] && cp "$src/tools/gpu-campaign.sh" "$out/tools/"
 id=$(sha256sum "$out/payload.tar.xz" | cut -c1-16)
 

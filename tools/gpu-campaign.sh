@@ -89,7 +89,7 @@ if [ -n "${RINGSIDE_DEMOS:-}" ]; then
 elif [ -d demos ]; then
     DEMOS=demos
 else
-    DEMOS=$here/../demos # the bundle's copy of this script: OUTDIR/tools
+    DEMOS=$here/../share/ringside/demos # the bundle's copy of this script: OUTDIR/tools
 fi
 GOLDEN=tests/golden
 REF=${CAMPAIGN_REF:-}
@@ -485,8 +485,8 @@ fi
 C=$report/capture.csv
 if step_begin capture 15 26; then
     say "bench capture, $CAP_RUNS runs per configuration (medians), sink $SINK (docs/capture.md)."
-    # bench capture reads $RINGSIDE_DATA/demos/dojo.rsr; the bundle keeps
-    # its demos beside share/ringside, not in it: lend it a data folder
+    # bench capture reads $RINGSIDE_DATA/demos/dojo.rsr; a data folder
+    # without demos/ (not the bundle's: it has them) is lent one
     data=${RINGSIDE_DATA:-}
     [ -n "$data" ] || [ ! -d "$(dirname "$RS")/share/ringside/shaders" ] || data=$(dirname "$RS")/share/ringside
     if [ -n "$data" ] && [ ! -f "$data/demos/dojo.rsr" ] && [ -f "$DEMOS/dojo.rsr" ]; then
