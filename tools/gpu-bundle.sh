@@ -62,12 +62,15 @@ RS_ONLY="egl ffmpeg" "$src/tools/configure.sh" >"$conf"
 if cmp -s "$conf" "$build/config.mk"; then rm -f "$conf"; touch "$build/config.mk"; else mv "$conf" "$build/config.mk"; fi
 grep -q "RS_HAVE_EGL" "$build/config.mk" || die "no EGL on this machine (tools/deps.sh build)"
 grep -q "RS_HAVE_FFMPEG" "$build/config.mk" || die "no FFmpeg libraries on this machine (tools/deps.sh build)"
-# a make that runs this (make test) must not pass its variables (SAN=1, ...) on
-unset MAKEFLAGS MFLAGS MAKELEVEL
+# a make that runs this (make test, make asan) must not pass its variables
+# on: neither through MAKEFLAGS nor through the environment (make exports
+# its command line's SAN=1 to the recipes, and so to the tests)
+unset MAKEFLAGS MFLAGS MAKELEVEL SAN DEBUG OPT EXTRA_CFLAGS WERROR
 say "building $build/ringside (EGL + FFmpeg)"
 # the Makefile names a BUILD inside the tree relatively: so must the target
 case "$build" in "$src"/*) target=${build#"$src"/}/ringside ;; *) target=$build/ringside ;; esac
-make -C "$src" -s -j"$(nproc 2>/dev/null || echo 2)" BUILD="$build" ONLY="egl ffmpeg" "$target" >&2 ||
+make -C "$src" -s -j"$(nproc 2>/dev/null || echo 2)" BUILD="$build" ONLY="egl ffmpeg" SAN= DEBUG= OPT=-O2 \
+    "$target" >&2 ||
     die "the build failed"
 
 # 2. stage the tree: bin/, lib/ (the loader and the closure of every NEEDED)
@@ -106,6 +109,7 @@ done <"$stage/ldd.txt"
 # and libglvnd0; the vendor's library (NVIDIA's libEGL_nvidia.so.0, Mesa's
 # libEGL_mesa.so.0) is the machine's
 [ -f "$stage/lib/libEGL.so.1" ] || die "libEGL.so.1 is not in the closure"
+! ls "$stage/lib" | grep -Eq '^lib(asan|ubsan|tsan|lsan)\.' || die "$build/ringside is a sanitizer build: remove $build"
 for f in "$stage/lib/"*; do strip --strip-unneeded "$f" 2>/dev/null || true; done
 
 # every NEEDED of every file must be in lib/ (the check the launcher's
