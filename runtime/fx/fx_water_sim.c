@@ -35,13 +35,15 @@ void fx_water_sim_params_fix(fx_water_sim_params *p)
     p->size = pick(p->size, 8.0f, 0.1f, 1000.0f);
 }
 
-/* h' = damping * ((2 h - h_prev) + C^2 * laplacian), clamped; a NaN
- * becomes 0, so nothing that is not finite survives one step.  Selects,
- * not branches, so a vectorising build can vectorise the inner loop. */
+/* A height under R_WATER_H_TINY is 0 (fx_water_sim.h: denormals). */
 static inline float flush(float v)
 {
     return fabsf(v) < R_WATER_H_TINY ? 0.0f : v;
 }
+
+/* h' = damping * ((2 h - h_prev) + C^2 * laplacian), clamped; a NaN
+ * becomes 0, so nothing that is not finite survives one step.  Selects,
+ * not branches, so a vectorising build can vectorise the inner loop. */
 
 static inline float safe(float v, float h_max)
 {
