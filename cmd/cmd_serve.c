@@ -1,9 +1,11 @@
 /* ringside serve: the replay-to-video daemon (service/, docs/service.md).
  * This file is the command line only: the settings from --config and the
  * options, then svc_serve (service/svc.h) runs the daemon. */
+#include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "../service/svc.h"
 #include "cli.h"
@@ -33,22 +35,57 @@ static void help(void)
     printf("\nexit status: 0 after a clean stop (signal), 1 on a start-up failure, 2 on bad usage\n");
 }
 
+/* Every setting is an option twice: --max_upload and --max-upload. */
+#define SERVE_FIXED 4
+static struct option serve_opts[SERVE_FIXED + 2 * 64 + 1];
+static char serve_names[64][32];
+
+static bool build_opts(void)
+{
+    static const struct option fixed[SERVE_FIXED] = {{"config", required_argument, 0, 'c'},
+                                                     {"print-config", no_argument, 0, 'P'},
+                                                     {"help", no_argument, 0, 'h'},
+                                                     {"set", required_argument, 0, 's'}};
+    memcpy(serve_opts, fixed, sizeof fixed);
+    int n = SERVE_FIXED;
+    const char *name;
+    for (size_t i = 0; (name = svc_config_name(i)); i++) {
+        if (i >= 64 || strlen(name) >= sizeof serve_names[0])
+            return false; /* the table outgrew this file: a bug, caught by every test */
+        serve_opts[n++] = (struct option){name, required_argument, 0, 1};
+        if (strchr(name, '_')) {
+            snprintf(serve_names[i], sizeof serve_names[i], "%s", name);
+            for (char *p = serve_names[i]; *p; p++)
+                if (*p == '_')
+                    *p = '-';
+            serve_opts[n++] = (struct option){serve_names[i], required_argument, 0, 1};
+        }
+    }
+    serve_opts[n] = (struct option){0};
+    return true;
+}
+
+/* getopt_long's '?' or ':' as one line naming the option. */
+static int bad_option(int c, char **argv)
+{
+    const char *arg = argv[optind - 1];
+    if (c == ':')
+        cli_error("serve", "option '%s' needs a value", arg);
+    else if (!strncmp(arg, "--", 2))
+        cli_error("serve", "unknown option '%.*s' (every setting of the table below works as --name VALUE)",
+                  (int)strcspn(arg, "="), arg);
+    else
+        cli_error("serve", "unknown option '%s'", arg);
+    return cli_usage_error("serve");
+}
+
 int cmd_serve(int argc, char **argv)
 {
-    /* every setting is also an option; --config is read before the rest */
-    static const struct option opts[] = {
-        {"config", required_argument, 0, 'c'}, {"print-config", no_argument, 0, 'P'}, {"help", no_argument, 0, 'h'},
-        {"set", required_argument, 0, 's'},
-        {"listen", required_argument, 0, 1}, {"workers", required_argument, 0, 1}, {"data", required_argument, 0, 1},
-        {"queue", required_argument, 0, 1}, {"output", required_argument, 0, 1},
-        {"max-upload", required_argument, 0, 1}, {"max_upload", required_argument, 0, 1},
-        {"max-attempts", required_argument, 0, 1}, {"max_attempts", required_argument, 0, 1},
-        {"lease", required_argument, 0, 1}, {"watchdog", required_argument, 0, 1}, {"grace", required_argument, 0, 1},
-        {"segment-seconds", required_argument, 0, 1}, {"segment_seconds", required_argument, 0, 1},
-        {"size", required_argument, 0, 1}, {"max-size", required_argument, 0, 1}, {"max_size", required_argument, 0, 1},
-        {"render-size", required_argument, 0, 1}, {"render_size", required_argument, 0, 1},
-        {"format", required_argument, 0, 1}, {"backend", required_argument, 0, 1},
-        {"log-level", required_argument, 0, 1}, {"log_level", required_argument, 0, 1}, {0}};
+    if (!build_opts()) {
+        cli_error("serve", "internal: too many settings for the option table");
+        return RS_EXIT_FAIL;
+    }
+    const struct option *opts = serve_opts;
     svc_config cfg;
     svc_config_defaults(&cfg);
     rs_err err = {0};
@@ -57,13 +94,21 @@ int cmd_serve(int argc, char **argv)
     /* pass 1: --help, --config */
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "h", opts, &idx)) != -1) {
+    while ((c = getopt_long(argc, argv, ":h", opts, &idx)) != -1) {
         if (c == 'h') {
             help();
             return RS_EXIT_OK;
         }
         if (c == '?' || c == ':')
-            return cli_usage_error("serve");
+            return bad_option(c, argv);
+        struct stat st;
+        if (c == 'c' && (stat(optarg, &st) != 0 || !S_ISREG(st.st_mode))) {
+            /* a missing file is a failure like any other missing input (1);
+             * a file that says something wrong is bad usage (2) */
+            cli_error("serve", "%s: cannot open the config file: %s", optarg,
+                      errno ? strerror(errno) : "not a regular file");
+            return RS_EXIT_FAIL;
+        }
         if (c == 'c' && !svc_config_load(&cfg, optarg, &err)) {
             cli_error("serve", "%s", err.msg);
             return RS_EXIT_USAGE;
@@ -75,7 +120,7 @@ int cmd_serve(int argc, char **argv)
     }
     /* pass 2: the settings, in order */
     optind = 1;
-    while ((c = getopt_long(argc, argv, "h", opts, &idx)) != -1) {
+    while ((c = getopt_long(argc, argv, ":h", opts, &idx)) != -1) {
         char name[64], value[1100];
         if (c == 'P')
             print = true;

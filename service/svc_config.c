@@ -10,7 +10,7 @@
 #include "../capture/cap.h"
 #include "../runtime/util/rs_file.h"
 
-typedef enum { C_INT, C_BYTES, C_STR, C_SIZE, C_CHOICE, C_LISTEN } c_type;
+typedef enum { C_INT, C_BYTES, C_STR, C_SIZE, C_CHOICE, C_LISTEN, C_DURATION } c_type;
 
 typedef struct c_row {
     const char *name;
@@ -54,6 +54,28 @@ static const c_row rows[] = {
     {"format", C_CHOICE, OFF(format), 0, 0, 0, "mp4", "mp4|webm|mkv", "a job's video format unless it asks"},
     {"backend", C_CHOICE, OFF(backend), 0, 0, 0, "egl", "egl|osmesa", "GL backend of the render processes"},
     {"log_level", C_CHOICE, OFF(log_level), 0, 0, 0, "info", "debug|info|warn|error", "least important log line shown"},
+    {"allowed_hosts", C_STR, OFF(allowed_hosts), 0, 0, sizeof((svc_config *)0)->allowed_hosts - 1, "", NULL,
+     "Host header values accepted, comma-separated (default: the listen address and localhost names; * = any); "
+     "others get 421"},
+    {"cors_origins", C_STR, OFF(cors_origins), 0, 0, sizeof((svc_config *)0)->cors_origins - 1, "", NULL,
+     "origins (scheme://host:port, comma-separated) whose web pages may call the API; default none but the "
+     "dashboard's own"},
+    {"max_connections", C_INT, OFF(max_connections), 0, 16, 1000000, "10000", NULL,
+     "HTTP connections held at once, from all addresses"},
+    {"max_connections_per_ip", C_INT, OFF(max_connections_per_ip), 0, 0, 1000000, "256", NULL,
+     "HTTP connections from one address (0: no cap, for a daemon behind a reverse proxy)"},
+    {"header_timeout", C_INT, OFF(header_timeout), 0, 1, 3600, "10", NULL,
+     "seconds a connection gets to send a request's headers (an idle keep-alive connection is closed after it)"},
+    {"min_body_rate", C_INT, OFF(min_body_rate), 0, 0, 1 << 30, "1024", NULL,
+     "bytes per second an upload must average once header_timeout has passed (0: no minimum)"},
+    {"upload_memory", C_BYTES, OFF(upload_memory), 0, 1024, 1L << 40, "64M", NULL,
+     "bytes held for uploads in progress, all connections together; over it a new upload gets 503"},
+    {"token_max_queued", C_INT, OFF(token_max_queued), 0, 0, 1000000, "20", NULL,
+     "a new API token's quota: its jobs queued or running at once (0: no cap)"},
+    {"token_seconds_per_hour", C_INT, OFF(token_seconds_per_hour), 0, 0, 100000000, "7200", NULL,
+     "a new API token's quota: seconds of game time it may submit per hour (0: no cap)"},
+    {"retention", C_DURATION, OFF(retention), 0, 0, 100L * 365 * 86400, "0", NULL,
+     "how long a finished job's video and hashes are kept (s, m, h or d suffix; 0: keep them)"},
 };
 #define NROWS (sizeof rows / sizeof rows[0])
 
@@ -145,6 +167,18 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
         }
         return rs_fail(err, 1, "%s: '%s' is not one of %s", r->name, v, r->choices);
     }
+    case C_DURATION: {
+        if (!parse_long(v, &n, &rest))
+            return rs_fail(err, 1, "%s: '%s' is not a duration (expected seconds, or a number with s, m, h or d)",
+                           r->name, v);
+        long mul = *rest == 'd' ? 86400 : *rest == 'h' ? 3600 : *rest == 'm' ? 60 : 1;
+        if (*rest && strchr("smhd", *rest))
+            rest++;
+        if (*rest || n < 0 || n > r->hi / mul)
+            return rs_fail(err, 1, "%s: '%s' is out of range (expected 0..%ldd)", r->name, v, r->hi / 86400);
+        *(long *)(base + r->off) = n * mul;
+        return true;
+    }
     case C_LISTEN: {
         const char *colon = strrchr(v, ':');
         if (!colon || colon == v || strlen(v) >= (size_t)r->hi || strpbrk(v, "#\r\n "))
@@ -174,7 +208,7 @@ bool svc_config_set(svc_config *c, const char *name, const char *value, rs_err *
 {
     const c_row *r = find(name);
     if (!r) {
-        char known[512] = "";
+        char known[1024] = "";
         for (size_t i = 0; i < NROWS; i++)
             snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", i ? ", " : "", rows[i].name);
         return rs_fail(err, 1, "unknown setting '%s' (known: %s)", name, known);
@@ -254,19 +288,42 @@ bool svc_config_finish(svc_config *c, rs_err *err)
 void svc_config_print_table(FILE *f)
 {
     for (size_t i = 0; i < NROWS; i++)
-        fprintf(f, "  %-15s %-16s %s\n", rows[i].name, rows[i].def[0] ? rows[i].def : "(see text)", rows[i].help);
+        fprintf(f, "  %-23s %-16s %s\n", rows[i].name, rows[i].def[0] ? rows[i].def : "(see text)", rows[i].help);
+}
+
+const char *svc_config_name(size_t i)
+{
+    return i < NROWS ? rows[i].name : NULL;
 }
 
 void svc_config_dump(const svc_config *c, FILE *f)
 {
     static const char *const levels[] = {"debug", "info", "warn", "error"};
-    fprintf(f,
-            "listen = %s\nworkers = %d\ndata = %s\nqueue = %s\noutput = %s\nmax_upload = %ld\nmax_seconds = %d\n"
-            "max_attempts = %d\n"
-            "lease = %d\nwatchdog = %d\ngrace = %d\nsegment_seconds = %d\nsize = %dx%d\nmax_size = %dx%d\n"
-            "render_size = %dx%d\n"
-            "format = %s\nbackend = %s\nlog_level = %s\n",
-            c->listen, c->workers, c->data, c->queue, c->output, c->max_upload, c->max_seconds, c->max_attempts, c->lease, c->watchdog,
-            c->grace, c->segment_seconds, c->width, c->height, c->max_width, c->max_height, c->render_width, c->render_height, c->format,
-            c->backend, levels[c->log_level & 3]);
+    const char *base = (const char *)c;
+    for (size_t i = 0; i < NROWS; i++) {
+        const c_row *r = &rows[i];
+        fprintf(f, "%s = ", r->name);
+        switch (r->type) {
+        case C_INT:
+            fprintf(f, "%d\n", *(const int *)(base + r->off));
+            break;
+        case C_BYTES:
+        case C_DURATION:
+            fprintf(f, "%ld\n", *(const long *)(base + r->off));
+            break;
+        case C_SIZE:
+            fprintf(f, "%dx%d\n", *(const int *)(base + r->off), *(const int *)(base + r->off2));
+            break;
+        case C_CHOICE:
+            if (r->off == OFF(log_level))
+                fprintf(f, "%s\n", levels[c->log_level & 3]);
+            else
+                fprintf(f, "%s\n", base + r->off);
+            break;
+        case C_STR:
+        case C_LISTEN:
+            fprintf(f, "%s\n", base + r->off);
+            break;
+        }
+    }
 }

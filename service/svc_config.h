@@ -32,6 +32,17 @@ typedef struct svc_config {
     char format[8];       /* mp4, webm or mkv */
     char backend[16];     /* egl or osmesa */
     int log_level;
+    /* the network (docs/service.md, "On a network") */
+    char allowed_hosts[512]; /* Host header values accepted ("" = the listen address and localhost names; "*" = any) */
+    char cors_origins[512];  /* origins allowed to call the API from a browser ("" = none but our own) */
+    int max_connections;     /* connections held at once, all addresses */
+    int max_connections_per_ip; /* from one address (0 = no cap, for a daemon behind a proxy) */
+    int header_timeout;      /* seconds a connection gets to send a request's headers */
+    int min_body_rate;       /* bytes/s an upload must keep up, averaged, after header_timeout */
+    long upload_memory;      /* bytes held for uploads in progress, all connections together */
+    int token_max_queued;    /* a new token's default: its jobs queued or running at once */
+    int token_seconds_per_hour; /* a new token's default: seconds of game time it may submit per hour */
+    long retention;          /* seconds a finished job's files are kept (0 = keep) */
 } svc_config;
 
 void svc_config_defaults(svc_config *c);
@@ -44,6 +55,9 @@ bool svc_config_load(svc_config *c, const char *path, rs_err *err);
 bool svc_config_finish(svc_config *c, rs_err *err);
 /* The table, for --help and docs: name, default, meaning. */
 void svc_config_print_table(FILE *f);
+/* The settings' names, in the table's order: i = 0.. until NULL (the
+ * command line makes an option of each). */
+const char *svc_config_name(size_t i);
 /* Every setting's current value, one "name = value" line each (a config
  * file that reproduces c). */
 void svc_config_dump(const svc_config *c, FILE *f);

@@ -101,8 +101,22 @@ static const set_case set_cases[] = {
     {"listen", "host:", 0, "the port must be 0..65535"}, {"listen", "host:-1", 0, "the port must be 0..65535"},
     {"listen", "host:80x", 0, "the port must be 0..65535"}, {"listen", "[::1]", 0, "an IPv6 address goes in brackets"},
     {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
-                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, format, backend, log_level)"},
+                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, format, backend, log_level, allowed_hosts, cors_origins, "
+                        "max_connections, max_connections_per_ip, header_timeout, min_body_rate, upload_memory, "
+                        "token_max_queued, token_seconds_per_hour, retention)"},
     {"", "1", 0, "unknown setting ''"},
+    {"retention", "0", 1, "retention = 0"}, {"retention", "90", 1, "retention = 90"},
+    {"retention", "90s", 1, "retention = 90"}, {"retention", "15m", 1, "retention = 900"},
+    {"retention", "2h", 1, "retention = 7200"}, {"retention", "7d", 1, "retention = 604800"},
+    {"retention", "36500d", 1, "retention = 3153600000"},
+    {"retention", "36501d", 0, "retention: '36501d' is out of range (expected 0..36500d)"},
+    {"retention", "-1", 0, "out of range"}, {"retention", "1w", 0, "out of range"},
+    {"retention", "1dd", 0, "out of range"}, {"retention", "d", 0, "retention: 'd' is not a duration"},
+    {"retention", "99999999999999999999", 0, "is not a duration"},
+    {"upload_memory", "1G", 0, "out of range"}, {"upload_memory", "1024M", 1, "upload_memory = 1073741824"},
+    {"max_connections_per_ip", "0", 1, "max_connections_per_ip = 0"},
+    {"max_connections", "15", 0, "max_connections: 15 is out of range (expected 16..1000000)"},
+    {"allowed_hosts", "ring.example,localhost", 1, "allowed_hosts = ring.example,localhost"},
 };
 
 static void set_check(const set_case *k)
@@ -217,7 +231,9 @@ static void t_config_load_errors(void)
     LOAD_BAD("workers = 2\ngarbage here\n", ":2: expected 'name = value', got 'garbage here'");
     LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, "
                                    "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, "
-                                   "format, backend, log_level)");
+                                   "format, backend, log_level, allowed_hosts, cors_origins, max_connections, "
+                                   "max_connections_per_ip, header_timeout, min_body_rate, upload_memory, token_max_queued, "
+                                   "token_seconds_per_hour, retention)");
     LOAD_BAD("size = 640x360\r\nsize = 640\r\n", ":2: size: '640' is not a size (expected WxH, such as 640x360)");
     LOAD_BAD("workers = # nothing left\n", ":1: workers: '' is not a whole number");
     LOAD_BAD("workers = 2\0\n", ": contains a NUL byte (not a text file)");

@@ -319,10 +319,17 @@ t_config_file_and_errors() {
     expect_fail 2 "bad2.conf:1: expected 'name = value'" "$RS_BIN" serve --config bad2.conf || return 1
     printf 'colour = red\n' >bad3.conf
     expect_fail 2 "bad3.conf:1: unknown setting 'colour'" "$RS_BIN" serve --config bad3.conf || return 1
-    expect_fail 2 "no-such.conf: cannot open" "$RS_BIN" serve --config no-such.conf || return 1
+    expect_fail 1 "no-such.conf: cannot open the config file" "$RS_BIN" serve --config no-such.conf || return 1
     expect_fail 2 "size: '640' is not a size" "$RS_BIN" serve --size 640 || return 1
     expect_fail 2 "format: 'avi' is not one of mp4\|webm\|mkv" "$RS_BIN" serve --format avi || return 1
     expect_fail 2 "unexpected argument 'extra'" "$RS_BIN" serve extra || return 1
+    # every setting is an option, with dashes or underscores; unknown ones are named
+    "$RS_BIN" serve --max-seconds 60 --max_attempts 5 --token-seconds-per-hour 10 --retention 2h --print-config \
+        >cfg2.txt || return 1
+    grep -qx 'max_seconds = 60' cfg2.txt && grep -qx 'max_attempts = 5' cfg2.txt &&
+        grep -qx 'token_seconds_per_hour = 10' cfg2.txt && grep -qx 'retention = 7200' cfg2.txt || { cat cfg2.txt; return 1; }
+    expect_fail 2 "unknown option '--max-secs'" "$RS_BIN" serve --max-secs 60 || return 1
+    expect_fail 2 "option '--workers' needs a value" "$RS_BIN" serve --workers || return 1
     expect_fail 1 "queue 'nonsense'" "$RS_BIN" serve --data dd --queue nonsense --listen 127.0.0.1:0 || return 1
     # one daemon per SQLite queue
     svc_start d $SVC_FAST || return 1
