@@ -138,7 +138,7 @@ static void worker_clear(svc_daemon *d, worker *w)
             unlink(part);
         }
     if (w->job.unit.kind == SVC_UNIT_SEGMENT && !w->keep)
-        svc_segment_remove(w->f.segdir, w->job.unit.index, w->job.unit.attempts);
+        svc_segment_remove(w->f.segdir, w->job.unit.index, w->job.unit.claim);
     /* the job is over (failed, cancelled, done): its segments go too, and
      * whatever crashed attempts (of any daemon) left */
     svc_job cur;
@@ -609,6 +609,25 @@ static void tend(svc_daemon *d, worker *w, double now)
     }
 }
 
+int svc_reap_leases(svc_daemon *d, bool all, rs_err *err)
+{
+    svc_reaped got[64];
+    int n = d->store->ops->reap(d->store, all, got, 64, err);
+    const char *whose = all ? "its daemon stopped" : "its lease expired: its daemon stopped or was cut off";
+    for (int i = 0; i < n && i < 64; i++) {
+        char c[96];
+        svc_unit_context(c, sizeof c, &got[i].unit);
+        if (got[i].failed)
+            svc_log(SVC_LOG_WARN, got[i].id, "%sfailed: " SVC_LOST_FMT, c, got[i].unit.lost + 1);
+        else
+            svc_log(SVC_LOG_INFO, got[i].id, "%sre-queued (%s; no attempt charged, %d lost lease%s of %d)", c, whose,
+                    got[i].unit.lost + 1, got[i].unit.lost ? "s" : "", SVC_LOST_MAX);
+    }
+    if (n > 64)
+        svc_log(SVC_LOG_INFO, -1, "%d more units re-queued the same way", n - 64);
+    return n;
+}
+
 static void start_job(svc_daemon *d, worker *w)
 {
     rs_err err = {0};
@@ -695,11 +714,7 @@ int svc_run(svc_daemon *d)
             break;
         if (!draining && now - last_reap >= 2.0) {
             rs_err err = {0};
-            int r = d->store->ops->reap(d->store, d->cfg.max_attempts, false, &err);
-            if (r > 0)
-                svc_log(SVC_LOG_WARN, -1, "%d job%s with an expired lease re-queued (or failed at the attempt cap)",
-                        r, r == 1 ? "" : "s");
-            else if (r < 0)
+            if (svc_reap_leases(d, false, &err) < 0)
                 svc_log(SVC_LOG_ERROR, -1, "reaping expired leases failed: %s", err.msg);
             last_reap = now;
         }

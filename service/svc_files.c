@@ -42,20 +42,20 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
         snprintf(f->segdir, sizeof f->segdir, "%s/.%s", cfg->output, j->key);
     switch (j->unit.kind) {
     case SVC_UNIT_SEGMENT:
-        svc_segment_path(f->out, sizeof f->out, f->segdir, j->unit.index, j->unit.attempts, j->format);
-        svc_segment_path(f->hashes, sizeof f->hashes, f->segdir, j->unit.index, j->unit.attempts, "hashes");
+        svc_segment_path(f->out, sizeof f->out, f->segdir, j->unit.index, j->unit.claim, j->format);
+        svc_segment_path(f->hashes, sizeof f->hashes, f->segdir, j->unit.index, j->unit.claim, "hashes");
         break;
     case SVC_UNIT_JOIN:
-        snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-j%d.%s", cfg->output, j->id, pid, j->unit.attempts,
+        snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-j%d.%s", cfg->output, j->id, pid, j->unit.claim,
                  j->format);
         snprintf(f->hashes, sizeof f->hashes, "%s/.job%" PRId64 "-%d-j%d.hashes", cfg->output, j->id, pid,
-                 j->unit.attempts);
+                 j->unit.claim);
         break;
     default:
-        snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-a%d.%s", cfg->output, j->id, pid, j->unit.attempts,
+        snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-a%d.%s", cfg->output, j->id, pid, j->unit.claim,
                  j->format);
         snprintf(f->hashes, sizeof f->hashes, "%s/.job%" PRId64 "-%d-a%d.hashes", cfg->output, j->id, pid,
-                 j->unit.attempts);
+                 j->unit.claim);
     }
 }
 

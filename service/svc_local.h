@@ -96,6 +96,10 @@ int svc_parse_range(const char *h, uint64_t len, uint64_t *first, uint64_t *last
 
 /* svc_daemon.c */
 int svc_run(svc_daemon *d);
+/* Expired leases (every running unit when all: the SQLite daemon starting
+ * up) back to the queue, no attempt charged; logs what became of each.
+ * Returns how many, or -1. */
+int svc_reap_leases(svc_daemon *d, bool all, rs_err *err);
 
 /* svc_files.c: a unit's files and the command that makes them, cleaning
  * up (the layout is described there). */

@@ -158,11 +158,8 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
     if (sqlite) {
         /* we hold the only lock: every running job belonged to a daemon
          * that is gone */
-        int r = d.store->ops->reap(d.store, d.cfg.max_attempts, true, err);
-        if (r < 0)
+        if (svc_reap_leases(&d, true, err) < 0)
             goto out;
-        if (r > 0)
-            svc_log(SVC_LOG_INFO, -1, "%d interrupted job%s from the last run re-queued", r, r == 1 ? "" : "s");
     }
     pthread_mutex_init(&d.mu, NULL);
     mu = true;

@@ -12,12 +12,17 @@
  *  - claim hands the oldest queued job to exactly one owner, sets its lease
  *    (claimed_until = now + lease_s, the database's clock) and adds one to
  *    its attempts;
+ *  - attempts count render failures only: a unit whose lease expired (its
+ *    daemon crashed, stopped or was cut off) gets its attempt back and
+ *    counts one more lost lease instead, so daemon crashes never fail a
+ *    job that did nothing wrong; a unit that has lost SVC_LOST_MAX leases
+ *    (a job that kills its daemon every time) fails its job;
  *  - heartbeat, finish and release act only while the row is still running
  *    and owned by the caller: a job whose lease was taken away (reaped, or
  *    cancelled by DELETE) cannot be finished by its old owner;
- *  - reap turns expired leases back into queued jobs, or into failed ones
- *    (dead letter: "gave up after N attempts: why") once attempts reach the
- *    cap; a job is never retried forever;
+ *  - reap turns expired leases back into queued jobs (no attempt charged),
+ *    or into failed ones ("lost its daemon N times (lease expired)") once
+ *    they reach SVC_LOST_MAX; a job is never retried forever;
  *  - times are Unix seconds from the database's clock, so machines with
  *    skewed clocks still agree on leases.
  *
@@ -118,7 +123,10 @@ typedef struct svc_unit {
     char error[SVC_ERROR_MAX];   /* why its last attempt ended */
     int renders;                 /* times it was finished done: 1 = rendered once */
     char done_by[SVC_OWNER_MAX]; /* the worker slot that finished it */
-    int done_attempt;            /* the attempt whose files are its output (0: not done) */
+    int done_attempt;            /* the claim whose files are its output (0: not done) */
+    int lost;                    /* leases it lost (its daemon gone): not charged as attempts */
+    int claim;                   /* this claim's number, attempts + lost: names its files, so a
+                                    render cut off from the queue never writes the next claim's */
 } svc_unit;
 
 /* The identity a split job's segment files carry (render --segment KEY):
@@ -134,7 +142,9 @@ typedef struct svc_job {
     char format[8];              /* "mp4", "webm", "mkv" */
     int64_t frames_done, frames_total;
     double fps;                  /* render speed of the running attempt */
-    int attempts;                /* claims so far (the running one included) */
+    int attempts;                /* charged attempts so far (the running one included) */
+    int lost;                    /* leases lost by its units (the most of any unit) */
+    bool expired;                /* done, and its files were removed by retention */
     int64_t desync_tick;         /* first checkpoint tick that differed; -1: none */
     char error[SVC_ERROR_MAX];   /* why it failed (or why the last attempt did) */
     char owner[SVC_OWNER_MAX];   /* "host:pid" of the daemon running it */
@@ -149,6 +159,20 @@ typedef struct svc_job {
 } svc_job;
 
 void svc_job_free(svc_job *j);
+
+/* DESIGN: a daemon killed by its job (memory exhausted, say) dies before
+ * it can tell a render failure from its own death, so lost leases are not
+ * charged; this bound is what stops such a job from killing daemon after
+ * daemon.  10: a sound job loses a lease only when its daemon dies, and
+ * ten daemon deaths during one unit means the unit is the likelier cause. */
+#define SVC_LOST_MAX 10
+
+/* What reap did to one unit (the restart log names each). */
+typedef struct svc_reaped {
+    int64_t id;
+    svc_unit unit; /* as it was when reaped (its lost count not yet raised) */
+    bool failed;   /* the job failed: SVC_LOST_MAX leases lost */
+} svc_reaped;
 
 typedef struct svc_store svc_store;
 
@@ -181,10 +205,12 @@ typedef struct svc_store_ops {
     int (*release)(svc_store *s, int64_t id, const char *owner, const char *error, bool count_attempt,
                    int max_attempts, rs_err *err);
     /* Running units whose lease has expired (all running units when all is
-     * true: the single daemon of an SQLite file starting up) are released
-     * as above with error "lease expired (worker or daemon lost)".
-     * Returns how many, or -1. */
-    int (*reap)(svc_store *s, int max_attempts, bool all, rs_err *err);
+     * true: the single daemon of an SQLite file starting up) go back to
+     * queued with their attempt given back and one more lost lease, error
+     * "lease expired (worker or daemon lost)"; at SVC_LOST_MAX lost leases
+     * the job fails.  What happened to each, up to max, into out (may be
+     * NULL).  Returns how many were reaped, or -1. */
+    int (*reap)(svc_store *s, bool all, svc_reaped *out, int max, rs_err *err);
     /* The join found bad segments (missing, truncated, not matching their
      * manifests): owner's JOIN unit goes back to waiting, its attempt given
      * back, and the segments bad[0..nbad-1] back to queued with why (their
@@ -223,6 +249,8 @@ svc_store *svc_store_pg_open(const char *conninfo, rs_err *err);
 
 /* The standard reason texts, shared so every backend words them alike. */
 #define SVC_LEASE_EXPIRED "lease expired (worker or daemon lost)"
+/* "lost its daemon N times (lease expired)" */
+#define SVC_LOST_FMT "lost its daemon %d times (lease expired)"
 /* "gave up after N attempts: why" into out. */
 void svc_dead_letter(char *out, size_t n, int attempts, const char *why);
 /* What a unit's messages start with in its job's error: "" (WHOLE),

@@ -377,20 +377,26 @@ static void scrub(char *msg, const char *conninfo)
 
 
 /* What the schema lacks: 1 the jobs table, 2 its segment columns (a queue
- * from before units), 4 the units table; -1 on error. */
+ * from before units), 4 the units table, 8 the lost-lease column (a queue
+ * from before it: sq_schema_lost); -1 on error. */
 static int schema_needs(pg_conn *s, rs_err *err)
 {
     sq_res r;
     if (d_exec(s, "look for the queue's tables",
                "SELECT to_regclass('jobs') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
                " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'segments'),"
-               " to_regclass('units') IS NULL",
+               " to_regclass('units') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
+               " WHERE table_schema = current_schema() AND table_name = 'units' AND column_name = 'lost')",
                NULL, 0, &r, err) < 0)
         return -1;
-    int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2) : -1;
+    int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2 | r.v[3].i << 3) : -1;
     d_res_free(&r);
     return need;
 }
+
+#define PG_HAS_COLUMN                                                                                               \
+    "SELECT COUNT(*) FROM information_schema.columns WHERE table_schema = current_schema() AND table_name = ?1"     \
+    " AND column_name = ?2"
 
 static bool create_schema(pg_conn *s, rs_err *err)
 {
@@ -419,7 +425,8 @@ static bool create_schema(pg_conn *s, rs_err *err)
         ok = ok && (!(need & 1) || d_exec(s, "create the jobs table", create_table, NULL, 0, NULL, err) >= 0) &&
              (!(need & 1) || d_exec(s, "create the index", "CREATE INDEX IF NOT EXISTS jobs_state ON jobs (state, id)",
                                     NULL, 0, NULL, err) >= 0) &&
-             (!need || sq_schema_units(&pg_driver, s, migrate, err)) && d_commit(s, err);
+             (!need || sq_schema_units(&pg_driver, s, migrate, err)) &&
+             (!need || sq_schema_lost(&pg_driver, s, PG_HAS_COLUMN, err)) && d_commit(s, err);
         if (!ok) {
             d_rollback(s);
             return false;
@@ -427,7 +434,7 @@ static bool create_schema(pg_conn *s, rs_err *err)
     }
     /* a jobs table that is not ours (another program's) */
     if (d_exec(s, "check the jobs table", "SELECT " SQ_JOB_COLS ", replay FROM jobs LIMIT 0", NULL, 0, NULL, err) < 0 ||
-        d_exec(s, "check the units table", "SELECT job_id, idx, kind, renders, done_attempt FROM units LIMIT 0", NULL, 0,
+        d_exec(s, "check the units table", "SELECT job_id, idx, kind, renders, done_attempt, lost FROM units LIMIT 0", NULL, 0,
                NULL, err) < 0) {
         rs_err_prefix(err, "%s: table jobs is not a ringside queue", s->label);
         if (err)

@@ -48,7 +48,7 @@ typedef struct sq_store {
 
 #define UNIT_COLS                                                                                                     \
     "kind, idx, first_tick, end_tick, state, attempts, owner, claimed_until, started, finished, frames_done, fps, "   \
-    "error, renders, done_by, done_attempt"
+    "error, renders, done_by, done_attempt, lost"
 
 static int64_t run(sq_store *s, const char *what, const char *sql, const sq_val *a, int n, sq_res *out, rs_err *err)
 {
@@ -105,6 +105,8 @@ static void job_from(const sq_res *r, int row, svc_job *j)
     char nonce[24];
     v_text(nonce, sizeof nonce, r, row, 19);
     snprintf(j->key, sizeof j->key, "job%" PRId64 "-%s", j->id, nonce);
+    j->lost = (int)v_int(r, row, 20);
+    j->expired = v_int(r, row, 21) != 0;
 }
 
 static void unit_from(const sq_res *r, int row, svc_unit *u)
@@ -126,6 +128,8 @@ static void unit_from(const sq_res *r, int row, svc_unit *u)
     u->renders = (int)v_int(r, row, 13);
     v_text(u->done_by, sizeof u->done_by, r, row, 14);
     u->done_attempt = (int)v_int(r, row, 15);
+    u->lost = (int)v_int(r, row, 16);
+    u->claim = u->attempts + u->lost;
 }
 
 /* --- transactions --- */
@@ -187,6 +191,7 @@ static bool refresh(sq_store *s, int64_t id, rs_err *err)
                " state = CASE WHEN state IN (2, 3, 4) THEN state"
                "   WHEN EXISTS (SELECT 1 FROM units u WHERE u.job_id = jobs.id AND u.state = 1) THEN 1 ELSE 0 END,"
                " attempts = (SELECT COALESCE(MAX(u.attempts), 0) FROM units u WHERE u.job_id = jobs.id),"
+               " lost = (SELECT COALESCE(MAX(u.lost), 0) FROM units u WHERE u.job_id = jobs.id),"
                " frames_done = (SELECT CAST(COALESCE(SUM(u.frames_done), 0) AS BIGINT) FROM units u"
                "   WHERE u.job_id = jobs.id AND u.kind <> 2),"
                " fps = (SELECT COALESCE(SUM(u.fps), 0) FROM units u WHERE u.job_id = jobs.id AND u.state = 1),"
@@ -257,6 +262,28 @@ static bool release_unit(sq_store *s, int64_t id, const svc_unit *u, const char 
                ARGS(I(id), I(u->index), I(count_attempt ? 0 : 1), T(why)), NULL, err) >= 0 &&
            run(s, "note why", "UPDATE jobs SET error = ?2, finished = 0 WHERE id = ?1", ARGS(I(id), T(msg)), NULL,
                err) >= 0;
+}
+
+/* A unit whose lease expired (the caller holds the job's lock): its
+ * attempt given back and one more lost lease counted, back to queued, or
+ * the job failed at SVC_LOST_MAX.  *failed says which. */
+static bool lose_unit(sq_store *s, int64_t id, const svc_unit *u, int64_t now, bool *failed, rs_err *err)
+{
+    char ctx[96], why[128], msg[SVC_ERROR_MAX + 96];
+    svc_unit_context(ctx, sizeof ctx, u);
+    *failed = u->lost + 1 >= SVC_LOST_MAX;
+    if (*failed) {
+        snprintf(why, sizeof why, SVC_LOST_FMT, u->lost + 1);
+        snprintf(msg, sizeof msg, "%s%s", ctx, why);
+        return run(s, "fail the unit",
+                   "UPDATE units SET state = 3, lost = lost + 1, attempts = attempts - 1, error = ?3, owner = '',"
+                   " claimed_until = 0, fps = 0, finished = ?4 WHERE job_id = ?1 AND idx = ?2",
+                   ARGS(I(id), I(u->index), T(why), I(now)), NULL, err) >= 0 &&
+               fail_job(s, id, msg, -1, now, err);
+    }
+    return run(s, "count the lost lease", "UPDATE units SET lost = lost + 1 WHERE job_id = ?1 AND idx = ?2",
+               ARGS(I(id), I(u->index)), NULL, err) >= 0 &&
+           release_unit(s, id, u, SVC_LEASE_EXPIRED, false, 0, now, err);
 }
 
 /* --- the ops --- */
@@ -368,7 +395,7 @@ static int claim_once(sq_store *s, const char *owner, int lease_s, svc_job *out,
          r.rows == 1;
     if (ok) {
         job_from(&r, 0, out);
-        const sq_val *rp = cell(&r, 0, 20);
+        const sq_val *rp = cell(&r, 0, 22);
         size_t n = rp->type == SQ_BLOB || rp->type == SQ_TEXT ? rp->n : 0;
         out->replay = malloc(n > 0 ? n : 1);
         if (!out->replay)
@@ -452,7 +479,7 @@ static int sq_finish(svc_store *bs, int64_t id, const char *owner, int state, co
         int64_t frames = u.kind == SVC_UNIT_SEGMENT ? u.end_tick - u.first_tick : u.kind == SVC_UNIT_WHOLE ? done : 0;
         ok = run(s, "finish the unit",
                  "UPDATE units SET state = 2, frames_done = ?3, fps = 0, claimed_until = 0, finished = ?4,"
-                 " renders = renders + 1, done_by = ?5, done_attempt = attempts, error = ''"
+                 " renders = renders + 1, done_by = ?5, done_attempt = attempts + lost, error = ''"
                  " WHERE job_id = ?1 AND idx = ?2",
                  ARGS(I(id), I(u.index), I(frames), I(now), T(owner)), NULL, err) >= 0;
         if (ok && u.kind != SVC_UNIT_SEGMENT)
@@ -498,7 +525,7 @@ out:
     return rc;
 }
 
-static int sq_reap(svc_store *bs, int max_attempts, bool all, rs_err *err)
+static int sq_reap(svc_store *bs, bool all, svc_reaped *out, int max, rs_err *err)
 {
     sq_store *s = S(bs);
     sq_res r;
@@ -534,12 +561,16 @@ static int sq_reap(svc_store *bs, int max_attempts, bool all, rs_err *err)
             unit_from(&ur, 0, &u);
         if (ok)
             res_free(s, &ur);
+        bool failed = false;
         if (hit)
-            ok = release_unit(s, id, &u, SVC_LEASE_EXPIRED, true, max_attempts, now, err) && refresh(s, id, err);
+            ok = lose_unit(s, id, &u, now, &failed, err) && refresh(s, id, err);
         if (tx_end(s, ok, 1, err) < 0)
             n = -1;
-        else
-            n += hit;
+        else if (hit) {
+            if (out && n < max)
+                out[n] = (svc_reaped){.id = id, .unit = u, .failed = failed};
+            n++;
+        }
     }
     res_free(s, &r);
     pthread_mutex_unlock(&s->mu);
@@ -781,6 +812,26 @@ bool sq_schema_units(const sq_driver *drv, void *c, bool migrate, rs_err *err)
                      " SELECT id, 0, 0, 0, frames_total, state, attempts, owner, claimed_until, started, frames_done,"
                      " fps, error FROM jobs WHERE state IN (0, 1)",
                      NULL, 0, NULL, err) >= 0;
+}
+
+bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_err *err)
+{
+    static const char *const cols[][3] = {
+        {"units", "lost", "ALTER TABLE units ADD COLUMN lost INTEGER NOT NULL DEFAULT 0"},
+        {"jobs", "lost", "ALTER TABLE jobs ADD COLUMN lost INTEGER NOT NULL DEFAULT 0"},
+        {"jobs", "expired", "ALTER TABLE jobs ADD COLUMN expired INTEGER NOT NULL DEFAULT 0"},
+    };
+    for (int i = 0; i < 3; i++) {
+        sq_res r = {0};
+        sq_val a[2] = {{.type = SQ_TEXT, .s = cols[i][0]}, {.type = SQ_TEXT, .s = cols[i][1]}};
+        if (drv->exec(c, "look for a column", has_column, a, 2, &r, err) < 0)
+            return false;
+        bool have = r.rows == 1 && r.v[0].i > 0;
+        drv->res_free(&r);
+        if (!have && drv->exec(c, "add a column", cols[i][2], NULL, 0, NULL, err) < 0)
+            return false;
+    }
+    return true;
 }
 
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar)

@@ -63,6 +63,13 @@ svc_store *sq_store_new(const sq_driver *drv, void *c, rs_err *err);
  * WHOLE unit for every queued or running job. */
 bool sq_schema_units(const sq_driver *drv, void *c, bool migrate, rs_err *err);
 
+/* The columns that came after units (lost leases counted apart from
+ * attempts, retention): units.lost, jobs.lost and jobs.expired, added
+ * where they are missing, to new and old queues alike (so the CREATE
+ * statements stay as they were).  has_column is the driver's query
+ * for "how many columns named ?2 has table ?1" (0 or 1). */
+bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_err *err);
+
 /* sql with @NOW, @LOCK and @SKIP spelt the driver's way, and with dollar
  * true ?N as $N (PostgreSQL).  False when out is too small. */
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar);
@@ -76,6 +83,6 @@ bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char 
 /* The columns of jobs (without replay) every backend checks at open. */
 #define SQ_JOB_COLS                                                                                                   \
     "id, state, name, width, height, format, frames_done, frames_total, fps, attempts, desync_tick, error, owner, "  \
-    "created, started, finished, claimed_until, segment_ticks, segments, seg_key"
+    "created, started, finished, claimed_until, segment_ticks, segments, seg_key, lost, expired"
 
 #endif

@@ -238,7 +238,9 @@ static bool make_schema(sq_conn *c, rs_err *err)
             err->code = SVC_STORE_ERR_SCHEMA; /* another program's jobs table: never migrated */
         ok = false;
     }
-    ok = ok && sq_schema_units(&sqlite_driver, c, migrate, err) && exec_plain(c, "COMMIT", err);
+    ok = ok && sq_schema_units(&sqlite_driver, c, migrate, err) &&
+         sq_schema_lost(&sqlite_driver, c, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2", err) &&
+         exec_plain(c, "COMMIT", err);
     if (!ok)
         d_rollback(c);
     return ok;
@@ -288,7 +290,7 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
     if (!exec_plain(c, "PRAGMA synchronous=FULL", err) || !make_schema(c, err))
         goto fail;
     if (d_exec(c, "check the jobs table", "SELECT " SQ_JOB_COLS ", replay FROM jobs LIMIT 0", NULL, 0, NULL, err) < 0 ||
-        d_exec(c, "check the units table", "SELECT job_id, idx, kind, renders, done_attempt FROM units LIMIT 0", NULL,
+        d_exec(c, "check the units table", "SELECT job_id, idx, kind, renders, done_attempt, lost FROM units LIMIT 0", NULL,
                0, NULL, err) < 0) {
         rs_err_prefix(err, "%s: not a ringside queue", path);
         if (err)

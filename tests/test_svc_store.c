@@ -395,12 +395,16 @@ static void reap(const char *spec)
     svc_job_free(&j);
     j = claim_ok(s, "b:2", 3600);
     svc_job_free(&j);
-    T_EQ(s->ops->reap(s, 3, false, &e), 1);
+    svc_reaped got[4];
+    T_EQ(s->ops->reap(s, false, got, 4, &e), 1);
+    T_ASSERT(got[0].id == lost && !got[0].failed && got[0].unit.lost == 0);
     svc_job g = get_ok(s, lost);
     T_EQ(g.state, SVC_QUEUED);
     T_ASSERTF(!strcmp(g.error, SVC_LEASE_EXPIRED), "error '%s'", g.error);
     T_ASSERT(!g.owner[0]);
-    T_EQ(g.attempts, 1);
+    /* a lost lease is no attempt: it is given back and counted apart */
+    T_EQ(g.attempts, 0);
+    T_EQ(g.lost, 1);
     T_EQ(get_ok(s, alive).state, SVC_RUNNING);
     T_EQ(get_ok(s, queued).state, SVC_QUEUED);
     /* the old owner comes back too late */
@@ -409,15 +413,30 @@ static void reap(const char *spec)
     T_EQ(s->ops->release(s, lost, "a:1", "x", true, 3, &e), 0);
     T_EQ(get_ok(s, lost).state, SVC_QUEUED);
 
-    /* reaped at the cap: dead letter */
+    /* the next claim is attempt 1 again, under a claim number of its own
+     * (its files never meet the lost claim's) */
     j = claim_ok(s, "a:1", -5);
     T_EQ(j.id, lost);
-    T_EQ(j.attempts, 2);
+    T_EQ(j.attempts, 1);
+    T_ASSERT(j.unit.attempts == 1 && j.unit.lost == 1 && j.unit.claim == 2);
     svc_job_free(&j);
-    T_EQ(s->ops->reap(s, 2, false, &e), 1);
+    /* a job that loses its daemon every time still ends: SVC_LOST_MAX */
+    for (int i = 2; i <= SVC_LOST_MAX; i++) {
+        if (i > 2) {
+            j = claim_ok(s, "a:1", -5);
+            T_EQ(j.id, lost);
+            svc_job_free(&j);
+        }
+        T_EQ(s->ops->reap(s, false, got, 4, &e), 1);
+        T_EQ(got[0].failed, i == SVC_LOST_MAX);
+    }
     g = get_ok(s, lost);
     T_EQ(g.state, SVC_FAILED);
-    T_ASSERTF(!strcmp(g.error, "gave up after 2 attempts: " SVC_LEASE_EXPIRED), "error '%s'", g.error);
+    T_EQ(g.lost, SVC_LOST_MAX);
+    T_EQ(g.attempts, 0);
+    char want[96];
+    snprintf(want, sizeof want, SVC_LOST_FMT, SVC_LOST_MAX);
+    T_ASSERTF(!strcmp(g.error, want), "error '%s'", g.error);
 
     /* a lease of 0 s lasts until the end of the current second:
      * claimed_until == now is still valid, claimed_until < now is not */
@@ -428,17 +447,17 @@ static void reap(const char *spec)
     struct timespec ts = {1, 200 * 1000 * 1000};
     while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
     }
-    T_EQ(s->ops->reap(s, 3, false, &e), 1);
+    T_EQ(s->ops->reap(s, false, NULL, 0, &e), 1);
     T_EQ(get_ok(s, zero).state, SVC_QUEUED);
     T_EQ(get_ok(s, alive).state, SVC_RUNNING);
 
     /* all: every running job, lease or not (an SQLite daemon starting up) */
-    T_EQ(s->ops->reap(s, 3, true, &e), 1);
+    T_EQ(s->ops->reap(s, true, NULL, 0, &e), 1);
     g = get_ok(s, alive);
     T_EQ(g.state, SVC_QUEUED);
     T_ASSERT(!strcmp(g.error, SVC_LEASE_EXPIRED));
-    T_EQ(g.attempts, 1);
-    T_EQ(s->ops->reap(s, 3, true, &e), 0);
+    T_EQ(g.attempts, 0);
+    T_EQ(s->ops->reap(s, true, NULL, 0, &e), 0);
     s->ops->close(s);
 }
 
@@ -907,12 +926,12 @@ static void split_reap_resumes(const char *spec)
     T_EQ(j.unit.index, 1);
     svc_job_free(&j);
     claim_unit(s, "b:2", id, SVC_UNIT_SEGMENT, 2);
-    T_EQ(s->ops->reap(s, 3, false, &e), 1);
+    T_EQ(s->ops->reap(s, false, NULL, 0, &e), 1);
     svc_unit u[5];
     units_of(s, id, u, 5);
     T_ASSERT(u[0].state == SVC_DONE && u[1].state == SVC_QUEUED && u[2].state == SVC_RUNNING);
     T_ASSERT(!strcmp(u[1].error, SVC_LEASE_EXPIRED));
-    T_EQ(s->ops->reap(s, 3, true, &e), 1); /* start-up of the one SQLite daemon */
+    T_EQ(s->ops->reap(s, true, NULL, 0, &e), 1); /* start-up of the one SQLite daemon */
     units_of(s, id, u, 5);
     T_ASSERT(u[0].state == SVC_DONE && u[0].renders == 1 && u[2].state == SVC_QUEUED);
     T_EQ(get_ok(s, id).state, SVC_QUEUED);
@@ -1077,9 +1096,10 @@ static void migrate_v1(const char *spec, void (*sql)(const char *spec, const cha
     T_EQ(units_of(s, 1, u, 2), 0);
     T_EQ(units_of(s, 2, u, 2), 1);
     T_ASSERT(u[0].kind == SVC_UNIT_WHOLE && u[0].state == SVC_RUNNING && !strcmp(u[0].owner, "old:1"));
-    T_EQ(s->ops->reap(s, 3, false, &e), 1); /* its lease ran out long ago */
+    T_EQ(s->ops->reap(s, false, NULL, 0, &e), 1); /* its lease ran out long ago: no attempt charged */
     svc_job j = claim_unit(s, "new:1", 2, SVC_UNIT_WHOLE, 0);
-    T_EQ(j.attempts, 2);
+    T_EQ(j.attempts, 1);
+    T_EQ(j.unit.lost, 1);
     T_EQ(j.segments, 0);
     claim_unit(s, "new:2", 3, SVC_UNIT_WHOLE, 0);
     T_EQ(s->ops->finish(s, 3, "new:2", SVC_DONE, NULL, -1, 60, &e), 1);
