@@ -669,7 +669,7 @@ int svc_run(svc_daemon *d)
         snprintf(ws[i].owner, sizeof ws[i].owner, "%s/%d", d->owner, i);
     }
     double last_reap = 0, drain_start = 0, last_sweep = now_s();
-    svc_sweep(d); /* what the last run (or a crash) left */
+    svc_sweep(d, true); /* what the last run (or a crash) left */
     bool draining = false;
     for (;;) {
         double now = now_s();
@@ -710,8 +710,10 @@ int svc_run(svc_daemon *d)
         int busy = 0;
         for (int i = 0; i < n; i++)
             busy += ws[i].busy;
-        if (draining && busy == 0)
+        if (draining && busy == 0) {
+            svc_sweep(d, false); /* what the last jobs' ends left: not until the next start */
             break;
+        }
         if (!draining && now - last_reap >= 2.0) {
             rs_err err = {0};
             if (svc_reap_leases(d, false, &err) < 0)
@@ -719,7 +721,7 @@ int svc_run(svc_daemon *d)
             last_reap = now;
         }
         if (!draining && now - last_sweep >= 10.0) {
-            svc_sweep(d);
+            svc_sweep(d, false);
             last_sweep = now;
         }
         for (int i = 0; i < n && !draining; i++)

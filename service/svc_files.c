@@ -216,28 +216,102 @@ void svc_remove_job_files(const svc_config *cfg, int64_t id)
         closedir(dir);
 }
 
-/* ".jobN-..." -> N; 0 when the name is not one of ours. */
-static int64_t job_of(const char *name)
+int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format)
 {
+    char path[1400];
+    int n = 0;
+    snprintf(path, sizeof path, "%s/%" PRId64 ".%s", cfg->output, id, format);
+    n += unlink(path) == 0;
+    snprintf(path, sizeof path, "%s/%" PRId64 ".hashes", cfg->output, id);
+    n += unlink(path) == 0;
+    svc_remove_job_files(cfg, id);
+    return n;
+}
+
+/* ".jobN-..." -> N; 0 when the name is not one of ours.  *pid: the daemon
+ * that wrote it (".jobN-PID-aK..." and "-jK...", a render or a join), or
+ * 0 (a segment directory ".jobN-NONCE", shared by every claim). */
+static int64_t job_of(const char *name, int *pid)
+{
+    *pid = 0;
     if (strncmp(name, ".job", 4) != 0)
         return 0;
     char *end;
     long long id = strtoll(name + 4, &end, 10);
-    return end > name + 4 && *end == '-' && id > 0 ? id : 0;
+    if (!(end > name + 4 && *end == '-' && id > 0))
+        return 0;
+    char *p;
+    long v = strtol(end + 1, &p, 10);
+    if (p > end + 1 && p[0] == '-' && (p[1] == 'a' || p[1] == 'j') && v > 0 && v < INT32_MAX)
+        *pid = (int)v;
+    return id;
+}
+
+/* A file of a daemon process that is gone: not running here, or (at
+ * start-up) our own pid left by an earlier daemon that had it (pid 1 in
+ * a container, every time). */
+static bool dead_writer(int pid, bool startup)
+{
+    if (pid == (int)getpid())
+        return startup;
+    return kill(pid, 0) != 0 && errno == ESRCH;
+}
+
+/* Finished jobs older than retention: their video and hashes go (those
+ * this host made: another host's output directory is its own to sweep),
+ * and the queue marks them expired. */
+static int sweep_retention(svc_daemon *d)
+{
+    if (d->cfg.retention <= 0)
+        return 0;
+    char host[SVC_OWNER_MAX];
+    snprintf(host, sizeof host, "%s", d->owner);
+    char *colon = strchr(host, ':');
+    if (colon)
+        *colon = 0;
+    int64_t ids[64];
+    rs_err err = {0};
+    int n = d->store->ops->expiring(d->store, d->cfg.retention, host, ids, 64, &err), removed = 0;
+    if (n < 0)
+        svc_log(SVC_LOG_ERROR, -1, "retention: cannot list expired jobs: %s", err.msg);
+    for (int i = 0; i < n; i++) {
+        svc_job j;
+        if (d->store->ops->get(d->store, ids[i], &j, &err) != 1)
+            continue;
+        removed += svc_remove_job_outputs(&d->cfg, ids[i], j.format);
+        if (d->store->ops->expire(d->store, ids[i], &err) < 0)
+            svc_log(SVC_LOG_ERROR, ids[i], "retention: removed its files but could not mark it expired: %s", err.msg);
+        else
+            svc_log(SVC_LOG_INFO, ids[i], "expired: its video and hashes removed (finished more than %ld s ago)",
+                    d->cfg.retention);
+    }
+    return removed;
 }
 
 /* The output directory: what belongs to a job that is over or that this
  * queue never had goes; so does a segment directory named by another key
- * than its job's (an older queue's job of the same id).  The work
- * directory: replay copies of daemons that are gone. */
-void svc_sweep(svc_daemon *d)
+ * than its job's (an older queue's job of the same id), and, on an SQLite
+ * queue, a render's or join's file of a daemon process that is gone.  The
+ * work directory: replay copies of daemons that are gone.
+ *
+ * DESIGN (a render finished, its daemon died before the rename or before
+ * the queue heard of it): the file is deleted, not renamed into place.
+ * The queue is the truth: the unit's lease expired and it was re-queued,
+ * perhaps already claimed again; a rename would show a finished video of
+ * a job the queue calls queued, and the next render writes the same bytes
+ * anyway.  On a PostgreSQL queue the output directory may be shared by
+ * hosts and a file name carries only a pid, so such files wait until
+ * their job is over (then any daemon removes them). */
+void svc_sweep(svc_daemon *d, bool startup)
 {
     DIR *dir = opendir(d->cfg.output);
     char path[1400];
-    int removed = 0;
+    int removed = sweep_retention(d);
+    bool one_daemon = !strcmp(d->store->ops->name, "sqlite");
     struct dirent *e;
     while (dir && (e = readdir(dir))) {
-        int64_t id = job_of(e->d_name);
+        int pid;
+        int64_t id = job_of(e->d_name, &pid);
         if (!id)
             continue;
         svc_job j;
@@ -251,7 +325,8 @@ void svc_sweep(svc_daemon *d)
             continue;
         bool over = r == 0 || j.state == SVC_DONE || j.state == SVC_FAILED || j.state == SVC_CANCELLED;
         bool stale_dir = !over && S_ISDIR(st.st_mode) && (j.segments == 0 || strcmp(e->d_name + 1, j.key) != 0);
-        if (!over && !stale_dir)
+        bool orphan = !over && one_daemon && pid && dead_writer(pid, startup);
+        if (!over && !stale_dir && !orphan)
             continue;
         if (S_ISDIR(st.st_mode))
             svc_remove_dir(path);
@@ -259,7 +334,8 @@ void svc_sweep(svc_daemon *d)
             unlink(path);
         removed++;
         svc_log(SVC_LOG_DEBUG, id, "removed %s (%s)", path,
-                r == 0 ? "no such job in this queue" : stale_dir ? "another key's segments" : "the job is over");
+                r == 0 ? "no such job in this queue" : stale_dir ? "another key's segments"
+                         : orphan ? "its daemon is gone" : "the job is over");
     }
     if (dir)
         closedir(dir);
@@ -269,10 +345,8 @@ void svc_sweep(svc_daemon *d)
     while (dir && (e = readdir(dir))) {
         long long id;
         int pid;
-        if (sscanf(e->d_name, "job%lld-%d", &id, &pid) != 2 || pid == (int)getpid())
-            continue;
-        if (kill(pid, 0) == 0 || errno != ESRCH)
-            continue; /* a daemon still running (sharing the data directory) */
+        if (sscanf(e->d_name, "job%lld-%d", &id, &pid) != 2 || !dead_writer(pid, startup))
+            continue; /* ours, or a daemon still running (sharing the data directory) */
         snprintf(path, sizeof path, "%s/%s", work, e->d_name);
         if (unlink(path) == 0)
             removed++;
@@ -280,5 +354,5 @@ void svc_sweep(svc_daemon *d)
     if (dir)
         closedir(dir);
     if (removed)
-        svc_log(SVC_LOG_INFO, -1, "removed %d leftover file%s of jobs that are over", removed, removed == 1 ? "" : "s");
+        svc_log(SVC_LOG_INFO, -1, "removed %d leftover or expired file%s", removed, removed == 1 ? "" : "s");
 }

@@ -471,6 +471,30 @@ static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
     return reply_json(c, 200, &b);
 }
 
+/* DELETE of a job that is over: its files, then its row (a crash between
+ * leaves a row whose video answers 410, and a second DELETE finishes). */
+static enum MHD_Result do_delete_finished(svc_daemon *d, struct MHD_Connection *c, int64_t id)
+{
+    svc_job j;
+    rs_err err = {0};
+    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
+    int files = r == 1 ? svc_remove_job_outputs(&d->cfg, id, j.format) : 0;
+    if (r == 1)
+        r = d->http_store->ops->remove(d->http_store, id, &err);
+    if (r < 0)
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    if (r == 0)
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    if (r == 2) /* the store's own check: an over job never runs again */
+        return reply_error(c, SVC_ERR_CONFLICT, "job %" PRId64 " is not over", id);
+    svc_log(SVC_LOG_INFO, id, "deleted by a client (%s, %d file%s removed)", svc_state_name(j.state), files,
+            files == 1 ? "" : "s");
+    char body[128];
+    snprintf(body, sizeof body, "{\"id\":%" PRId64 ",\"deleted\":true,\"state\":\"%s\",\"files_removed\":%d}\n", id,
+             svc_state_name(j.state), files);
+    return reply(c, 200, "application/json", body, strlen(body));
+}
+
 static enum MHD_Result do_cancel(svc_daemon *d, struct MHD_Connection *c, int64_t id)
 {
     rs_err err = {0};
@@ -479,11 +503,8 @@ static enum MHD_Result do_cancel(svc_daemon *d, struct MHD_Connection *c, int64_
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     if (r == 0)
         return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
-    if (r == 2) {
-        svc_job j;
-        const char *st = d->http_store->ops->get(d->http_store, id, &j, &err) == 1 ? svc_state_name(j.state) : "over";
-        return reply_error(c, SVC_ERR_CONFLICT, "job %" PRId64 " is already %s", id, st);
-    }
+    if (r == 2)
+        return do_delete_finished(d, c, id);
     svc_log(SVC_LOG_INFO, id, "cancelled by a client");
     return do_get_job(d, c, id);
 }
@@ -500,6 +521,9 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, int64_t 
     if (j.state != SVC_DONE)
         return reply_error(c, SVC_ERR_NOT_FOUND, "job %" PRId64 " is %s: its %s exists once it is done", id, svc_state_name(j.state),
                            video ? "video" : "hash list");
+    if (j.expired)
+        return reply_error(c, SVC_ERR_GONE, "job %" PRId64 "'s %s was removed by retention (kept %ld s after it finished)",
+                           id, video ? "video" : "hash list", d->cfg.retention);
     char path[1100];
     if (video)
         snprintf(path, sizeof path, "%s/%" PRId64 ".%s", d->cfg.output, id, j.format);

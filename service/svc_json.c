@@ -149,7 +149,10 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
         svc_buf_printf(b, ",\"eta_s\":%.1f", (double)(j->frames_total - done) / j->fps);
     else
         svc_buf_add(b, ",\"eta_s\":null", 13);
-    svc_buf_printf(b, ",\"attempts\":%d,\"max_attempts\":%d,\"error\":", j->attempts, max_attempts);
+    svc_buf_printf(b, ",\"attempts\":%d,\"max_attempts\":%d,", j->attempts, max_attempts);
+    if (j->lost > 0) /* leases lost to daemon crashes: not attempts, shown when there were any */
+        svc_buf_printf(b, "\"lost_leases\":%d,", j->lost);
+    svc_buf_add(b, "\"error\":", 8);
     if (j->error[0])
         svc_json_str(b, j->error);
     else
@@ -185,7 +188,9 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
             }
     }
     svc_buf_printf(b, ",\"url\":\"/jobs/%lld\"", (long long)j->id);
-    if (j->state == SVC_DONE)
+    if (j->expired)
+        svc_buf_add(b, ",\"expired\":true", 15);
+    else if (j->state == SVC_DONE)
         svc_buf_printf(b, ",\"video\":\"/jobs/%lld/video\",\"hashes\":\"/jobs/%lld/hashes\"", (long long)j->id,
                        (long long)j->id);
     svc_buf_add(b, "}", 1);

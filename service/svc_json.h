@@ -22,7 +22,9 @@ void svc_buf_printf(svc_buf *b, const char *fmt, ...) RS_PRINTF(2, 3);
 /* A JSON string literal: quotes, escapes, control characters as \u00XX;
  * invalid UTF-8 bytes become U+FFFD so the output is always valid JSON. */
 void svc_json_str(svc_buf *b, const char *s);
-/* The job object of GET /jobs/N.  max_attempts comes from the config.  A
+/* The job object of GET /jobs/N.  max_attempts comes from the config;
+ * lost_leases only when its daemon was lost; a done job has video and
+ * hashes URLs, or "expired": true once retention removed them.  A
  * split job adds segment_seconds and segment_count, and with its units
  * (n > 0; GET /jobs/N, not the list) "segments" (each segment's ticks,
  * state, attempts, renders, frames and worker) and "join". */

@@ -126,7 +126,12 @@ void svc_remove_dir(const char *path);
 /* Everything hidden of job id in the output directory (".jobN-..."): its
  * segments, temporaries of crashed renders and joins.  For a job that is over. */
 void svc_remove_job_files(const svc_config *cfg, int64_t id);
-/* Leftovers of jobs that are over or unknown, and of dead daemons' work files. */
-void svc_sweep(svc_daemon *d);
+/* N.fmt, N.hashes and everything hidden of job id: the number of visible
+ * files removed.  For a job that is over. */
+int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format);
+/* Leftovers of jobs that are over or unknown, and of dead daemons' work
+ * files; finished jobs past retention.  startup: no render of ours runs
+ * yet, so files under our own pid are an earlier daemon's. */
+void svc_sweep(svc_daemon *d, bool startup);
 
 #endif

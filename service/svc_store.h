@@ -229,6 +229,17 @@ typedef struct svc_store_ops {
     /* Queued or running -> cancelled.  1: cancelled; 0: no such job;
      * 2: already over (done, failed or cancelled); -1: error. */
     int (*cancel)(svc_store *s, int64_t id, rs_err *err);
+    /* Done jobs finished more than age_s ago (the database's clock), not
+     * yet expired, whose video was made on host (done by "host:..."): up
+     * to max ids into out, oldest first.  Returns the count, or -1. */
+    int (*expiring)(svc_store *s, int64_t age_s, const char *host, int64_t *out, int max, rs_err *err);
+    /* Done job id's files were removed by retention: it says so from now
+     * on (expired).  1: marked; 0: no such done job; -1: error. */
+    int (*expire)(svc_store *s, int64_t id, rs_err *err);
+    /* A job that is over (done, failed, cancelled) leaves the queue with its
+     * units.  1: removed; 0: no such job; 2: not over (queued or running:
+     * cancel it first); -1: error. */
+    int (*remove)(svc_store *s, int64_t id, rs_err *err);
     /* Jobs per state. */
     bool (*counts)(svc_store *s, int64_t by_state[SVC_NSTATES], rs_err *err);
     void (*close)(svc_store *s);

@@ -716,6 +716,59 @@ out:
     return rc;
 }
 
+static int sq_expiring(svc_store *bs, int64_t age_s, const char *host, int64_t *out, int max, rs_err *err)
+{
+    sq_store *s = S(bs);
+    if (max <= 0)
+        return 0;
+    char like[SVC_OWNER_MAX + 4];
+    snprintf(like, sizeof like, "%s:%%", host);
+    sq_res r;
+    pthread_mutex_lock(&s->mu);
+    /* the WHOLE unit or the join made the video: its done_by names the host */
+    int n = (int)run(s, "find expired videos",
+                     "SELECT j.id FROM jobs j WHERE j.state = 2 AND j.expired = 0 AND j.finished < @NOW - ?1"
+                     " AND EXISTS (SELECT 1 FROM units u WHERE u.job_id = j.id AND u.kind <> 1 AND u.done_by LIKE ?2)"
+                     " ORDER BY j.finished, j.id LIMIT ?3",
+                     ARGS(I(age_s), T(like), I(max)), &r, err);
+    if (n >= 0) {
+        n = r.rows < max ? r.rows : max;
+        for (int i = 0; i < n; i++)
+            out[i] = v_int(&r, i, 0);
+        res_free(s, &r);
+    }
+    pthread_mutex_unlock(&s->mu);
+    return n < 0 ? -1 : n;
+}
+
+static int sq_expire(svc_store *bs, int64_t id, rs_err *err)
+{
+    sq_store *s = S(bs);
+    pthread_mutex_lock(&s->mu);
+    int64_t n = run(s, "mark expired", "UPDATE jobs SET expired = 1 WHERE id = ?1 AND state = 2", ARGS(I(id)), NULL, err);
+    pthread_mutex_unlock(&s->mu);
+    return n < 0 ? -1 : n > 0;
+}
+
+static int sq_remove(svc_store *bs, int64_t id, rs_err *err)
+{
+    sq_store *s = S(bs);
+    int64_t now;
+    int rc = -1, state = 0;
+    pthread_mutex_lock(&s->mu);
+    if (!tx_begin(s, &now, err))
+        goto out;
+    int l = lock_job(s, id, &state, NULL, err);
+    bool ok = l >= 0, over = l > 0 && state != SVC_QUEUED && state != SVC_RUNNING;
+    if (ok && over)
+        ok = run(s, "remove the units", "DELETE FROM units WHERE job_id = ?1", ARGS(I(id)), NULL, err) >= 0 &&
+             run(s, "remove the job", "DELETE FROM jobs WHERE id = ?1", ARGS(I(id)), NULL, err) >= 0;
+    rc = tx_end(s, ok, l == 0 ? 0 : over ? 1 : 2, err);
+out:
+    pthread_mutex_unlock(&s->mu);
+    return rc;
+}
+
 static bool sq_counts(svc_store *bs, int64_t by_state[SVC_NSTATES], rs_err *err)
 {
     sq_store *s = S(bs);
@@ -757,6 +810,9 @@ static const svc_store_ops sq_ops = {
     .get = sq_get,
     .list = sq_list,
     .cancel = sq_cancel,
+    .expiring = sq_expiring,
+    .expire = sq_expire,
+    .remove = sq_remove,
     .counts = sq_counts,
     .close = sq_close,
 };
