@@ -48,5 +48,72 @@ t_random_kills_charge_nothing_and_leave_nothing() {
     return $bad
 }
 
-t_run ${T_ONLY:-random_kills_charge_nothing_and_leave_nothing}
+t_failing_render_still_dead_letters() {
+    # a render that crashes every time (SIGKILL to the render process, not
+    # the daemon) is charged each time and ends failed after max_attempts
+    "$RS_BIN" record --ai --quiet --seconds 20 --seed 3 -o long.rsr || return 1
+    svc_start d $SVC_FAST --max-attempts 2 || return 1
+    id=$(svc_submit long.rsr) || return 1
+    for attempt in 1 2; do
+        i=0
+        until [ "$(svc_field "$id" attempts)" = $attempt ] && w=$(svc_worker_pid "$SVC_PID" "$id"); do
+            sleep 0.2; i=$((i + 1)); [ $i -lt 150 ] || { echo "attempt $attempt did not start"; return 1; }
+        done
+        sleep 0.3
+        kill -KILL "$w"
+    done
+    svc_wait_state "$id" failed 30 || return 1
+    svc_field "$id" error | grep -q "gave up after 2 attempts" || { svc_field "$id" error; return 1; }
+    svc_stop
+}
+
+t_lost_daemon_is_bounded() {
+    # a job whose unit keeps losing its daemon is failed at SVC_LOST_MAX
+    # lost leases, with a true reason (the count is made to look as if
+    # nine daemons had died under it already)
+    "$RS_BIN" record --ai --quiet --seconds 20 --seed 4 -o long.rsr || return 1
+    svc_start d $SVC_FAST --max-attempts 1 || return 1
+    id=$(svc_submit long.rsr) || return 1
+    svc_wait_state "$id" running 30 || return 1
+    kill -KILL "$SVC_PID"
+    wait "$SVC_PID" 2>/dev/null
+    [ "$(sqlite3 d/queue.db "SELECT lost FROM units WHERE job_id = $id")" = 0 ] || return 1
+    sqlite3 d/queue.db "UPDATE units SET lost = 9 WHERE job_id = $id" || return 1
+    svc_start d $SVC_FAST --max-attempts 1 || return 1
+    [ "$(svc_field "$id" state)" = failed ] || { curl -s "$SVC_URL/jobs/$id"; return 1; }
+    [ "$(svc_field "$id" error)" = "lost its daemon 10 times (lease expired)" ] || { svc_field "$id" error; return 1; }
+    [ "$(svc_field "$id" lost_leases)" = 10 ] || return 1
+    grep -q "job $id: failed: lost its daemon 10 times" d.log || { cat d.log; return 1; }
+    svc_stop
+}
+
+t_retention_and_delete() {
+    "$RS_BIN" record --ai --quiet --seconds 1 --seed 5 -o a.rsr || return 1
+    svc_start d $SVC_FAST --retention 2 || return 1
+    a=$(svc_submit a.rsr) || return 1
+    svc_wait_state "$a" done 60 || return 1
+    # retention: 2 s after it finished, the next sweep (every 10 s) removes it
+    i=0
+    until [ "$(svc_field "$a" expired)" = true ]; do
+        sleep 0.5; i=$((i + 1)); [ $i -lt 40 ] || { echo "job $a never expired"; curl -s "$SVC_URL/jobs/$a"; return 1; }
+    done
+    [ -z "$(ls -A d/videos)" ] || { echo "expired files stay:"; ls -la d/videos; return 1; }
+    [ "$(curl -s -o v.json -w '%{http_code}' "$SVC_URL/jobs/$a/video")" = 410 ] || { cat v.json; return 1; }
+    grep -q "removed by retention" v.json || { cat v.json; return 1; }
+    svc_stop
+    # DELETE of a done job: its files and its row go
+    svc_start d $SVC_FAST || return 1
+    b=$(svc_submit a.rsr) || return 1
+    svc_wait_state "$b" done 60 || return 1
+    [ -n "$(ls d/videos/$b.*)" ] || return 1
+    [ "$(curl -s -o c.json -w '%{http_code}' -X DELETE "$SVC_URL/jobs/$b")" = 200 ] || { cat c.json; return 1; }
+    [ "$(json_get files_removed <c.json)" = 2 ] || { cat c.json; return 1; }
+    [ -z "$(ls -A d/videos)" ] || { echo "DELETE left files:"; ls -la d/videos; return 1; }
+    [ "$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/$b")" = 404 ] || return 1
+    [ "$(curl -s -o /dev/null -w '%{http_code}' -X DELETE "$SVC_URL/jobs/$b")" = 404 ] || return 1
+    svc_stop
+}
+
+t_run ${T_ONLY:-random_kills_charge_nothing_and_leave_nothing failing_render_still_dead_letters lost_daemon_is_bounded \
+    retention_and_delete}
 t_done
