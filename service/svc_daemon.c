@@ -28,8 +28,14 @@
  * that both think they own a job (a lease lost to a network partition)
  * write different temporary names and the same final bytes.  Segments and
  * joins keep the same rules (svc_files.c).  What a crash leaves behind is
- * removed when the unit ends, and the sweep (svc_sweep, every 10 s)
- * removes what belongs to jobs that are over.
+ * removed when the unit ends, and the sweep (svc_sweep: at start-up,
+ * every 10 s and at the end of a drain) removes what belongs to jobs that
+ * are over or to daemons that are gone, and expires old videos
+ * (retention).
+ *
+ * Attempts are charged for render failures only: a unit whose daemon died
+ * comes back through reap (svc_reap_leases) with its attempt given back
+ * and a lost lease counted (svc_store.h).
  *
  * Children get PR_SET_PDEATHSIG: a daemon killed with SIGKILL takes its
  * renders with it, so a restarted daemon never races an orphan. */

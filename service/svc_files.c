@@ -5,19 +5,20 @@
  * here keeps state.  The layout under the output directory:
  *
  *   N.fmt, N.hashes                 a finished job (the only names clients see)
- *   .jobN-PID-aK.fmt / .hashes      an unsplit job's render, attempt K, by daemon PID
- *   .jobN-PID-jK.fmt / .hashes      a split job's join, attempt K
+ *   .jobN-PID-aK.fmt / .hashes      an unsplit job's render, claim K, by daemon PID
+ *   .jobN-PID-jK.fmt / .hashes      a split job's join, claim K
  *   .jobN-NONCE/                    a split job's segments: the directory is
  *                                   named by the job's key (svc_store.h), so a
  *                                   reused job id (a new queue, the same output
  *                                   directory) never meets the old files
- *       sI-aK.fmt, sI-aK.hashes,    segment I as attempt K rendered it (its
+ *       sI-aK.fmt, sI-aK.hashes,    segment I as claim K rendered it (its
  *       sI-aK.fmt.seg               manifest last: a manifest means complete)
  *
- * Each attempt writes names of its own, and the join is given the names of
- * the attempt the queue recorded (done_attempt), so a stale render of an
- * earlier attempt (a daemon cut off by a network partition) can never put
- * its file under the join.  Everything hidden (".job...") belongs to a job;
+ * K is the unit's claim number (svc_unit.claim: attempts + lost leases), so
+ * each claim writes names of its own, even when a lost lease gave its
+ * attempt back; the join is given the names of the claim the queue
+ * recorded (done_attempt), so a stale render of an earlier claim (a daemon
+ * cut off by a network partition) can never put its file under the join.  Everything hidden (".job...") belongs to a job;
  * the sweep removes it once its job is over or unknown to the queue, and
  * leaves every other name alone (the directory may be shared). */
 #include <dirent.h>

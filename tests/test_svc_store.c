@@ -461,6 +461,43 @@ static void reap(const char *spec)
     s->ops->close(s);
 }
 
+/* Retention lists the done jobs of one host past their age; remove takes
+ * only jobs that are over. */
+static void expire_and_remove(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t a = submit(s, "a", "a", 1), b = submit(s, "b", "b", 1), c = submit(s, "c", "c", 1);
+    svc_job j = claim_ok(s, "here:1-x/0", 60);
+    T_EQ(s->ops->finish(s, a, "here:1-x/0", SVC_DONE, NULL, -1, 1, &e), 1);
+    svc_job_free(&j);
+    j = claim_ok(s, "there:1-y/0", 60);
+    T_EQ(s->ops->finish(s, b, "there:1-y/0", SVC_DONE, NULL, -1, 1, &e), 1);
+    svc_job_free(&j);
+    int64_t ids[4];
+    T_EQ(s->ops->expiring(s, 3600, "here", ids, 4, &e), 0); /* not old enough */
+    T_EQ(s->ops->expiring(s, -5, "here", ids, 4, &e), 1);   /* "finished more than -5 s ago" */
+    T_EQ(ids[0], a);
+    T_EQ(s->ops->expiring(s, -5, "there", ids, 4, &e), 1);
+    T_EQ(ids[0], b);
+    T_EQ(s->ops->expire(s, a, &e), 1);
+    T_ASSERT(get_ok(s, a).expired && get_ok(s, a).state == SVC_DONE);
+    T_EQ(s->ops->expiring(s, -5, "here", ids, 4, &e), 0);
+    T_EQ(s->ops->expire(s, c, &e), 0); /* queued: nothing to expire */
+    /* remove: over jobs only */
+    T_EQ(s->ops->remove(s, c, &e), 2);
+    T_EQ(s->ops->remove(s, a, &e), 1);
+    svc_job g;
+    T_EQ(s->ops->get(s, a, &g, &e), 0);
+    svc_unit u[1];
+    T_EQ(s->ops->units(s, a, u, 1, &e), 0);
+    T_EQ(s->ops->remove(s, a, &e), 0);
+    T_EQ(s->ops->cancel(s, c, &e), 1);
+    T_EQ(s->ops->remove(s, c, &e), 1);
+    T_EQ(get_ok(s, b).state, SVC_DONE);
+    s->ops->close(s);
+}
+
 static void list_paging(const char *spec)
 {
     svc_store *s = open_ok(spec);
@@ -1156,6 +1193,36 @@ static void pg_admin_in_schema(const char *spec, const char *stmt)
     pg_admin(full);
 }
 
+/* A queue made before lost leases and retention: the columns are added,
+ * a lease lost then is no attempt either. */
+static void migrate_v2(const char *spec, void (*sql)(const char *spec, const char *stmt))
+{
+    svc_store *s = open_ok(spec);
+    int64_t id = submit(s, "old", "o", 1);
+    svc_job j = claim_ok(s, "old:1", -5);
+    svc_job_free(&j);
+    s->ops->close(s);
+    sql(spec, "ALTER TABLE units DROP COLUMN lost");
+    sql(spec, "ALTER TABLE jobs DROP COLUMN lost");
+    sql(spec, "ALTER TABLE jobs DROP COLUMN expired");
+    s = open_ok(spec);
+    rs_err e = {0};
+    T_EQ(s->ops->reap(s, false, NULL, 0, &e), 1);
+    svc_job g = get_ok(s, id);
+    T_ASSERT(g.state == SVC_QUEUED && g.attempts == 0 && g.lost == 1 && !g.expired);
+    s->ops->close(s);
+}
+
+static void t_sqlite_migrate_v2(void)
+{
+    migrate_v2(sqlite_spec(), sqlite_admin);
+}
+
+static void t_pg_migrate_v2(void)
+{
+    migrate_v2(pg_spec(), pg_admin_in_schema);
+}
+
 static void t_sqlite_migrate_v1(void)
 {
     migrate_v1(sqlite_spec(), sqlite_admin);
@@ -1172,6 +1239,7 @@ static void t_pg_migrate_v1(void)
 #define CASES(fn) {"sqlite_" #fn, t_sqlite_##fn}, {"pg_" #fn, t_pg_##fn}
 
 BOTH(roundtrip)
+BOTH(expire_and_remove)
 BOTH(claim_order)
 BOTH(attempts)
 BOTH(heartbeat)
@@ -1330,6 +1398,6 @@ T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), 
        CASES(dead_letter), CASES(give_back), CASES(reap), CASES(list_paging), CASES(counts), CASES(persistence),
        CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), CASES(split_plan), CASES(split_run),
        CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin),
-       CASES(split_concurrent), CASES(migrate_v1), {"sqlite_bad_files", t_sqlite_bad_files},
+       CASES(split_concurrent), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove), {"sqlite_bad_files", t_sqlite_bad_files},
        {"pg_unreachable", t_pg_unreachable}, {"pg_foreign_table", t_pg_foreign_table},
        {"pg_reconnect", t_pg_reconnect}, {"error_ids_have_texts", t_error_ids_have_texts})

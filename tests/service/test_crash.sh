@@ -33,7 +33,12 @@ t_random_kills_charge_nothing_and_leave_nothing() {
     for k in 1 2 3 4 5 6 7 8; do ids="$ids $(svc_submit r/r$k.rsr)" || return 1; done
     svc_stop
     crash_kill_run 4 21 --workers 2 --max-attempts 1 || return 1
+    # what the last killed daemon left: its pid in every name
+    dead=$SVC_PID
+    crash_leftovers d | grep -q -- "-$dead-" || { echo "the kill left nothing: the case tests nothing"; return 1; }
     svc_start d $SVC_FAST --workers 2 --max-attempts 1 || return 1
+    # swept at start-up, though the jobs they belong to are not over yet
+    if crash_leftovers d | grep -- "-$dead-"; then echo "the dead daemon's files survived the start-up"; return 1; fi
     bad=0
     for id in $ids; do
         svc_wait_state "$id" done 120 || bad=1
