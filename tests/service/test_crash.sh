@@ -26,23 +26,29 @@ crash_kill_run() { # KILLS SEED [serve options...]
     done
 }
 
+# CRASH_JOBS, CRASH_KILLS, CRASH_SEED and CRASH_MAX_ATTEMPTS make the larger
+# run of docs/service.md; its figures go to the file CRASH_REPORT names
 t_random_kills_charge_nothing_and_leave_nothing() {
-    svc_replays r 8 3 || return 1
+    n=${CRASH_JOBS:-8} kills=${CRASH_KILLS:-4} seed=${CRASH_SEED:-21} cap=${CRASH_MAX_ATTEMPTS:-1}
+    svc_replays r "$n" 3 || return 1
     svc_start d $SVC_FAST --workers 2 || return 1
-    ids=""
-    for k in 1 2 3 4 5 6 7 8; do ids="$ids $(svc_submit r/r$k.rsr)" || return 1; done
+    ids="" k=1
+    while [ $k -le "$n" ]; do ids="$ids $(svc_submit r/r$k.rsr)" || return 1; k=$((k + 1)); done
     svc_stop
-    crash_kill_run 4 21 --workers 2 --max-attempts 1 || return 1
+    crash_kill_run "$kills" "$seed" --workers 2 --max-attempts "$cap" || return 1
     # what the last killed daemon left: its pid in every name
     dead=$SVC_PID
+    before=$(crash_leftovers d | wc -l)
     crash_leftovers d | grep -q -- "-$dead-" || { echo "the kill left nothing: the case tests nothing"; return 1; }
-    svc_start d $SVC_FAST --workers 2 --max-attempts 1 || return 1
+    svc_start d $SVC_FAST --workers 2 --max-attempts "$cap" || return 1
     # swept at start-up, though the jobs they belong to are not over yet
     if crash_leftovers d | grep -- "-$dead-"; then echo "the dead daemon's files survived the start-up"; return 1; fi
-    bad=0
+    bad=0 failed=0 charged=0 lost=0
     for id in $ids; do
-        svc_wait_state "$id" done 120 || bad=1
-        a=$(svc_field "$id" attempts)
+        svc_wait_state "$id" done 300 || { bad=1; failed=$((failed + 1)); }
+        a=$(svc_field "$id" attempts) l=$(svc_field "$id" lost_leases)
+        charged=$((charged + a))
+        [ "$l" = null ] || lost=$((lost + l))
         [ "$a" = 1 ] || { echo "job $id: attempts $a, want 1 (a daemon crash charged it)"; bad=1; }
     done
     grep "re-queued\|lost its daemon" d.log
@@ -50,6 +56,10 @@ t_random_kills_charge_nothing_and_leave_nothing() {
     [ -z "$left" ] || { echo "leftover files after the last restart:"; echo "$left"; bad=1; }
     svc_stop
     [ -z "$(crash_leftovers d)" ] || { echo "leftovers after the drain:"; crash_leftovers d; bad=1; }
+    figures="$n jobs, $kills kills, max_attempts $cap: $failed failed, $charged attempts charged, $lost leases lost,"
+    figures="$figures $before leftover files before the last restart, $(crash_leftovers d | wc -l) after it and the drain"
+    echo "$figures"
+    [ -z "${CRASH_REPORT:-}" ] || echo "$figures" >>"$CRASH_REPORT"
     return $bad
 }
 
