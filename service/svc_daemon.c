@@ -630,7 +630,7 @@ int svc_reap_leases(svc_daemon *d, bool all, rs_err *err)
                     got[i].unit.lost + 1, got[i].unit.lost ? "s" : "", SVC_LOST_MAX);
     }
     if (n > 64)
-        svc_log(SVC_LOG_INFO, -1, "%d more units re-queued the same way", n - 64);
+        svc_log(SVC_LOG_INFO, -1, "%d more units taken back from lost leases (not listed one by one)", n - 64);
     return n;
 }
 
