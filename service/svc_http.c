@@ -450,7 +450,7 @@ static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
     if (!jobs)
         return reply_error(c, SVC_ERR_NOMEM, "out of memory");
     rs_err err = {0};
-    int n = d->http_store->ops->list(d->http_store, before, (int)limit, jobs, &err);
+    int n = d->http_store->ops->list(d->http_store, 0, before, (int)limit, jobs, &err);
     if (n < 0) {
         free(jobs);
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);

@@ -63,6 +63,11 @@ svc_store *sq_store_new(const sq_driver *drv, void *c, rs_err *err);
  * WHOLE unit for every queued or running job. */
 bool sq_schema_units(const sq_driver *drv, void *c, bool migrate, rs_err *err);
 
+/* The tokens table (its id column as serial says: each backend spells an
+ * auto-numbered key its own way) and the jobs' token index; migrate true
+ * adds jobs.token_id to a queue made before tokens existed. */
+bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool migrate, rs_err *err);
+
 /* sql with @NOW, @LOCK and @SKIP spelt the driver's way, and with dollar
  * true ?N as $N (PostgreSQL).  False when out is too small. */
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar);
