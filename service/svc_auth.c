@@ -1,4 +1,4 @@
-/* svc_auth: API tokens (svc_auth.h).
+/* svc_auth: API tokens (svc_auth.h), and `ringside serve token` (svc.h).
  *
  * DESIGN: a token is 32 bytes from getrandom(2), shown once as text; the
  * queue keeps only SHA-256 of that text, so a copy of the database lets
@@ -13,9 +13,14 @@
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
+#include <stdlib.h>
 #include <sys/random.h>
+#include <time.h>
 
+#include "svc.h"
 #include "svc_auth.h"
+#include "svc_store.h"
+#include "../runtime/util/rs_file.h"
 
 /* --- SHA-256 --- */
 
@@ -147,4 +152,117 @@ bool svc_listen_is_loopback(const char *listen)
     char extra;
     return sscanf(host, "%d.%d.%d.%d%c", &a, &b, &c, &d, &extra) == 4 && a == 127 && b >= 0 && b < 256 && c >= 0 &&
            c < 256 && d >= 0 && d < 256;
+}
+
+/* --- `ringside serve token` --- */
+
+/* The queue of cfg, made if it is new (a token may come before the first
+ * start).  An SQLite queue is not locked: WAL lets this run beside its
+ * daemon. */
+static svc_store *open_queue(const svc_config *cfg, rs_err *err)
+{
+    bool pg = !strncmp(cfg->queue, "postgres://", 11) || !strncmp(cfg->queue, "postgresql://", 13);
+    const char *db = !strncmp(cfg->queue, "sqlite:", 7) ? cfg->queue + 7 : cfg->queue;
+    if (!pg && *db && !rs_mkdirs_for(db, err))
+        return NULL;
+    return svc_store_open(cfg->queue, err);
+}
+
+/* Names people read in logs and lists: 1..64 of letters, digits, . _ - @,
+ * not all digits (revoke takes an id too). */
+static bool name_ok(const char *name, rs_err *err)
+{
+    size_t n = strlen(name);
+    bool digits = true;
+    for (const char *p = name; *p; p++) {
+        if (!isalnum((unsigned char)*p) && !strchr("._-@", *p))
+            return rs_fail(err, SVC_TOKEN_USAGE, "name '%s': use letters, digits and . _ - @ only", name);
+        digits = digits && isdigit((unsigned char)*p);
+    }
+    if (n == 0 || n > 64)
+        return rs_fail(err, SVC_TOKEN_USAGE, "name '%s': 1 to 64 characters", name);
+    if (digits)
+        return rs_fail(err, SVC_TOKEN_USAGE, "name '%s': not only digits (revoke takes an id as well as a name)", name);
+    return true;
+}
+
+bool svc_token_add(const svc_config *cfg, const char *name, bool is_operator, int max_queued, int seconds_per_hour,
+                   rs_err *err)
+{
+    if (!name_ok(name, err))
+        return false;
+    char token[SVC_TOKEN_LEN + 1], hash[SVC_TOKEN_HASH_LEN];
+    if (!svc_token_make(token, err))
+        return false;
+    svc_token_hash(token, hash);
+    svc_store *s = open_queue(cfg, err);
+    if (!s)
+        return false;
+    svc_token t = {.is_operator = is_operator, .max_queued = max_queued, .seconds_per_hour = seconds_per_hour};
+    snprintf(t.name, sizeof t.name, "%s", name);
+    int r = s->ops->token_add(s, &t, hash, err);
+    s->ops->close(s);
+    if (r == 0)
+        return rs_fail(err, 1, "a token named '%s' exists already (revoked ones keep their names)", name);
+    if (r < 0)
+        return false;
+    printf("%s\n", token);
+    fflush(stdout);
+    fprintf(stderr, "ringside serve token: added token %lld '%s'%s; it is shown this once and cannot be shown again\n",
+            (long long)t.id, name, is_operator ? " (operator)" : "");
+    return true;
+}
+
+static void put_time(char *out, size_t n, int64_t t)
+{
+    time_t tt = (time_t)t;
+    struct tm tm;
+    if (t == 0 || !gmtime_r(&tt, &tm) || !strftime(out, n, "%Y-%m-%dT%H:%MZ", &tm))
+        snprintf(out, n, "-");
+}
+
+bool svc_token_list(const svc_config *cfg, rs_err *err)
+{
+    svc_store *s = open_queue(cfg, err);
+    if (!s)
+        return false;
+    enum { MAX = 10000 };
+    svc_token *t = calloc(MAX, sizeof *t);
+    int n = t ? s->ops->token_list(s, t, MAX, err) : -1;
+    s->ops->close(s);
+    if (!t)
+        return rs_fail(err, 1, "out of memory");
+    if (n < 0) {
+        free(t);
+        return false;
+    }
+    printf("%-5s %-24s %-8s %-10s %-8s %-17s %-17s %s\n", "ID", "NAME", "OPERATOR", "MAX_QUEUED", "SEC/HOUR", "CREATED",
+           "REVOKED", "LAST_USED");
+    for (int i = 0; i < n; i++) {
+        char created[32], revoked[32], used[32];
+        put_time(created, sizeof created, t[i].created);
+        put_time(revoked, sizeof revoked, t[i].revoked);
+        put_time(used, sizeof used, t[i].last_used);
+        printf("%-5lld %-24s %-8s %-10d %-8d %-17s %-17s %s\n", (long long)t[i].id, t[i].name,
+               t[i].is_operator ? "yes" : "no", t[i].max_queued, t[i].seconds_per_hour, created, revoked, used);
+    }
+    free(t);
+    return true;
+}
+
+bool svc_token_revoke(const svc_config *cfg, const char *which, rs_err *err)
+{
+    svc_store *s = open_queue(cfg, err);
+    if (!s)
+        return false;
+    svc_token t;
+    int r = s->ops->token_revoke(s, which, &t, err);
+    s->ops->close(s);
+    if (r < 0)
+        return false;
+    if (r == 0)
+        return rs_fail(err, 1, "no token named '%s' or with that id ('ringside serve token list' shows them)", which);
+    fprintf(stderr, "ringside serve token: token %lld '%s' %s\n", (long long)t.id, t.name,
+            r == 2 ? "was revoked already" : "revoked: it stops working at its next request");
+    return true;
 }
