@@ -129,8 +129,9 @@ t_quotas_answer_429() {
 
 t_beyond_loopback() {
     mkdir -p d
+    # bounded: a daemon that wrongly starts is killed after 10 s (exit 124)
     expect_fail 1 "no API token: make one first with 'ringside serve token add NAME'" \
-        "$RS_BIN" serve --listen 0.0.0.0:0 --data d || return 1
+        timeout 10 "$RS_BIN" serve --listen 0.0.0.0:0 --data d || return 1
     a=$(token alice) || return 1
     "$RS_BIN" serve --listen 0.0.0.0:0 --data d $SVC_FAST >d.log 2>&1 &
     SVC_PID=$!
