@@ -26,4 +26,16 @@ typedef struct svc_desc {
  * the supervisor failed.  One daemon per process. */
 bool svc_serve(const svc_desc *desc, rs_err *err);
 
+/* `ringside serve token ...`: API tokens in the queue of cfg (after
+ * svc_config_finish), docs/service.md "Tokens".  add prints the new token
+ * on stdout (once: only its hash is kept) and a note on stderr; list
+ * prints a table of every token, never a token itself; revoke takes a
+ * name, or an id.  false with err filled: err->code SVC_TOKEN_USAGE for a
+ * bad name (bad usage), anything else a failure. */
+#define SVC_TOKEN_USAGE 2
+bool svc_token_add(const svc_config *cfg, const char *name, bool is_operator, int max_queued, int seconds_per_hour,
+                   rs_err *err);
+bool svc_token_list(const svc_config *cfg, rs_err *err);
+bool svc_token_revoke(const svc_config *cfg, const char *which, rs_err *err);
+
 #endif

@@ -20,6 +20,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "svc_auth.h"
 #include "svc_json.h"
 #include "svc_local.h"
 #include "svc_log.h"
@@ -48,7 +49,7 @@ static const struct {
     {SVC_ERR_EMPTY, 400},     {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
     {SVC_ERR_BAD_BODY, 400},  {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
     {SVC_ERR_GONE, 410},      {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
-    {SVC_ERR_NOMEM, 500},
+    {SVC_ERR_NOMEM, 500},     {SVC_ERR_AUTH, 401},      {SVC_ERR_QUOTA, 429},
 };
 
 unsigned svc_http_status(int code)
@@ -148,6 +149,10 @@ typedef struct req {
     const char *bad; /* a malformed body: answered 400 once it is read */
     char name[SVC_NAME_MAX];
     char size[32], format[16];
+    /* who asks (authorize): tok.id 0 without a token; all: sees every job
+     * (an operator token, or loopback with no tokens at all) */
+    svc_token tok;
+    bool all;
 } req;
 
 static enum MHD_Result reply(struct MHD_Connection *c, unsigned status, const char *type, const char *body, size_t n)
@@ -185,6 +190,32 @@ static enum MHD_Result reply_error(struct MHD_Connection *c, int id, const char 
     svc_buf b = {0};
     svc_json_error(&b, msg);
     return reply_json(c, svc_http_status(id), &b);
+}
+
+/* An error answer with one more header (401's WWW-Authenticate, 429's
+ * Retry-After). */
+static enum MHD_Result reply_error_header(struct MHD_Connection *c, int id, const char *header, const char *value,
+                                          const char *fmt, ...) RS_PRINTF(5, 6);
+static enum MHD_Result reply_error_header(struct MHD_Connection *c, int id, const char *header, const char *value,
+                                          const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    svc_buf b = {0};
+    svc_json_error(&b, msg);
+    struct MHD_Response *r = b.oom ? NULL : MHD_create_response_from_buffer(b.len, b.p, MHD_RESPMEM_MUST_COPY);
+    svc_buf_free(&b);
+    if (!r)
+        return MHD_NO;
+    MHD_add_response_header(r, "Content-Type", "application/json");
+    MHD_add_response_header(r, "Cache-Control", "no-store");
+    MHD_add_response_header(r, header, value);
+    enum MHD_Result ret = MHD_queue_response(c, svc_http_status(id), r);
+    MHD_destroy_response(r);
+    return ret;
 }
 
 static bool append(req *q, const char *data, size_t n, long limit)
@@ -290,6 +321,43 @@ static enum MHD_Result reject(svc_daemon *d, struct MHD_Connection *c, int id, c
     return reply_error(c, id, "%s", msg);
 }
 
+/* A token's quotas against job j (frames_total known).  1: within them;
+ * 0: over one (msg says which, *retry the seconds until trying again may
+ * work); -1: the queue failed (err). */
+static int check_quota(svc_daemon *d, const svc_token *t, const svc_job *j, char *msg, size_t n, int64_t *retry,
+                       rs_err *err)
+{
+    if (t->max_queued == 0 && t->seconds_per_hour == 0)
+        return 1;
+    svc_usage u;
+    if (!d->http_store->ops->token_usage(d->http_store, t->id, &u, err))
+        return -1;
+    if (t->max_queued > 0 && u.active >= t->max_queued) {
+        *retry = 30; /* jobs end at render speed: look again in a while */
+        snprintf(msg, n, "token '%s' has %" PRId64 " jobs queued or running, its quota (max_queued %d)", t->name,
+                 u.active, t->max_queued);
+        return 0;
+    }
+    int64_t limit = (int64_t)t->seconds_per_hour * 60; /* in ticks, as frames_total */
+    if (t->seconds_per_hour > 0 && u.hour_frames + j->frames_total > limit) {
+        /* the oldest job of the hour leaves the window first */
+        *retry = u.oldest ? u.oldest + 3600 - u.now : 3600;
+        if (*retry < 1)
+            *retry = 1;
+        snprintf(msg, n,
+                 "token '%s' submitted %" PRId64 " s of game time in the last hour; this replay's %" PRId64
+                 " s would pass its quota (seconds_per_hour %d)",
+                 t->name, u.hour_frames / 60, (j->frames_total + 59) / 60, t->seconds_per_hour);
+        return 0;
+    }
+    return 1;
+}
+
+/* Quota check and submit under one lock, so two uploads of one token at
+ * once cannot both pass the same last slot (on one daemon; several
+ * daemons of a PostgreSQL queue can each let one through). */
+static pthread_mutex_t submit_mu = PTHREAD_MUTEX_INITIALIZER;
+
 static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     if (q->oom)
@@ -339,7 +407,20 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
     j.replay = q->body;
     j.replay_len = q->len;
     j.segment_ticks = d->cfg.segment_seconds * 60; /* the store splits it if it is longer */
-    if (!d->http_store->ops->submit(d->http_store, &j, &err)) {
+    j.token_id = q->tok.id;
+    char over[512];
+    int64_t retry = 0;
+    pthread_mutex_lock(&submit_mu);
+    int quota = q->tok.id ? check_quota(d, &q->tok, &j, over, sizeof over, &retry, &err) : 1;
+    bool queued = quota == 1 && d->http_store->ops->submit(d->http_store, &j, &err);
+    pthread_mutex_unlock(&submit_mu);
+    if (quota == 0) {
+        char ra[32];
+        snprintf(ra, sizeof ra, "%" PRId64, retry);
+        svc_log(SVC_LOG_INFO, -1, "upload refused (429): %s", over);
+        return reply_error_header(c, SVC_ERR_QUOTA, "Retry-After", ra, "%s; try again in %" PRId64 " s", over, retry);
+    }
+    if (!queued) {
         svc_log(SVC_LOG_ERROR, -1, "could not queue an upload: %s", err.msg);
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     }
@@ -404,14 +485,21 @@ static void overlay_live(svc_daemon *d, svc_job *j, svc_unit *units, int n)
         j->fps = 0;
 }
 
-static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, int64_t id)
+/* A token sees its own jobs only (an operator's, or no token on an open
+ * loopback daemon: every job); another's answers 404, as a missing one. */
+static bool may_see(const req *q, const svc_job *j)
+{
+    return q->all || (q->tok.id != 0 && j->token_id == q->tok.id);
+}
+
+static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
 {
     svc_job j;
     rs_err err = {0};
     int r = d->http_store->ops->get(d->http_store, id, &j, &err);
     if (r < 0)
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
-    if (r == 0)
+    if (r == 0 || !may_see(q, &j))
         return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
     /* a split job shows its segments: who rendered each, how often */
     svc_unit *units = NULL;
@@ -434,7 +522,7 @@ static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, int64
     return reply_json(c, 200, &b);
 }
 
-static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
+static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c, const req *q)
 {
     long limit = 50;
     int64_t before = 0, lim;
@@ -450,7 +538,7 @@ static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c)
     if (!jobs)
         return reply_error(c, SVC_ERR_NOMEM, "out of memory");
     rs_err err = {0};
-    int n = d->http_store->ops->list(d->http_store, before, (int)limit, jobs, &err);
+    int n = d->http_store->ops->list(d->http_store, q->all ? 0 : q->tok.id, before, (int)limit, jobs, &err);
     if (n < 0) {
         free(jobs);
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
@@ -495,28 +583,36 @@ static enum MHD_Result do_delete_finished(svc_daemon *d, struct MHD_Connection *
     return reply(c, 200, "application/json", body, strlen(body));
 }
 
-static enum MHD_Result do_cancel(svc_daemon *d, struct MHD_Connection *c, int64_t id)
+static enum MHD_Result do_cancel(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
 {
     rs_err err = {0};
-    int r = d->http_store->ops->cancel(d->http_store, id, &err);
+    svc_job mine;
+    int r = d->http_store->ops->get(d->http_store, id, &mine, &err);
+    if (r == 1 && !may_see(q, &mine))
+        r = 0;
+    if (r == 1)
+        r = d->http_store->ops->cancel(d->http_store, id, &err);
     if (r < 0)
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     if (r == 0)
         return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
     if (r == 2)
         return do_delete_finished(d, c, id);
-    svc_log(SVC_LOG_INFO, id, "cancelled by a client");
-    return do_get_job(d, c, id);
+    if (q->tok.id)
+        svc_log(SVC_LOG_INFO, id, "cancelled by a client (token '%s')", q->tok.name);
+    else
+        svc_log(SVC_LOG_INFO, id, "cancelled by a client");
+    return do_get_job(d, c, q, id);
 }
 
-static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, int64_t id, bool video)
+static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id, bool video)
 {
     svc_job j;
     rs_err err = {0};
     int r = d->http_store->ops->get(d->http_store, id, &j, &err);
     if (r < 0)
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
-    if (r == 0)
+    if (r == 0 || !may_see(q, &j))
         return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
     if (j.state != SVC_DONE)
         return reply_error(c, SVC_ERR_NOT_FOUND, "job %" PRId64 " is %s: its %s exists once it is done", id, svc_state_name(j.state),
@@ -670,7 +766,7 @@ static enum MHD_Result do_dashboard(svc_daemon *d, struct MHD_Connection *c)
     return r;
 }
 
-static enum MHD_Result route(svc_daemon *d, struct MHD_Connection *c, const char *url, const char *method)
+static enum MHD_Result route(svc_daemon *d, struct MHD_Connection *c, const req *q, const char *url, const char *method)
 {
     bool get = !strcmp(method, "GET") || !strcmp(method, "HEAD");
     if (!strcmp(url, "/") || !strcmp(url, "/index.html"))
@@ -680,7 +776,7 @@ static enum MHD_Result route(svc_daemon *d, struct MHD_Connection *c, const char
     if (!strcmp(url, "/metrics"))
         return get ? do_metrics(d, c) : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
     if (!strcmp(url, "/jobs") || !strcmp(url, "/jobs/"))
-        return get ? do_list(d, c) : reply_error(c, SVC_ERR_METHOD, "%s /jobs: expected GET or POST", method);
+        return get ? do_list(d, c, q) : reply_error(c, SVC_ERR_METHOD, "%s /jobs: expected GET or POST", method);
     if (!strncmp(url, "/jobs/", 6)) {
         const char *p = url + 6, *slash = strchr(p, '/');
         size_t n = slash ? (size_t)(slash - p) : strlen(p);
@@ -689,15 +785,72 @@ static enum MHD_Result route(svc_daemon *d, struct MHD_Connection *c, const char
             return reply_error(c, SVC_ERR_NOT_FOUND, "%s: not a job id", url);
         if (!slash) {
             if (get)
-                return do_get_job(d, c, id);
+                return do_get_job(d, c, q, id);
             if (!strcmp(method, "DELETE"))
-                return do_cancel(d, c, id);
+                return do_cancel(d, c, q, id);
             return reply_error(c, SVC_ERR_METHOD, "%s %s: expected GET or DELETE", method, url);
         }
         if (!strcmp(slash, "/video") || !strcmp(slash, "/hashes"))
-            return get ? do_file(d, c, id, slash[1] == 'v') : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
+            return get ? do_file(d, c, q, id, slash[1] == 'v') : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
     }
     return reply_error(c, SVC_ERR_NOT_FOUND, "%s: no such resource (see /jobs, /healthz, /metrics)", url);
+}
+
+/* Who asks (docs/service.md, "Tokens").  Every route but the dashboard
+ * and /healthz needs a valid token once any token exists or the daemon
+ * listens beyond loopback.  Called at a request's first call, before any
+ * body is read, so a refused upload costs no memory.  Nothing is cached:
+ * the token is looked up on every request, so a revoked one stops working
+ * at its next request.  true: go on (q->tok, q->all say who); false:
+ * answered (401, 503), *ret what to return. */
+static bool authorize(svc_daemon *d, struct MHD_Connection *c, const char *url, req *q, enum MHD_Result *ret)
+{
+    if (!strcmp(url, "/") || !strcmp(url, "/index.html") || !strcmp(url, "/healthz"))
+        return true;
+    const char *h = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Authorization");
+    rs_err err = {0};
+    q->done = true;
+    if (!h) {
+        int64_t active = svc_listen_is_loopback(d->cfg.listen) ? d->http_store->ops->token_active(d->http_store, &err) : 1;
+        if (active == 0) {
+            q->done = false;
+            q->all = true; /* loopback, no tokens: the convenience of a local daemon */
+            return true;
+        }
+        *ret = active < 0 ? reply_error(c, err.code, "the queue is unavailable: %s", err.msg)
+                          : reply_error_header(c, SVC_ERR_AUTH, "WWW-Authenticate", "Bearer",
+                                               "this service needs an API token: send 'Authorization: Bearer TOKEN' "
+                                               "('ringside serve token add NAME' makes one)");
+        return false;
+    }
+    size_t n = 0;
+    const char *tok = svc_bearer(h, &n);
+    if (!tok || n == 0 || n > SVC_TOKEN_LEN) {
+        *ret = reply_error_header(c, SVC_ERR_AUTH, "WWW-Authenticate", "Bearer error=\"invalid_token\"",
+                                  tok ? "not a token of this service" : "Authorization: expected 'Bearer TOKEN'");
+        return false;
+    }
+    char text[SVC_TOKEN_LEN + 1], hash[SVC_TOKEN_HASH_LEN];
+    memcpy(text, tok, n);
+    text[n] = 0;
+    svc_token_hash(text, hash);
+    int r = d->http_store->ops->token_find(d->http_store, hash, &q->tok, &err);
+    if (r < 0) {
+        *ret = reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+        return false;
+    }
+    if (r == 0 || q->tok.revoked) {
+        bool revoked = r == 1;
+        if (revoked)
+            svc_log(SVC_LOG_INFO, -1, "refused a request with token '%s' (revoked)", q->tok.name);
+        *ret = reply_error_header(c, SVC_ERR_AUTH, "WWW-Authenticate", "Bearer error=\"invalid_token\"",
+                                  revoked ? "token '%s' was revoked" : "%sunknown token", revoked ? q->tok.name : "");
+        memset(&q->tok, 0, sizeof q->tok);
+        return false;
+    }
+    q->done = false;
+    q->all = q->tok.is_operator;
+    return true;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url, const char *method,
@@ -712,6 +865,9 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             return MHD_NO;
         *con_cls = cx;
         req *q = &cx->q;
+        enum MHD_Result answered;
+        if (!authorize(d, c, url, q, &answered))
+            return answered;
         if (strcmp(method, "POST") != 0 || (strcmp(url, "/jobs") != 0 && strcmp(url, "/jobs/") != 0))
             return MHD_YES; /* answered below, once any body is read */
         q->post_jobs = true;
@@ -764,7 +920,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     q->done = true;
     if (q->post_jobs)
         return do_submit(d, c, q);
-    return route(d, c, url, method);
+    return route(d, c, q, url, method);
 }
 
 static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls, enum MHD_RequestTerminationCode toe)

@@ -68,6 +68,8 @@ typedef struct svc_daemon {
     X(RANGE, "the byte range asked for is outside the file")                    \
     X(METHOD, "the resource does not take that method")                         \
     X(DRAINING, "the daemon is shutting down and takes no new jobs")            \
+    X(AUTH, "no API token, or an unknown or revoked one")                       \
+    X(QUOTA, "the API token's quota is used up for now")                        \
     X(NOMEM, "out of memory")
 
 typedef enum svc_error {

@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "svc.h"
+#include "svc_auth.h"
 #include "svc_local.h"
 #include "svc_log.h"
 #include "../runtime/util/rs_file.h"
@@ -114,6 +115,29 @@ static bool desc_files(svc_daemon *d, const svc_desc *desc, rs_err *err)
     return true;
 }
 
+/* Beyond loopback, anyone who reaches the port could list, download and
+ * cancel every job: refuse to start without a token to ask for.  Says in
+ * the log whether requests need one. */
+static bool check_tokens(svc_daemon *d, rs_err *err)
+{
+    int64_t n = d->store->ops->token_active(d->store, err);
+    if (n < 0)
+        return false;
+    bool loopback = svc_listen_is_loopback(d->cfg.listen);
+    if (!loopback && n == 0)
+        return rs_fail(err, 1,
+                       "listen %s reaches beyond this machine and the queue has no API token: make one first with "
+                       "'ringside serve token add NAME' (with the same --data or --queue), or listen on 127.0.0.1",
+                       d->cfg.listen);
+    if (n > 0)
+        svc_log(SVC_LOG_INFO, -1, "API tokens required (%lld active)%s", (long long)n,
+                loopback ? "" : ": listening beyond loopback");
+    else
+        svc_log(SVC_LOG_INFO, -1, "API tokens not required: loopback and no tokens ('ringside serve token add NAME' "
+                                  "makes the first and turns them on)");
+    return true;
+}
+
 bool svc_serve(const svc_desc *desc, rs_err *err)
 {
     static svc_daemon d;
@@ -154,6 +178,8 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
             goto out;
     }
     if (!(d.store = svc_store_open(d.cfg.queue, err)) || !(d.http_store = svc_store_open(d.cfg.queue, err)))
+        goto out;
+    if (!check_tokens(&d, err))
         goto out;
     if (sqlite) {
         /* we hold the only lock: every running job belonged to a daemon

@@ -152,6 +152,7 @@ typedef struct svc_job {
     int segment_ticks;           /* submit: split into segments this long (0: unsplit) */
     int segments;                /* how many it was split into (0: unsplit, one WHOLE unit) */
     char key[SVC_KEY_MAX];       /* "job<id>-<nonce>" */
+    int64_t token_id;            /* the API token that submitted it (0: none; svc_token) */
     svc_unit unit;               /* claim: the unit handed out (the rest leave it zero) */
     /* the replay: submit reads it, claim fills it (malloc'd; svc_job_free) */
     uint8_t *replay;
@@ -173,6 +174,25 @@ typedef struct svc_reaped {
     svc_unit unit; /* as it was when reaped (its lost count not yet raised) */
     bool failed;   /* the job failed: SVC_LOST_MAX leases lost */
 } svc_reaped;
+
+/* An API token (svc_auth.h): what the queue knows of it.  The token itself
+ * is never stored, only its hash. */
+typedef struct svc_token {
+    int64_t id;
+    char name[SVC_NAME_MAX];
+    bool is_operator;     /* sees and acts on every job */
+    int max_queued;       /* its jobs queued or running at once (0: no cap) */
+    int seconds_per_hour; /* game seconds it may submit in any hour (0: no cap) */
+    int64_t created, revoked, last_used; /* Unix seconds; 0: not (yet) */
+} svc_token;
+
+/* What a token's quotas are measured against (token_usage). */
+typedef struct svc_usage {
+    int64_t active;      /* its jobs queued or running */
+    int64_t hour_frames; /* frames of its jobs created in the last hour */
+    int64_t oldest;      /* when the oldest of those was created (0: none) */
+    int64_t now;         /* the database's clock */
+} svc_usage;
 
 typedef struct svc_store svc_store;
 
@@ -223,9 +243,10 @@ typedef struct svc_store_ops {
     int (*units)(svc_store *s, int64_t id, svc_unit *out, int max, rs_err *err);
     /* 1: found; 0: no such job; -1: error.  out->replay stays NULL. */
     int (*get)(svc_store *s, int64_t id, svc_job *out, rs_err *err);
-    /* Newest first, ids below before_id (0: from the newest); up to limit
-     * rows into out.  Returns the count, or -1. */
-    int (*list)(svc_store *s, int64_t before_id, int limit, svc_job *out, rs_err *err);
+    /* Newest first, ids below before_id (0: from the newest), only token
+     * token_id's jobs (0: every job); up to limit rows into out.  Returns
+     * the count, or -1. */
+    int (*list)(svc_store *s, int64_t token_id, int64_t before_id, int limit, svc_job *out, rs_err *err);
     /* Queued or running -> cancelled.  1: cancelled; 0: no such job;
      * 2: already over (done, failed or cancelled); -1: error. */
     int (*cancel)(svc_store *s, int64_t id, rs_err *err);
@@ -242,6 +263,21 @@ typedef struct svc_store_ops {
     int (*remove)(svc_store *s, int64_t id, rs_err *err);
     /* Jobs per state. */
     bool (*counts)(svc_store *s, int64_t by_state[SVC_NSTATES], rs_err *err);
+    /* API tokens.  token_add: t's name, is_operator and quotas, with hash
+     * (svc_token_hash); fills t->id and t->created.  1: added; 0: a token
+     * of that name exists (revoked ones too: names are never reused); -1. */
+    int (*token_add)(svc_store *s, svc_token *t, const char *hash, rs_err *err);
+    /* Every token, oldest first, up to max into out.  Returns the count, or -1. */
+    int (*token_list)(svc_store *s, svc_token *out, int max, rs_err *err);
+    /* The token named which, or else with the id which spells.  1: revoked
+     * now; 2: it was already; 0: no such token; -1.  out: the token. */
+    int (*token_revoke)(svc_store *s, const char *which, svc_token *out, rs_err *err);
+    /* The token whose hash this is (revoked ones too: out->revoked says),
+     * its last_used brought up to the minute.  1, 0 (none), -1. */
+    int (*token_find)(svc_store *s, const char *hash, svc_token *out, rs_err *err);
+    /* Tokens not revoked, or -1. */
+    int64_t (*token_active)(svc_store *s, rs_err *err);
+    bool (*token_usage)(svc_store *s, int64_t token_id, svc_usage *out, rs_err *err);
     void (*close)(svc_store *s);
 } svc_store_ops;
 

@@ -63,7 +63,8 @@ static const char create_table[] =
     " created BIGINT NOT NULL DEFAULT 0, started BIGINT NOT NULL DEFAULT 0, finished BIGINT NOT NULL DEFAULT 0,"
     " claimed_until BIGINT NOT NULL DEFAULT 0,"
     " replay BYTEA NOT NULL,"
-    " segment_ticks INTEGER NOT NULL DEFAULT 0, segments INTEGER NOT NULL DEFAULT 0, seg_key TEXT NOT NULL DEFAULT '')";
+    " segment_ticks INTEGER NOT NULL DEFAULT 0, segments INTEGER NOT NULL DEFAULT 0, seg_key TEXT NOT NULL DEFAULT '',"
+    " token_id BIGINT NOT NULL DEFAULT 0)";
 
 /* libpq's messages span lines and indent with tabs: one line, single spaces. */
 static void one_line(char *dst, size_t n, const char *src)
@@ -378,7 +379,8 @@ static void scrub(char *msg, const char *conninfo)
 
 /* What the schema lacks: 1 the jobs table, 2 its segment columns (a queue
  * from before units), 4 the units table, 8 the lost-lease column (a queue
- * from before it: sq_schema_lost); -1 on error. */
+ * from before it: sq_schema_lost), 16 jobs.token_id (a queue from before
+ * tokens), 32 the tokens table; -1 on error. */
 static int schema_needs(pg_conn *s, rs_err *err)
 {
     sq_res r;
@@ -386,10 +388,15 @@ static int schema_needs(pg_conn *s, rs_err *err)
                "SELECT to_regclass('jobs') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
                " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'segments'),"
                " to_regclass('units') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
-               " WHERE table_schema = current_schema() AND table_name = 'units' AND column_name = 'lost')",
+               " WHERE table_schema = current_schema() AND table_name = 'units' AND column_name = 'lost'),"
+               " NOT EXISTS (SELECT 1 FROM information_schema.columns"
+               " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'token_id'),"
+               " to_regclass('tokens') IS NULL",
                NULL, 0, &r, err) < 0)
         return -1;
-    int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2 | r.v[3].i << 3) : -1;
+    int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2 | r.v[3].i << 3 | r.v[4].i << 4 |
+                                   r.v[5].i << 5)
+                           : -1;
     d_res_free(&r);
     return need;
 }
@@ -425,8 +432,10 @@ static bool create_schema(pg_conn *s, rs_err *err)
         ok = ok && (!(need & 1) || d_exec(s, "create the jobs table", create_table, NULL, 0, NULL, err) >= 0) &&
              (!(need & 1) || d_exec(s, "create the index", "CREATE INDEX IF NOT EXISTS jobs_state ON jobs (state, id)",
                                     NULL, 0, NULL, err) >= 0) &&
-             (!need || sq_schema_units(&pg_driver, s, migrate, err)) &&
-             (!need || sq_schema_lost(&pg_driver, s, PG_HAS_COLUMN, err)) && d_commit(s, err);
+             (!(need & 15) || sq_schema_units(&pg_driver, s, migrate, err)) &&
+             (!(need & 15) || sq_schema_lost(&pg_driver, s, PG_HAS_COLUMN, err)) &&
+             (!(need & 48) || sq_schema_tokens(&pg_driver, s, "BIGSERIAL PRIMARY KEY", (need & 16) && !(need & 1), err)) &&
+             d_commit(s, err);
         if (!ok) {
             d_rollback(s);
             return false;

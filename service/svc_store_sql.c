@@ -109,6 +109,9 @@ static void job_from(const sq_res *r, int row, svc_job *j)
     j->expired = v_int(r, row, 21) != 0;
 }
 
+/* get and list read token_id after SQ_JOB_COLS (the claim does not need it) */
+#define TOKEN_COL 20
+
 static void unit_from(const sq_res *r, int row, svc_unit *u)
 {
     memset(u, 0, sizeof *u);
@@ -322,9 +325,9 @@ static bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
     sq_res r;
     ok = run(s, "insert job",
              "INSERT INTO jobs (state, name, width, height, format, frames_total, created, replay, segment_ticks,"
-             " segments, seg_key) VALUES (0, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) RETURNING id",
+             " segments, seg_key, token_id) VALUES (0, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11) RETURNING id",
              ARGS(T(j->name), I(j->width), I(j->height), T(j->format), I(j->frames_total), I(now),
-                  B(j->replay, j->replay_len), I(seg), I(n), T(nonce)),
+                  B(j->replay, j->replay_len), I(seg), I(n), T(nonce), I(j->token_id)),
              &r, err) >= 0 &&
          r.rows == 1;
     int64_t id = ok ? v_int(&r, 0, 0) : 0;
@@ -665,9 +668,10 @@ static int sq_get(svc_store *bs, int64_t id, svc_job *out, rs_err *err)
     sq_store *s = S(bs);
     sq_res r;
     pthread_mutex_lock(&s->mu);
-    int rc = run(s, "get", "SELECT " SQ_JOB_COLS " FROM jobs WHERE id = ?1", ARGS(I(id)), &r, err) < 0 ? -1 : 0;
+    int rc = run(s, "get", "SELECT " SQ_JOB_COLS ", token_id FROM jobs WHERE id = ?1", ARGS(I(id)), &r, err) < 0 ? -1 : 0;
     if (rc == 0 && r.rows > 0) {
         job_from(&r, 0, out);
+        out->token_id = v_int(&r, 0, TOKEN_COL);
         rc = 1;
     }
     if (rc >= 0)
@@ -676,7 +680,7 @@ static int sq_get(svc_store *bs, int64_t id, svc_job *out, rs_err *err)
     return rc;
 }
 
-static int sq_list(svc_store *bs, int64_t before, int limit, svc_job *out, rs_err *err)
+static int sq_list(svc_store *bs, int64_t token_id, int64_t before, int limit, svc_job *out, rs_err *err)
 {
     sq_store *s = S(bs);
     if (limit <= 0) /* PostgreSQL refuses a negative LIMIT */
@@ -684,12 +688,16 @@ static int sq_list(svc_store *bs, int64_t before, int limit, svc_job *out, rs_er
     sq_res r;
     pthread_mutex_lock(&s->mu);
     /* 0 means "from the newest"; a plain id < ?1 keeps the primary key usable */
-    int n = (int)run(s, "list", "SELECT " SQ_JOB_COLS " FROM jobs WHERE id < ?1 ORDER BY id DESC LIMIT ?2",
-                     ARGS(I(before == 0 ? INT64_MAX : before), I(limit)), &r, err);
+    int n = (int)run(s, "list",
+                     "SELECT " SQ_JOB_COLS ", token_id FROM jobs WHERE id < ?1 AND (?3 = 0 OR token_id = ?3)"
+                     " ORDER BY id DESC LIMIT ?2",
+                     ARGS(I(before == 0 ? INT64_MAX : before), I(limit), I(token_id)), &r, err);
     if (n >= 0) {
         n = r.rows < limit ? r.rows : limit;
-        for (int i = 0; i < n; i++)
+        for (int i = 0; i < n; i++) {
             job_from(&r, i, &out[i]);
+            out[i].token_id = v_int(&r, i, TOKEN_COL);
+        }
         res_free(s, &r);
     }
     pthread_mutex_unlock(&s->mu);
@@ -788,6 +796,166 @@ static bool sq_counts(svc_store *bs, int64_t by_state[SVC_NSTATES], rs_err *err)
     return ok;
 }
 
+/* --- API tokens --- */
+
+#define TOKEN_COLS "id, name, is_operator, max_queued, seconds_per_hour, created, revoked, last_used"
+
+static void token_from(const sq_res *r, int row, svc_token *t)
+{
+    memset(t, 0, sizeof *t);
+    t->id = v_int(r, row, 0);
+    v_text(t->name, sizeof t->name, r, row, 1);
+    t->is_operator = v_int(r, row, 2) != 0;
+    t->max_queued = (int)v_int(r, row, 3);
+    t->seconds_per_hour = (int)v_int(r, row, 4);
+    t->created = v_int(r, row, 5);
+    t->revoked = v_int(r, row, 6);
+    t->last_used = v_int(r, row, 7);
+}
+
+/* The first row of a token query into out.  1, 0 (no row), -1. */
+static int token_row(sq_store *s, const char *what, const char *sql, const sq_val *a, int n, svc_token *out,
+                     rs_err *err)
+{
+    sq_res r;
+    if (run(s, what, sql, a, n, &r, err) < 0)
+        return -1;
+    int rc = r.rows > 0;
+    if (rc && out)
+        token_from(&r, 0, out);
+    res_free(s, &r);
+    return rc;
+}
+
+static int sq_token_add(svc_store *bs, svc_token *t, const char *hash, rs_err *err)
+{
+    sq_store *s = S(bs);
+    int64_t now;
+    int rc = -1;
+    pthread_mutex_lock(&s->mu);
+    if (!tx_begin(s, &now, err))
+        goto out;
+    int taken = token_row(s, "look for the name", "SELECT " TOKEN_COLS " FROM tokens WHERE name = ?1@LOCK",
+                          ARGS(T(t->name)), NULL, err);
+    sq_res r = {0};
+    bool ok = taken >= 0;
+    if (ok && !taken)
+        ok = run(s, "add the token",
+                 "INSERT INTO tokens (name, hash, is_operator, max_queued, seconds_per_hour, created)"
+                 " VALUES (?1, ?2, ?3, ?4, ?5, ?6) RETURNING id",
+                 ARGS(T(t->name), T(hash), I(t->is_operator), I(t->max_queued), I(t->seconds_per_hour), I(now)), &r,
+                 err) >= 0 &&
+             r.rows == 1;
+    if (ok && !taken) {
+        t->id = v_int(&r, 0, 0);
+        t->created = now;
+        t->revoked = t->last_used = 0;
+    }
+    res_free(s, &r);
+    rc = tx_end(s, ok, !taken, err);
+out:
+    pthread_mutex_unlock(&s->mu);
+    return rc;
+}
+
+static int sq_token_list(svc_store *bs, svc_token *out, int max, rs_err *err)
+{
+    sq_store *s = S(bs);
+    if (max <= 0)
+        return 0;
+    sq_res r;
+    pthread_mutex_lock(&s->mu);
+    int n = (int)run(s, "list the tokens", "SELECT " TOKEN_COLS " FROM tokens ORDER BY id LIMIT ?1", ARGS(I(max)), &r,
+                     err);
+    if (n >= 0) {
+        n = r.rows < max ? r.rows : max;
+        for (int i = 0; i < n; i++)
+            token_from(&r, i, &out[i]);
+        res_free(s, &r);
+    }
+    pthread_mutex_unlock(&s->mu);
+    return n < 0 ? -1 : n;
+}
+
+static int sq_token_revoke(svc_store *bs, const char *which, svc_token *out, rs_err *err)
+{
+    sq_store *s = S(bs);
+    int64_t now;
+    int rc = -1;
+    /* a name first: "7" may be a token's name as well as another's id */
+    char *end;
+    long long id = strtoll(which, &end, 10);
+    if (*end || end == which)
+        id = -1;
+    pthread_mutex_lock(&s->mu);
+    if (!tx_begin(s, &now, err))
+        goto out;
+    int have = token_row(s, "find the token", "SELECT " TOKEN_COLS " FROM tokens WHERE name = ?1@LOCK",
+                         ARGS(T(which)), out, err);
+    if (have == 0)
+        have = token_row(s, "find the token", "SELECT " TOKEN_COLS " FROM tokens WHERE id = ?1@LOCK", ARGS(I(id)), out,
+                         err);
+    bool ok = have >= 0, already = have > 0 && out->revoked != 0;
+    if (ok && have && !already) {
+        ok = run(s, "revoke the token", "UPDATE tokens SET revoked = ?2 WHERE id = ?1", ARGS(I(out->id), I(now)), NULL,
+                 err) >= 0;
+        out->revoked = now;
+    }
+    rc = tx_end(s, ok, !have ? 0 : already ? 2 : 1, err);
+out:
+    pthread_mutex_unlock(&s->mu);
+    return rc;
+}
+
+static int sq_token_find(svc_store *bs, const char *hash, svc_token *out, rs_err *err)
+{
+    sq_store *s = S(bs);
+    pthread_mutex_lock(&s->mu);
+    int rc = token_row(s, "find the token", "SELECT " TOKEN_COLS " FROM tokens WHERE hash = ?1", ARGS(T(hash)), out,
+                       err);
+    /* last_used to the minute: a write per request would cost a commit each */
+    if (rc == 1 && !out->revoked &&
+        run(s, "note the token's use", "UPDATE tokens SET last_used = @NOW WHERE id = ?1 AND last_used < @NOW - 60",
+            ARGS(I(out->id)), NULL, err) < 0)
+        rc = -1;
+    pthread_mutex_unlock(&s->mu);
+    return rc;
+}
+
+static int64_t sq_token_active(svc_store *bs, rs_err *err)
+{
+    sq_store *s = S(bs);
+    sq_res r;
+    pthread_mutex_lock(&s->mu);
+    int64_t n = run(s, "count the tokens", "SELECT COUNT(*) FROM tokens WHERE revoked = 0", NOARGS, &r, err);
+    if (n >= 0) {
+        n = r.rows == 1 ? v_int(&r, 0, 0) : 0;
+        res_free(s, &r);
+    }
+    pthread_mutex_unlock(&s->mu);
+    return n;
+}
+
+static bool sq_token_usage(svc_store *bs, int64_t token_id, svc_usage *out, rs_err *err)
+{
+    sq_store *s = S(bs);
+    sq_res r;
+    pthread_mutex_lock(&s->mu);
+    bool ok = run(s, "measure the token's use",
+                  "SELECT (SELECT COUNT(*) FROM jobs WHERE token_id = ?1 AND state IN (0, 1)),"
+                  " (SELECT CAST(COALESCE(SUM(frames_total), 0) AS BIGINT) FROM jobs"
+                  "   WHERE token_id = ?1 AND created > @NOW - 3600),"
+                  " (SELECT COALESCE(MIN(created), 0) FROM jobs WHERE token_id = ?1 AND created > @NOW - 3600), @NOW",
+                  ARGS(I(token_id)), &r, err) >= 0 &&
+              r.rows == 1;
+    if (ok)
+        *out = (svc_usage){.active = v_int(&r, 0, 0), .hour_frames = v_int(&r, 0, 1), .oldest = v_int(&r, 0, 2),
+                           .now = v_int(&r, 0, 3)};
+    res_free(s, &r);
+    pthread_mutex_unlock(&s->mu);
+    return ok;
+}
+
 static void sq_close(svc_store *bs)
 {
     sq_store *s = S(bs);
@@ -814,6 +982,12 @@ static const svc_store_ops sq_ops = {
     .expire = sq_expire,
     .remove = sq_remove,
     .counts = sq_counts,
+    .token_add = sq_token_add,
+    .token_list = sq_token_list,
+    .token_revoke = sq_token_revoke,
+    .token_find = sq_token_find,
+    .token_active = sq_token_active,
+    .token_usage = sq_token_usage,
     .close = sq_close,
 };
 
@@ -888,6 +1062,23 @@ bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_er
             return false;
     }
     return true;
+}
+
+bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool migrate, rs_err *err)
+{
+    char sql[1024];
+    snprintf(sql, sizeof sql,
+             "CREATE TABLE IF NOT EXISTS tokens ("
+             " id %s, name TEXT NOT NULL UNIQUE, hash TEXT NOT NULL UNIQUE,"
+             " is_operator INTEGER NOT NULL DEFAULT 0, max_queued INTEGER NOT NULL DEFAULT 0,"
+             " seconds_per_hour INTEGER NOT NULL DEFAULT 0, created BIGINT NOT NULL DEFAULT 0,"
+             " revoked BIGINT NOT NULL DEFAULT 0, last_used BIGINT NOT NULL DEFAULT 0)",
+             serial);
+    return (!migrate || drv->exec(c, "add a column to jobs", "ALTER TABLE jobs ADD COLUMN token_id BIGINT NOT NULL DEFAULT 0",
+                                  NULL, 0, NULL, err) >= 0) &&
+           drv->exec(c, "create the tokens table", sql, NULL, 0, NULL, err) >= 0 &&
+           drv->exec(c, "create the jobs' token index", "CREATE INDEX IF NOT EXISTS jobs_token ON jobs (token_id, created)",
+                     NULL, 0, NULL, err) >= 0;
 }
 
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar)

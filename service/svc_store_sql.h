@@ -69,6 +69,10 @@ bool sq_schema_units(const sq_driver *drv, void *c, bool migrate, rs_err *err);
  * statements stay as they were).  has_column is the driver's query
  * for "how many columns named ?2 has table ?1" (0 or 1). */
 bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_err *err);
+/* The tokens table (its id column as serial says: each backend spells an
+ * auto-numbered key its own way) and the jobs' token index; migrate true
+ * adds jobs.token_id to a queue made before tokens existed. */
+bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool migrate, rs_err *err);
 
 /* sql with @NOW, @LOCK and @SKIP spelt the driver's way, and with dollar
  * true ?N as $N (PostgreSQL).  False when out is too small. */

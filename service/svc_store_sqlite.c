@@ -39,7 +39,8 @@ static const char schema[] =
     " created INTEGER NOT NULL DEFAULT 0, started INTEGER NOT NULL DEFAULT 0, finished INTEGER NOT NULL DEFAULT 0,"
     " claimed_until INTEGER NOT NULL DEFAULT 0,"
     " replay BLOB NOT NULL,"
-    " segment_ticks INTEGER NOT NULL DEFAULT 0, segments INTEGER NOT NULL DEFAULT 0, seg_key TEXT NOT NULL DEFAULT '');"
+    " segment_ticks INTEGER NOT NULL DEFAULT 0, segments INTEGER NOT NULL DEFAULT 0, seg_key TEXT NOT NULL DEFAULT '',"
+    " token_id INTEGER NOT NULL DEFAULT 0);"
     "CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, id);";
 
 /* BUSY when another connection held the lock past the busy timeout; OPEN
@@ -220,6 +221,18 @@ static const sq_driver sqlite_driver = {
     .close = d_close,
 };
 
+/* The tokens table, and jobs.token_id in a queue made before tokens. */
+static bool schema_tokens(sq_conn *c, rs_err *err)
+{
+    sq_res r = {0};
+    if (d_exec(c, "look at the jobs table", "SELECT COUNT(*) FROM pragma_table_info('jobs') WHERE name = 'token_id'",
+               NULL, 0, &r, err) < 0)
+        return false;
+    bool migrate = r.rows == 1 && r.v[0].i == 0;
+    d_res_free(&r);
+    return sq_schema_tokens(&sqlite_driver, c, "INTEGER PRIMARY KEY AUTOINCREMENT", migrate, err);
+}
+
 /* The schema, made or brought up to date in one transaction. */
 static bool make_schema(sq_conn *c, rs_err *err)
 {
@@ -240,7 +253,7 @@ static bool make_schema(sq_conn *c, rs_err *err)
     }
     ok = ok && sq_schema_units(&sqlite_driver, c, migrate, err) &&
          sq_schema_lost(&sqlite_driver, c, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2", err) &&
-         exec_plain(c, "COMMIT", err);
+         schema_tokens(c, err) && exec_plain(c, "COMMIT", err);
     if (!ok)
         d_rollback(c);
     return ok;
@@ -266,7 +279,7 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
     sq_res r = {0};
     if (d_exec(c, "look at the tables",
                "SELECT COUNT(*) FROM sqlite_master WHERE name NOT LIKE 'sqlite_%'"
-               " AND name NOT IN ('jobs', 'jobs_state', 'units', 'units_state')",
+               " AND name NOT IN ('jobs', 'jobs_state', 'jobs_token', 'units', 'units_state', 'tokens')",
                NULL, 0, &r, err) < 0)
         goto fail;
     int64_t foreign = r.rows == 1 ? r.v[0].i : -1;

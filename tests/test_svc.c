@@ -13,6 +13,7 @@
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
+#include "../service/svc_auth.h"
 #include "../service/svc_config.h"
 #include "../service/svc_json.h"
 #include "../service/svc_local.h"
@@ -880,7 +881,7 @@ static void t_http_status_table(void)
         {SVC_ERR_EMPTY, 400},    {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
         {SVC_ERR_BAD_BODY, 400}, {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
         {SVC_ERR_GONE, 410},     {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
-        {SVC_ERR_NOMEM, 500},
+        {SVC_ERR_AUTH, 401},     {SVC_ERR_QUOTA, 429},     {SVC_ERR_NOMEM, 500},
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
@@ -894,7 +895,66 @@ static void t_http_status_table(void)
     T_EQ(svc_http_status(RP_ERR_FIELD), 500);
 }
 
-T_MAIN({"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
+/* SHA-256 against FIPS 180-4's examples (one block, two blocks, a million
+ * bytes) and the padding edges; tokens, Bearer headers, loopback. */
+static void t_sha256_known_answers(void)
+{
+    static const struct {
+        const char *msg;
+        const char *hex;
+    } kat[] = {
+        {"", "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"},
+        {"abc", "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"},
+        {"abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq",
+         "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"},
+    };
+    char hex[65];
+    uint8_t h[32];
+    for (size_t i = 0; i < sizeof kat / sizeof kat[0]; i++) {
+        svc_token_hash(kat[i].msg, hex);
+        T_ASSERTF(!strcmp(hex, kat[i].hex), "sha256(\"%s\") = %s", kat[i].msg, hex);
+    }
+    char *a = malloc(1000000);
+    T_ASSERT(a);
+    memset(a, 'a', 1000000);
+    svc_sha256(a, 1000000, h);
+    free(a);
+    static const uint8_t million[32] = {0xcd, 0xc7, 0x6e, 0x5c, 0x99, 0x14, 0xfb, 0x92, 0x81, 0xa1, 0xc7,
+                                        0xe2, 0x84, 0xd7, 0x3e, 0x67, 0xf1, 0x80, 0x9a, 0x48, 0xa4, 0x97,
+                                        0x20, 0x0e, 0x04, 0x6d, 0x39, 0xcc, 0xc7, 0x11, 0x2c, 0xd0};
+    T_ASSERT(!memcmp(h, million, 32));
+    /* 55 and 56 bytes: the length fits in the last block, or needs another */
+    char m[57];
+    memset(m, 'a', sizeof m);
+    m[55] = 0;
+    svc_token_hash(m, hex);
+    T_ASSERT(!strcmp(hex, "9f4390f8d30c2dd92ec9f095b65e2b9ae9b0a925a5258e241c9f1e910f734318"));
+    m[55] = 'a', m[56] = 0;
+    svc_token_hash(m, hex);
+    T_ASSERT(!strcmp(hex, "b35439a4ac6f0948b6d6f9e3c6af0f5f590ce20f1bde7090ef7970686ec6738a"));
+}
+
+static void t_tokens_and_bearer(void)
+{
+    char a[SVC_TOKEN_LEN + 1], b[SVC_TOKEN_LEN + 1];
+    rs_err e = {0};
+    T_ASSERT(svc_token_make(a, &e) && svc_token_make(b, &e));
+    T_EQ(strlen(a), SVC_TOKEN_LEN);
+    T_ASSERT(!strncmp(a, "rs_", 3) && strcmp(a, b) != 0);
+    T_ASSERT(strspn(a + 3, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_") == 43);
+    size_t n = 0;
+    const char *t = svc_bearer("  bearer   rs_abc  ", &n);
+    T_ASSERT(t && n == 6 && !strncmp(t, "rs_abc", 6));
+    T_ASSERT(!svc_bearer("Basic YTpi", &n) && !svc_bearer("Bearerrs_x", &n) && !svc_bearer(NULL, &n));
+    T_ASSERT(svc_listen_is_loopback("127.0.0.1:8080") && svc_listen_is_loopback("127.9.8.7:0"));
+    T_ASSERT(svc_listen_is_loopback("[::1]:80") && svc_listen_is_loopback("localhost:1"));
+    T_ASSERT(!svc_listen_is_loopback("0.0.0.0:8080") && !svc_listen_is_loopback(":8080"));
+    T_ASSERT(!svc_listen_is_loopback("[::]:80") && !svc_listen_is_loopback("127.0.0.1.evil:80"));
+    T_ASSERT(!svc_listen_is_loopback("10.0.0.1:80") && !svc_listen_is_loopback("1270.0.0.1:80"));
+}
+
+T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t_tokens_and_bearer},
+       {"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
        {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
        {"config_load_errors", t_config_load_errors}, {"config_finish", t_config_finish},
        {"config_dump_roundtrip", t_config_dump_roundtrip}, {"config_dump_hash", t_config_dump_hash},

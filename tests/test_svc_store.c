@@ -146,6 +146,63 @@ static void fill_random(uint8_t *p, size_t n, uint64_t seed)
     }
 }
 
+/* API tokens: add (names unique, revoked ones too), find by hash, revoke
+ * by name or id, the active count, a token's jobs and its usage. */
+static void tokens(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    T_EQ(s->ops->token_active(s, &e), 0);
+    svc_token a = {.max_queued = 3, .seconds_per_hour = 60}, b = {.is_operator = true}, got;
+    snprintf(a.name, sizeof a.name, "alice");
+    snprintf(b.name, sizeof b.name, "ops");
+    T_EQ(s->ops->token_add(s, &a, "hash-a", &e), 1);
+    T_EQ(s->ops->token_add(s, &b, "hash-b", &e), 1);
+    T_ASSERT(a.id > 0 && b.id > a.id && a.created > 0);
+    svc_token dup = {0};
+    snprintf(dup.name, sizeof dup.name, "alice");
+    T_EQ(s->ops->token_add(s, &dup, "hash-c", &e), 0);
+    T_EQ(s->ops->token_active(s, &e), 2);
+    T_EQ(s->ops->token_find(s, "hash-a", &got, &e), 1);
+    T_ASSERT(got.id == a.id && !strcmp(got.name, "alice") && !got.is_operator && got.max_queued == 3 &&
+             got.seconds_per_hour == 60 && got.revoked == 0);
+    T_EQ(s->ops->token_find(s, "nope", &got, &e), 0);
+    svc_token list[4];
+    T_EQ(s->ops->token_list(s, list, 4, &e), 2);
+    T_ASSERT(list[0].id == a.id && list[1].is_operator && list[0].last_used > 0 && list[1].last_used == 0);
+    /* a job of alice's, one of nobody's */
+    svc_job j = {.width = 64, .height = 36, .frames_total = 600, .replay = (uint8_t *)"x", .replay_len = 1,
+                 .token_id = a.id};
+    snprintf(j.format, sizeof j.format, "mp4");
+    T_ASSERT(s->ops->submit(s, &j, &e));
+    int64_t mine = j.id;
+    submit(s, "anon.rsr", "y", 1);
+    T_EQ(get_ok(s, mine).token_id, a.id);
+    svc_job out[4];
+    T_EQ(s->ops->list(s, a.id, 0, 4, out, &e), 1);
+    T_EQ(out[0].id, mine);
+    T_EQ(s->ops->list(s, b.id, 0, 4, out, &e), 0);
+    T_EQ(s->ops->list(s, 0, 0, 4, out, &e), 2);
+    svc_usage u;
+    T_ASSERT(s->ops->token_usage(s, a.id, &u, &e));
+    T_ASSERT(u.active == 1 && u.hour_frames == 600 && u.oldest > 0 && u.oldest <= u.now);
+    T_EQ(s->ops->cancel(s, mine, &e), 1);
+    T_ASSERT(s->ops->token_usage(s, a.id, &u, &e));
+    T_ASSERT(u.active == 0 && u.hour_frames == 600); /* the hour counts what was submitted */
+    /* revoke by name, then by id; twice is "already" */
+    T_EQ(s->ops->token_revoke(s, "alice", &got, &e), 1);
+    T_ASSERT(got.id == a.id && got.revoked > 0);
+    T_EQ(s->ops->token_revoke(s, "alice", &got, &e), 2);
+    char id[32];
+    snprintf(id, sizeof id, "%lld", (long long)b.id);
+    T_EQ(s->ops->token_revoke(s, id, &got, &e), 1);
+    T_EQ(s->ops->token_revoke(s, "nobody", &got, &e), 0);
+    T_EQ(s->ops->token_active(s, &e), 0);
+    T_EQ(s->ops->token_find(s, "hash-a", &got, &e), 1);
+    T_ASSERT(got.revoked > 0);
+    s->ops->close(s);
+}
+
 /* --- the contract, once for both backends --- */
 
 static void roundtrip(const char *spec)
@@ -503,27 +560,27 @@ static void list_paging(const char *spec)
     svc_store *s = open_ok(spec);
     rs_err e = {0};
     svc_job out[8];
-    T_EQ(s->ops->list(s, 0, 8, out, &e), 0);
+    T_EQ(s->ops->list(s, 0, 0, 8, out, &e), 0);
     int64_t id[5];
     for (int i = 0; i < 5; i++) {
         char name[16];
         snprintf(name, sizeof name, "j%d", i);
         id[i] = submit(s, name, "x", 1);
     }
-    T_EQ(s->ops->list(s, 0, 2, out, &e), 2);
+    T_EQ(s->ops->list(s, 0, 0, 2, out, &e), 2);
     T_EQ(out[0].id, id[4]);
     T_EQ(out[1].id, id[3]);
     T_ASSERT(!strcmp(out[0].name, "j4") && out[0].replay == NULL);
-    T_EQ(s->ops->list(s, out[1].id, 2, out, &e), 2);
+    T_EQ(s->ops->list(s, 0, out[1].id, 2, out, &e), 2);
     T_EQ(out[0].id, id[2]);
     T_EQ(out[1].id, id[1]);
-    T_EQ(s->ops->list(s, out[1].id, 8, out, &e), 1);
+    T_EQ(s->ops->list(s, 0, out[1].id, 8, out, &e), 1);
     T_EQ(out[0].id, id[0]);
-    T_EQ(s->ops->list(s, id[0], 8, out, &e), 0);
-    T_EQ(s->ops->list(s, 0, 8, out, &e), 5);
+    T_EQ(s->ops->list(s, 0, id[0], 8, out, &e), 0);
+    T_EQ(s->ops->list(s, 0, 0, 8, out, &e), 5);
     for (int i = 0; i < 5; i++)
         T_EQ(out[i].id, id[4 - i]);
-    T_EQ(s->ops->list(s, 0, 0, out, &e), 0);
+    T_EQ(s->ops->list(s, 0, 0, 0, out, &e), 0);
     s->ops->close(s);
 }
 
@@ -1142,6 +1199,7 @@ static void migrate_v1(const char *spec, void (*sql)(const char *spec, const cha
     T_EQ(s->ops->finish(s, 3, "new:2", SVC_DONE, NULL, -1, 60, &e), 1);
     T_EQ(get_ok(s, 3).state, SVC_DONE);
     T_EQ(get_ok(s, 1).state, SVC_DONE);
+    T_EQ(get_ok(s, 3).token_id, 0); /* jobs from before tokens were made without one */
     s->ops->close(s);
     s = open_ok(spec); /* and again: nothing more to migrate */
     T_EQ(units_of(s, 3, u, 2), 1);
@@ -1261,6 +1319,7 @@ BOTH(split_cancel_and_desync)
 BOTH(split_reap_resumes)
 BOTH(split_rejoin)
 BOTH(split_concurrent)
+BOTH(tokens)
 
 /* --- what each backend refuses, and how it says so --- */
 
@@ -1398,6 +1457,7 @@ T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), 
        CASES(dead_letter), CASES(give_back), CASES(reap), CASES(list_paging), CASES(counts), CASES(persistence),
        CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), CASES(split_plan), CASES(split_run),
        CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin),
-       CASES(split_concurrent), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove), {"sqlite_bad_files", t_sqlite_bad_files},
+        CASES(split_concurrent), CASES(tokens), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove),
+        {"sqlite_bad_files", t_sqlite_bad_files},
        {"pg_unreachable", t_pg_unreachable}, {"pg_foreign_table", t_pg_foreign_table},
        {"pg_reconnect", t_pg_reconnect}, {"error_ids_have_texts", t_error_ids_have_texts})
