@@ -110,7 +110,7 @@ static void job_from(const sq_res *r, int row, svc_job *j)
 }
 
 /* get and list read token_id after SQ_JOB_COLS (the claim does not need it) */
-#define TOKEN_COL 20
+#define TOKEN_COL 22 /* SQ_JOB_COLS has 22 columns */
 
 static void unit_from(const sq_res *r, int row, svc_unit *u)
 {
