@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -49,7 +50,8 @@ static const struct {
     {SVC_ERR_EMPTY, 400},     {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
     {SVC_ERR_BAD_BODY, 400},  {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
     {SVC_ERR_GONE, 410},      {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
-    {SVC_ERR_NOMEM, 500},     {SVC_ERR_AUTH, 401},      {SVC_ERR_QUOTA, 429},
+    {SVC_ERR_NOMEM, 500},     {SVC_ERR_AUTH, 401},      {SVC_ERR_QUOTA, 429},     {SVC_ERR_BAD_REQUEST, 400},
+    {SVC_ERR_HOST, 421},      {SVC_ERR_ORIGIN, 403},    {SVC_ERR_CODING, 501},    {SVC_ERR_BUSY, 503},
 };
 
 unsigned svc_http_status(int code)
@@ -138,10 +140,205 @@ int svc_parse_range(const char *h, uint64_t len, uint64_t *first, uint64_t *last
 
 #if defined(RS_HAVE_MHD)
 #include <microhttpd.h>
+#include <netdb.h>
+#include <pthread.h>
+#include <sys/socket.h>
+#include <time.h>
+
+/* --- the network's guards: connections, their deadlines, the upload budget ---
+ *
+ * DESIGN: libmicrohttpd's own timeout is an idle timeout (any byte resets
+ * it), so a client trickling a header line every few seconds holds its
+ * connection forever.  Every connection is recorded here when libmicrohttpd
+ * opens it (MHD_OPTION_NOTIFY_CONNECTION) with the phase it is in; a reaper
+ * thread looks at them once a second and shuts down (never closes: the fd is
+ * libmicrohttpd's) a connection whose headers took longer than
+ * header_timeout or whose upload averages less than min_body_rate.  The
+ * table's mutex is held across shutdown(), and libmicrohttpd reports a
+ * connection closed before it closes the fd, so the reaper never touches an
+ * fd that has been reused. */
+enum { NET_HEADERS, NET_BODY, NET_ANSWER }; /* a connection's phase */
+enum { CUT_HEADER_TIMEOUT, CUT_BODY_RATE, CUT_MAX_UPLOAD, NET_NCUTS };
+static const char *const cut_name[NET_NCUTS] = {"header_timeout", "min_body_rate", "max_upload"};
+
+typedef struct net_conn {
+    struct net_conn *prev, *next;
+    int fd;
+    char ip[64];
+    int phase;
+    double since;   /* when the phase began (monotonic seconds) */
+    uint64_t body;  /* bytes of the request body read in this phase */
+    bool cut;       /* shut down by the reaper */
+    char cors[256]; /* the Origin to answer with CORS headers ("" none) */
+    bool vary;      /* answers depend on Origin (cors_origins is set) */
+} net_conn;
+
+struct svc_net {
+    svc_daemon *d;
+    pthread_mutex_t mu; /* guards everything below */
+    net_conn *conns;
+    long open;
+    uint64_t cuts[NET_NCUTS];
+    long reserved;      /* upload bytes promised to requests in progress */
+    bool stop;
+    pthread_cond_t wake;
+    pthread_t reaper;
+    bool reaper_started;
+    char hosts[1024];   /* accepted Host names, comma-separated, lower case */
+};
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec / 1e9;
+}
+
+static net_conn *conn_of(struct MHD_Connection *c)
+{
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    return ci ? ci->socket_context : NULL;
+}
+
+/* A connection enters a phase: its deadline starts over. */
+static void conn_phase(svc_net *n, struct MHD_Connection *c, int phase)
+{
+    net_conn *nc = conn_of(c);
+    if (!nc)
+        return;
+    pthread_mutex_lock(&n->mu);
+    nc->phase = phase;
+    nc->since = now_s();
+    nc->body = 0;
+    pthread_mutex_unlock(&n->mu);
+}
+
+/* Body bytes read: what min_body_rate is measured on. */
+static void conn_body(svc_net *n, struct MHD_Connection *c, size_t bytes)
+{
+    net_conn *nc = conn_of(c);
+    if (!nc)
+        return;
+    pthread_mutex_lock(&n->mu);
+    nc->body += bytes;
+    pthread_mutex_unlock(&n->mu);
+}
+
+static void on_connection(void *cls, struct MHD_Connection *c, void **socket_context, enum MHD_ConnectionNotificationCode code)
+{
+    svc_net *n = cls;
+    net_conn *nc = *socket_context;
+    if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
+        if (!nc)
+            return;
+        pthread_mutex_lock(&n->mu);
+        if (nc->prev)
+            nc->prev->next = nc->next;
+        else
+            n->conns = nc->next;
+        if (nc->next)
+            nc->next->prev = nc->prev;
+        n->open--;
+        pthread_mutex_unlock(&n->mu);
+        free(nc);
+        *socket_context = NULL;
+        return;
+    }
+    const union MHD_ConnectionInfo *fd = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (!fd || !(nc = calloc(1, sizeof *nc)))
+        return; /* not watched: libmicrohttpd's idle timeout still applies */
+    nc->fd = fd->connect_fd;
+    const union MHD_ConnectionInfo *ad = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+    if (!ad || getnameinfo(ad->client_addr, ad->client_addr->sa_family == AF_INET6 ? sizeof(struct sockaddr_in6)
+                                                                                   : sizeof(struct sockaddr_in),
+                           nc->ip, sizeof nc->ip, NULL, 0, NI_NUMERICHOST) != 0)
+        snprintf(nc->ip, sizeof nc->ip, "?");
+    nc->phase = NET_HEADERS;
+    nc->since = now_s();
+    pthread_mutex_lock(&n->mu);
+    nc->next = n->conns;
+    if (n->conns)
+        n->conns->prev = nc;
+    n->conns = nc;
+    n->open++;
+    pthread_mutex_unlock(&n->mu);
+    *socket_context = nc;
+}
+
+/* Ends a connection for a reason (the table's mutex held): the peer sees
+ * the connection end; libmicrohttpd sees an error on it and closes it. */
+static void conn_cut(svc_net *n, net_conn *nc, int why, double age)
+{
+    shutdown(nc->fd, SHUT_RDWR);
+    nc->cut = true;
+    n->cuts[why]++;
+    svc_log(SVC_LOG_DEBUG, -1, "http: connection from %s cut after %.1f s: %s (%" PRIu64 " body bytes)", nc->ip, age,
+            cut_name[why], nc->body);
+}
+
+static void *reaper(void *arg)
+{
+    svc_net *n = arg;
+    const svc_config *cfg = &n->d->cfg;
+    pthread_mutex_lock(&n->mu);
+    while (!n->stop) {
+        double t = now_s();
+        for (net_conn *nc = n->conns; nc; nc = nc->next) {
+            double age = t - nc->since;
+            if (nc->cut || age <= cfg->header_timeout)
+                continue;
+            if (nc->phase == NET_HEADERS)
+                conn_cut(n, nc, CUT_HEADER_TIMEOUT, age);
+            else if (nc->phase == NET_BODY && (double)nc->body < (double)cfg->min_body_rate * age)
+                conn_cut(n, nc, CUT_BODY_RATE, age);
+        }
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        until.tv_sec += 1;
+        pthread_cond_timedwait(&n->wake, &n->mu, &until);
+    }
+    pthread_mutex_unlock(&n->mu);
+    return NULL;
+}
+
+/* Every answer goes out through here: the CORS headers of the request's
+ * connection are added to it. */
+static enum MHD_Result queue(struct MHD_Connection *c, unsigned status, struct MHD_Response *r)
+{
+    net_conn *nc = conn_of(c);
+    if (nc && nc->cors[0]) {
+        MHD_add_response_header(r, "Access-Control-Allow-Origin", nc->cors);
+        MHD_add_response_header(r, "Access-Control-Expose-Headers", "Location, Retry-After");
+    }
+    if (nc && nc->vary)
+        MHD_add_response_header(r, "Vary", "Origin");
+    return MHD_queue_response(c, status, r);
+}
+
+static void net_metrics(svc_net *n, svc_buf *b)
+{
+    pthread_mutex_lock(&n->mu);
+    long open = n->open, reserved = n->reserved;
+    uint64_t cuts[NET_NCUTS];
+    memcpy(cuts, n->cuts, sizeof cuts);
+    pthread_mutex_unlock(&n->mu);
+    svc_buf_printf(b, "# HELP ringside_http_connections HTTP connections open now.\n"
+                      "# TYPE ringside_http_connections gauge\nringside_http_connections %ld\n"
+                      "# HELP ringside_http_upload_bytes_reserved Bytes of upload_memory held by uploads in progress.\n"
+                      "# TYPE ringside_http_upload_bytes_reserved gauge\nringside_http_upload_bytes_reserved %ld\n"
+                      "# HELP ringside_http_connections_cut_total Connections ended by the daemon, by reason.\n"
+                      "# TYPE ringside_http_connections_cut_total counter\n",
+                   open, reserved);
+    for (int i = 0; i < NET_NCUTS; i++)
+        svc_buf_printf(b, "ringside_http_connections_cut_total{reason=\"%s\"} %" PRIu64 "\n", cut_name[i], cuts[i]);
+}
 
 typedef struct req {
+    bool started;       /* the first call (headers only) is over */
     bool post_jobs;
     bool done;          /* a response was queued early (413, 503) */
+    uint64_t received;  /* body bytes read */
+    long reserved;      /* bytes of upload_memory held for it */
     struct MHD_PostProcessor *pp;
     uint8_t *body;
     size_t len, cap;
@@ -162,7 +359,7 @@ static enum MHD_Result reply(struct MHD_Connection *c, unsigned status, const ch
         return MHD_NO;
     MHD_add_response_header(r, "Content-Type", type);
     MHD_add_response_header(r, "Cache-Control", "no-store");
-    enum MHD_Result ret = MHD_queue_response(c, status, r);
+    enum MHD_Result ret = queue(c, status, r);
     MHD_destroy_response(r);
     return ret;
 }
@@ -213,7 +410,7 @@ static enum MHD_Result reply_error_header(struct MHD_Connection *c, int id, cons
     MHD_add_response_header(r, "Content-Type", "application/json");
     MHD_add_response_header(r, "Cache-Control", "no-store");
     MHD_add_response_header(r, header, value);
-    enum MHD_Result ret = MHD_queue_response(c, svc_http_status(id), r);
+    enum MHD_Result ret = queue(c, svc_http_status(id), r);
     MHD_destroy_response(r);
     return ret;
 }
@@ -289,6 +486,7 @@ typedef struct pp_ctx {
 typedef struct conn_ctx {
     req q;
     pp_ctx pc;
+    bool bad_uri; /* a control character in the raw path or query */
 } conn_ctx;
 
 static bool parse_id(const char *s, size_t n, int64_t *id)
@@ -442,7 +640,7 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
     snprintf(loc, sizeof loc, "/jobs/%" PRId64, j.id);
     MHD_add_response_header(r, "Content-Type", "application/json");
     MHD_add_response_header(r, "Location", loc);
-    enum MHD_Result ret = MHD_queue_response(c, 201, r);
+    enum MHD_Result ret = queue(c, 201, r);
     MHD_destroy_response(r);
     return ret;
 }
@@ -642,7 +840,7 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, const re
         char cr[64];
         snprintf(cr, sizeof cr, "bytes */%" PRIu64, len);
         MHD_add_response_header(resp, "Content-Range", cr);
-        enum MHD_Result ret = MHD_queue_response(c, svc_http_status(SVC_ERR_RANGE), resp);
+        enum MHD_Result ret = queue(c, svc_http_status(SVC_ERR_RANGE), resp);
         MHD_destroy_response(resp);
         return ret;
     }
@@ -667,7 +865,7 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, const re
         snprintf(cr, sizeof cr, "bytes %" PRIu64 "-%" PRIu64 "/%" PRIu64, first, last, len);
         MHD_add_response_header(resp, "Content-Range", cr);
     }
-    enum MHD_Result ret = MHD_queue_response(c, rr > 0 ? 206 : 200, resp);
+    enum MHD_Result ret = queue(c, rr > 0 ? 206 : 200, resp);
     MHD_destroy_response(resp);
     return ret;
 }
@@ -744,6 +942,7 @@ static enum MHD_Result do_metrics(svc_daemon *d, struct MHD_Connection *c)
                    "# HELP ringside_uploads_rejected_total Uploads refused (bad, too large).\n"
                    "# TYPE ringside_uploads_rejected_total counter\nringside_uploads_rejected_total %" PRIu64 "\n",
                    frames, fps, d->cfg.workers, busy, done, failed, retried, crashes, wd, rejected);
+    net_metrics(d->net, &b);
     if (b.oom)
         return MHD_NO;
     enum MHD_Result r = reply(c, 200, "text/plain; version=0.0.4", b.p, b.len);
@@ -853,21 +1052,329 @@ static bool authorize(svc_daemon *d, struct MHD_Connection *c, const char *url, 
     return true;
 }
 
+
+/* --- the gate: what every request must pass before it is routed --- */
+
+/* A refusal at the gate, with an optional extra header. */
+static enum MHD_Result refuse(struct MHD_Connection *c, int id, const char *header, const char *value, const char *fmt,
+                              ...) RS_PRINTF(5, 6);
+static enum MHD_Result refuse(struct MHD_Connection *c, int id, const char *header, const char *value, const char *fmt,
+                              ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    svc_log(SVC_LOG_INFO, -1, "request refused (%u): %s", svc_http_status(id), msg);
+    svc_buf b = {0};
+    svc_json_error(&b, msg);
+    struct MHD_Response *r = b.oom ? NULL : MHD_create_response_from_buffer(b.len, b.p, MHD_RESPMEM_MUST_COPY);
+    svc_buf_free(&b);
+    if (!r)
+        return MHD_NO;
+    MHD_add_response_header(r, "Content-Type", "application/json");
+    MHD_add_response_header(r, "Cache-Control", "no-store");
+    if (header)
+        MHD_add_response_header(r, header, value);
+    enum MHD_Result ret = queue(c, svc_http_status(id), r);
+    MHD_destroy_response(r);
+    return ret;
+}
+
+/* The host of a Host header or an allowed_hosts entry, lower case, without
+ * its port or IPv6 brackets ("[::1]:8080" -> "::1"); false if empty or too long. */
+static bool host_part(const char *in, size_t in_len, char *out, size_t n)
+{
+    const char *s = in;
+    size_t len = in_len;
+    if (len && *s == '[') {
+        const char *e = memchr(s, ']', len);
+        if (!e)
+            return false;
+        s++;
+        len = (size_t)(e - s);
+    } else {
+        const char *colon = memchr(s, ':', len);
+        if (colon && !memchr(colon + 1, ':', len - (size_t)(colon + 1 - s))) /* host:port, not a bare IPv6 */
+            len = (size_t)(colon - s);
+    }
+    if (len == 0 || len >= n)
+        return false;
+    for (size_t i = 0; i < len; i++)
+        out[i] = (char)tolower((unsigned char)s[i]);
+    out[len] = 0;
+    return true;
+}
+
+/* Whether NAME is one of the comma-separated items of LIST (spaces around
+ * items ignored, case-insensitive). */
+static bool in_list(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    for (const char *p = list; *p;) {
+        while (*p == ' ' || *p == ',')
+            p++;
+        const char *e = p;
+        while (*e && *e != ',')
+            e++;
+        const char *t = e;
+        while (t > p && t[-1] == ' ')
+            t--;
+        if ((size_t)(t - p) == n && n && !strncasecmp(p, name, n))
+            return true;
+        p = e;
+    }
+    return false;
+}
+
+/* The Host names accepted when allowed_hosts is empty: the listen host,
+ * the loopback names and, listening on every address, this machine's name. */
+static void default_hosts(svc_net *n)
+{
+    char lh[128] = "";
+    const char *listen = n->d->cfg.listen, *colon = strrchr(listen, ':');
+    host_part(listen, colon ? (size_t)(colon - listen) : strlen(listen), lh, sizeof lh);
+    bool any = !lh[0] || !strcmp(lh, "0.0.0.0") || !strcmp(lh, "::");
+    char me[256] = "";
+    if (any && gethostname(me, sizeof me - 1) != 0)
+        me[0] = 0;
+    snprintf(n->hosts, sizeof n->hosts, "localhost,127.0.0.1,::1%s%s%s%s", any ? "" : ",", any ? "" : lh,
+             me[0] ? "," : "", me);
+}
+
+static bool host_allowed(svc_net *n, const char *host)
+{
+    if (!strcmp(n->hosts, "*"))
+        return true;
+    char h[256];
+    if (!host_part(host, strlen(host), h, sizeof h))
+        return false;
+    for (const char *p = n->hosts; *p;) { /* entries may carry ports or brackets too */
+        while (*p == ' ' || *p == ',')
+            p++;
+        const char *e = p + strcspn(p, ",");
+        char item[256];
+        if (host_part(p, (size_t)(e - p), item, sizeof item) && !strcmp(item, h))
+            return true;
+        p = e;
+    }
+    return false;
+}
+
+static bool state_changing(const char *method)
+{
+    return !strcmp(method, "POST") || !strcmp(method, "DELETE") || !strcmp(method, "PUT") || !strcmp(method, "PATCH");
+}
+
+/* The query parameters each resource takes; any other is refused. */
+static const struct {
+    const char *method, *path, *params;
+} query_params[] = {
+    {"POST", "/jobs", "size,format,name"},
+    {"GET", "/jobs", "limit,before"},
+    {"HEAD", "/jobs", "limit,before"},
+};
+
+typedef struct unknown_params {
+    const char *allowed;
+    char names[256];
+} unknown_params;
+
+static enum MHD_Result note_param(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind, (void)value;
+    unknown_params *u = cls;
+    if (in_list(u->allowed, key))
+        return MHD_YES;
+    size_t k = strlen(u->names);
+    snprintf(u->names + k, sizeof u->names - k, "%s%s", k ? ", " : "", key);
+    return MHD_YES;
+}
+
+static enum MHD_Result note_spaced_name(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind, (void)value;
+    if (!strpbrk(key, " \t"))
+        return MHD_YES;
+    *(const char **)cls = key;
+    return MHD_NO;
+}
+
+/* The CORS preflight of a listed origin. */
+static enum MHD_Result preflight(struct MHD_Connection *c)
+{
+    struct MHD_Response *r = MHD_create_response_from_buffer(0, "", MHD_RESPMEM_PERSISTENT);
+    if (!r)
+        return MHD_NO;
+    MHD_add_response_header(r, "Access-Control-Allow-Methods", "GET, POST, DELETE");
+    MHD_add_response_header(r, "Access-Control-Allow-Headers", "Authorization, Content-Type");
+    MHD_add_response_header(r, "Access-Control-Max-Age", "600");
+    enum MHD_Result ret = queue(c, 204, r);
+    MHD_destroy_response(r);
+    return ret;
+}
+
+/* Origin: a state-changing request from a foreign page is refused; a listed
+ * origin gets the CORS headers (noted on the connection for queue()). */
+static bool gate_origin(svc_daemon *d, struct MHD_Connection *c, const char *method, enum MHD_Result *ret)
+{
+    net_conn *nc = conn_of(c);
+    if (nc) {
+        nc->cors[0] = 0;
+        nc->vary = d->cfg.cors_origins[0] != 0;
+    }
+    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
+    if (!origin)
+        return true;
+    bool listed = in_list(d->cfg.cors_origins, origin);
+    if (listed && nc)
+        snprintf(nc->cors, sizeof nc->cors, "%s", origin);
+    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host");
+    bool own = host && !strncasecmp(origin, "http://", 7) && !strcasecmp(origin + 7, host);
+    if (listed && !strcmp(method, "OPTIONS") &&
+        MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Access-Control-Request-Method")) {
+        *ret = preflight(c);
+        return false;
+    }
+    if (state_changing(method) && !own && !listed) {
+        *ret = refuse(c, SVC_ERR_ORIGIN, NULL, NULL,
+                      "%s from Origin %s refused: not this server's own origin, nor one of cors_origins", method, origin);
+        return false;
+    }
+    return true;
+}
+
+/* Every check a request passes before it is routed or its body is read:
+ * false with *ret the answer when it is refused. */
+static bool gate_request(svc_daemon *d, struct MHD_Connection *c, conn_ctx *cx, const char *url, const char *method,
+                         enum MHD_Result *ret)
+{
+    if (cx->bad_uri) {
+        *ret = refuse(c, SVC_ERR_BAD_REQUEST, NULL, NULL, "a control character (raw or %%-encoded) in the path or query");
+        return false;
+    }
+    const char *spaced = NULL;
+    MHD_get_connection_values(c, MHD_HEADER_KIND, note_spaced_name, &spaced);
+    if (spaced) {
+        *ret = refuse(c, SVC_ERR_BAD_REQUEST, NULL, NULL, "header '%.64s': whitespace before the colon", spaced);
+        return false;
+    }
+    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host");
+    if (host && !host_allowed(d->net, host)) {
+        *ret = refuse(c, SVC_ERR_HOST, NULL, NULL, "Host '%.200s' is not served here (see the allowed_hosts setting)", host);
+        return false;
+    }
+    const char *te = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Transfer-Encoding");
+    if (te && strcasecmp(te, "chunked") && strcasecmp(te, "identity")) {
+        *ret = refuse(c, SVC_ERR_CODING, NULL, NULL, "Transfer-Encoding '%.100s': only chunked is understood", te);
+        return false;
+    }
+    if (!gate_origin(d, c, method, ret))
+        return false;
+    unknown_params u = {.allowed = ""};
+    for (size_t i = 0; i < sizeof query_params / sizeof query_params[0]; i++)
+        if (!strcmp(method, query_params[i].method) && (!strcmp(url, query_params[i].path) ||
+                                                        (!strncmp(url, query_params[i].path, strlen(query_params[i].path)) &&
+                                                         !strcmp(url + strlen(query_params[i].path), "/"))))
+            u.allowed = query_params[i].params;
+    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, note_param, &u);
+    if (u.names[0]) {
+        *ret = refuse(c, SVC_ERR_BAD_PARAM, NULL, NULL, "unknown query parameter %s for %s %s (it takes: %s)", u.names, method,
+                      url, u.allowed[0] ? u.allowed : "none");
+        return false;
+    }
+    return true;
+}
+
+/* Runs before the URI is decoded: control characters, raw or %-encoded,
+ * are noted here and refused by the gate.  Its answer is the request's
+ * context (*con_cls of on_request). */
+static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
+{
+    (void)cls, (void)c;
+    conn_ctx *cx = calloc(1, sizeof *cx);
+    if (!cx)
+        return NULL;
+    for (const unsigned char *p = (const unsigned char *)uri; *p; p++) {
+        if (*p < 0x20 || *p == 0x7f)
+            cx->bad_uri = true;
+        if (*p == '%' && isxdigit(p[1]) && isxdigit(p[2])) {
+            unsigned v = (unsigned)strtoul((char[]){(char)p[1], (char)p[2], 0}, NULL, 16);
+            cx->bad_uri |= v < 0x20 || v == 0x7f;
+        }
+    }
+    return cx;
+}
+
+/* An upload's room in upload_memory, reserved before its body is read. */
+static bool reserve_upload(svc_net *n, req *q, long bytes)
+{
+    pthread_mutex_lock(&n->mu);
+    bool ok = n->reserved + bytes <= n->d->cfg.upload_memory;
+    if (ok) {
+        n->reserved += bytes;
+        q->reserved = bytes;
+    }
+    pthread_mutex_unlock(&n->mu);
+    return ok;
+}
+
+/* DESIGN: libmicrohttpd 0.9.75 queues no response while a body is arriving
+ * (MHD_queue_response accepts one only right after the headers or after the
+ * whole request), so an upload that passes max_upload would be read to its
+ * end, however long, before it could be answered.  Instead the 413 is
+ * written to the socket here, whole, with Connection: close, and MHD_NO
+ * makes libmicrohttpd close the connection: nothing more is read. */
+static enum MHD_Result cut_oversize(svc_daemon *d, struct MHD_Connection *c, req *q)
+{
+    pthread_mutex_lock(&d->mu);
+    d->uploads_rejected++;
+    pthread_mutex_unlock(&d->mu);
+    svc_log(SVC_LOG_INFO, -1, "upload refused (413): more than max_upload %ld bytes sent; connection closed",
+            d->cfg.max_upload);
+    svc_buf b = {0};
+    char msg[160];
+    snprintf(msg, sizeof msg, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
+    svc_json_error(&b, msg);
+    char head[256];
+    int hn = snprintf(head, sizeof head,
+                      "HTTP/1.1 413 Content Too Large\r\nContent-Type: application/json\r\nCache-Control: no-store\r\n"
+                      "Content-Length: %zu\r\nConnection: close\r\n\r\n",
+                      b.len);
+    net_conn *nc = conn_of(c);
+    if (nc && !b.oom) {
+        pthread_mutex_lock(&d->net->mu);
+        nc->cut = true;
+        d->net->cuts[CUT_MAX_UPLOAD]++;
+        pthread_mutex_unlock(&d->net->mu);
+        send(nc->fd, head, (size_t)hn, MSG_NOSIGNAL | MSG_DONTWAIT | MSG_MORE);
+        send(nc->fd, b.p, b.len, MSG_NOSIGNAL | MSG_DONTWAIT);
+        shutdown(nc->fd, SHUT_WR);
+    }
+    svc_buf_free(&b);
+    q->too_large = true;
+    return MHD_NO;
+}
+
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url, const char *method,
                                   const char *version, const char *upload, size_t *upload_size, void **con_cls)
 {
     (void)version;
     svc_daemon *d = cls;
-    conn_ctx *cx = *con_cls;
-    if (!cx) {
-        cx = calloc(1, sizeof *cx);
-        if (!cx)
-            return MHD_NO;
-        *con_cls = cx;
+    conn_ctx *cx = *con_cls; /* made by on_uri */
+    if (!cx)
+        return MHD_NO;
+    if (!cx->q.started) {
         req *q = &cx->q;
-        enum MHD_Result answered;
-        if (!authorize(d, c, url, q, &answered))
-            return answered;
+        q->started = true;
+        conn_phase(d->net, c, NET_BODY);
+        enum MHD_Result refused;
+        /* the request's form first (Host, Origin, strict HTTP), then who asks */
+        if (!gate_request(d, c, cx, url, method, &refused) || !authorize(d, c, url, q, &refused)) {
+            q->done = true;
+            return refused;
+        }
         if (strcmp(method, "POST") != 0 || (strcmp(url, "/jobs") != 0 && strcmp(url, "/jobs/") != 0))
             return MHD_YES; /* answered below, once any body is read */
         q->post_jobs = true;
@@ -889,6 +1396,14 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             return reply_error(c, SVC_ERR_TOO_LARGE, "the upload (%s bytes) is over the limit of %ld bytes (max_upload)", cl,
                                d->cfg.max_upload);
         }
+        long want = cl ? (long)strtoull(cl, NULL, 10)
+                       : MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Transfer-Encoding") ? d->cfg.max_upload : 0;
+        if (want > 0 && !reserve_upload(d->net, q, want)) {
+            q->done = true;
+            return refuse(c, SVC_ERR_BUSY, "Retry-After", "5",
+                          "uploads in progress hold upload_memory (%ld bytes): try again in a few seconds",
+                          d->cfg.upload_memory);
+        }
         const char *ct = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Type");
         if (ct && strcasestr(ct, "multipart/form-data")) {
             cx->pc.pair[0] = d;
@@ -901,6 +1416,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     }
     req *q = &cx->q;
     if (*upload_size) {
+        q->received += *upload_size;
+        if (q->received > (uint64_t)d->cfg.max_upload)
+            return cut_oversize(d, c, q);
+        conn_body(d->net, c, *upload_size);
         if (!q->done) {
             if (!q->post_jobs)
                 ; /* a body nobody asked for: ignored */
@@ -918,6 +1437,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     if (q->done)
         return MHD_YES;
     q->done = true;
+    conn_phase(d->net, c, NET_ANSWER);
     if (q->post_jobs)
         return do_submit(d, c, q);
     return route(d, c, q, url, method);
@@ -925,10 +1445,17 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
 
 static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls, enum MHD_RequestTerminationCode toe)
 {
-    (void)cls, (void)c, (void)toe;
+    (void)toe;
+    svc_daemon *d = cls;
+    conn_phase(d->net, c, NET_HEADERS); /* a keep-alive connection's next request */
     conn_ctx *cx = *con_cls;
     if (!cx)
         return;
+    if (cx->q.reserved) {
+        pthread_mutex_lock(&d->net->mu);
+        d->net->reserved -= cx->q.reserved;
+        pthread_mutex_unlock(&d->net->mu);
+    }
     if (cx->q.pp)
         MHD_destroy_post_processor(cx->q.pp);
     free(cx->q.body);
@@ -947,8 +1474,61 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
     svc_log(SVC_LOG_DEBUG, -1, "http: %s", msg);
 }
 
-#include <netdb.h>
-#include <sys/socket.h>
+/* The connections the fd limit allows: the soft RLIMIT_NOFILE is raised
+ * toward the hard one; what is still short lowers the limit, with a word. */
+static unsigned connection_limit(const svc_config *cfg)
+{
+    enum { RESERVE = 128 }; /* the queue, logs, render pipes, the listen socket */
+    rlim_t want = (rlim_t)cfg->max_connections + RESERVE;
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_NOFILE, &rl) != 0)
+        return (unsigned)cfg->max_connections;
+    if (rl.rlim_cur < want && rl.rlim_cur < rl.rlim_max) {
+        rl.rlim_cur = rl.rlim_max == RLIM_INFINITY || rl.rlim_max > want ? want : rl.rlim_max;
+        setrlimit(RLIMIT_NOFILE, &rl);
+        getrlimit(RLIMIT_NOFILE, &rl);
+    }
+    if (rl.rlim_cur >= want)
+        return (unsigned)cfg->max_connections;
+    unsigned n = rl.rlim_cur > RESERVE + 16 ? (unsigned)(rl.rlim_cur - RESERVE) : 16;
+    svc_log(SVC_LOG_WARN, -1, "max_connections %d lowered to %u: the open-file limit is %llu (raise `ulimit -n`)",
+            cfg->max_connections, n, (unsigned long long)rl.rlim_cur);
+    return n;
+}
+
+static svc_net *net_new(svc_daemon *d)
+{
+    svc_net *n = calloc(1, sizeof *n);
+    if (!n)
+        return NULL;
+    n->d = d;
+    pthread_mutex_init(&n->mu, NULL);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_cond_init(&n->wake, &ca);
+    pthread_condattr_destroy(&ca);
+    if (d->cfg.allowed_hosts[0])
+        snprintf(n->hosts, sizeof n->hosts, "%s", d->cfg.allowed_hosts);
+    else
+        default_hosts(n);
+    return n;
+}
+
+static void net_free(svc_net *n)
+{
+    if (!n)
+        return;
+    if (n->reaper_started) {
+        pthread_mutex_lock(&n->mu);
+        n->stop = true;
+        pthread_cond_signal(&n->wake);
+        pthread_mutex_unlock(&n->mu);
+        pthread_join(n->reaper, NULL);
+    }
+    pthread_cond_destroy(&n->wake);
+    pthread_mutex_destroy(&n->mu);
+    free(n);
+}
 
 struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
 {
@@ -969,28 +1549,47 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
         rs_fail(err, 1, "listen %s: %s", d->cfg.listen, gai_strerror(gr));
         return NULL;
     }
-    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG;
+    if (!(d->net = net_new(d))) {
+        freeaddrinfo(ai);
+        rs_fail(err, 1, "out of memory starting the HTTP server");
+        return NULL;
+    }
+    /* epoll: no FD_SETSIZE limit, and thousands of idle connections cost
+     * nothing per wake-up; each of the pool's threads has its own */
+    unsigned flags = MHD_USE_EPOLL_INTERNAL_THREAD | MHD_USE_ERROR_LOG;
     if (ai->ai_family == AF_INET6)
         flags |= MHD_USE_IPv6;
-    flags |= MHD_USE_AUTO; /* epoll on Linux: no FD_SETSIZE limit */
+    /* strict: HTTP/1.1 without Host and spaces in the request line are
+     * answered 400 by libmicrohttpd itself */
     struct MHD_Daemon *mhd = MHD_start_daemon(
         flags, 0, NULL, NULL, on_request, d, MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, d, MHD_OPTION_SOCK_ADDR,
         ai->ai_addr, MHD_OPTION_THREAD_POOL_SIZE, 4u, MHD_OPTION_NOTIFY_COMPLETED, on_completed, d,
-        MHD_OPTION_CONNECTION_TIMEOUT, 60u, MHD_OPTION_CONNECTION_LIMIT, 256u, MHD_OPTION_END);
+        MHD_OPTION_NOTIFY_CONNECTION, on_connection, d->net, MHD_OPTION_URI_LOG_CALLBACK, on_uri, d,
+        MHD_OPTION_STRICT_FOR_CLIENT, 1, MHD_OPTION_CONNECTION_TIMEOUT, 60u, MHD_OPTION_CONNECTION_LIMIT,
+        connection_limit(&d->cfg), MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)d->cfg.max_connections_per_ip,
+        MHD_OPTION_END);
     freeaddrinfo(ai);
     if (!mhd) {
+        net_free(d->net);
+        d->net = NULL;
         rs_fail(err, 1, "cannot listen on %s (in use, or not an address of this machine?)", d->cfg.listen);
         return NULL;
     }
+    if (pthread_create(&d->net->reaper, NULL, reaper, d->net) == 0)
+        d->net->reaper_started = true;
+    else
+        svc_log(SVC_LOG_WARN, -1, "no connection reaper thread: header_timeout and min_body_rate are not enforced");
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(mhd, MHD_DAEMON_INFO_BIND_PORT);
     d->port = info ? info->port : 0;
     return mhd;
 }
 
-void svc_http_stop(struct MHD_Daemon *h)
+void svc_http_stop(svc_daemon *d, struct MHD_Daemon *h)
 {
     if (h)
-        MHD_stop_daemon(h);
+        MHD_stop_daemon(h); /* reports every connection closed first */
+    net_free(d->net);
+    d->net = NULL;
 }
 
 #else /* !RS_HAVE_MHD */
@@ -1002,9 +1601,9 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
     return NULL;
 }
 
-void svc_http_stop(struct MHD_Daemon *h)
+void svc_http_stop(svc_daemon *d, struct MHD_Daemon *h)
 {
-    (void)h;
+    (void)d, (void)h;
 }
 
 #endif

@@ -35,6 +35,8 @@ typedef struct svc_live {
     double beat_fps;
 } svc_live;
 
+typedef struct svc_net svc_net; /* svc_http.c: connections, deadlines, upload budget */
+
 typedef struct svc_daemon {
     svc_config cfg;
     svc_store *store;      /* the supervisor's handle */
@@ -44,6 +46,7 @@ typedef struct svc_daemon {
     char dashboard[1024];  /* service/dashboard.html under the data root ("" if not found) */
     volatile sig_atomic_t stop; /* 1: drain; 2: a second signal, stop now */
     unsigned short port;   /* the port actually bound */
+    svc_net *net;          /* the HTTP server's connection table (locks itself) */
 
     pthread_mutex_t mu;    /* guards everything below */
     bool draining;         /* POST /jobs answers 503 */
@@ -70,7 +73,12 @@ typedef struct svc_daemon {
     X(DRAINING, "the daemon is shutting down and takes no new jobs")            \
     X(AUTH, "no API token, or an unknown or revoked one")                       \
     X(QUOTA, "the API token's quota is used up for now")                        \
-    X(NOMEM, "out of memory")
+    X(NOMEM, "out of memory")                                                   \
+    X(BAD_REQUEST, "a malformed request (control characters, header syntax)")   \
+    X(HOST, "the Host header names no host this daemon serves")                 \
+    X(ORIGIN, "a state-changing request from a foreign web page (Origin)")      \
+    X(CODING, "a transfer coding the daemon does not understand")               \
+    X(BUSY, "uploads in progress hold all of upload_memory")
 
 typedef enum svc_error {
     SVC_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC),
@@ -87,7 +95,8 @@ unsigned svc_http_status(int code);
 
 struct MHD_Daemon;
 struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err);
-void svc_http_stop(struct MHD_Daemon *h);
+/* Stops the HTTP threads and the connection reaper. */
+void svc_http_stop(svc_daemon *d, struct MHD_Daemon *h);
 /* Checks an upload and fills the job (frames_total from the replay); the
  * message says what is wrong.  Exposed for tests. */
 bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, const char *name, svc_job *j,

@@ -218,11 +218,11 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
     ok = svc_run(&d) == 0;
     if (!ok)
         rs_fail(err, 1, "the supervisor stopped on an error (see the log above)");
-    svc_http_stop(http);
+    svc_http_stop(&d, http);
     http = NULL;
     svc_log(SVC_LOG_INFO, -1, "stopped");
 out:
-    svc_http_stop(http);
+    svc_http_stop(&d, http);
     if (d.http_store)
         d.http_store->ops->close(d.http_store);
     if (d.store)

@@ -881,7 +881,9 @@ static void t_http_status_table(void)
         {SVC_ERR_EMPTY, 400},    {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
         {SVC_ERR_BAD_BODY, 400}, {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
         {SVC_ERR_GONE, 410},     {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
-        {SVC_ERR_AUTH, 401},     {SVC_ERR_QUOTA, 429},     {SVC_ERR_NOMEM, 500},
+        {SVC_ERR_AUTH, 401},     {SVC_ERR_QUOTA, 429},
+        {SVC_ERR_NOMEM, 500},    {SVC_ERR_BAD_REQUEST, 400}, {SVC_ERR_HOST, 421},   {SVC_ERR_ORIGIN, 403},
+        {SVC_ERR_CODING, 501},   {SVC_ERR_BUSY, 503},
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
