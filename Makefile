@@ -152,7 +152,7 @@ build/fuzz/fuzz_replay: tests/fuzz_replay.c $(SIM_SRC)
 	    -o $@ tests/fuzz_replay.c $(filter-out tests/simhash.c,$(SIM_SRC)) -lm
 fuzz-run: build/fuzz/fuzz_replay
 	@mkdir -p build/fuzz/corpus
-	cp demos/*.rsr build/fuzz/corpus/
+	cp demos/*.rsr tests/golden/dojo-format1.rsr build/fuzz/corpus/
 	build/fuzz/fuzz_replay -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -print_final_stats=1 build/fuzz/corpus
 
 # the same with clang, where it is installed: a second compiler must agree too

@@ -18,7 +18,8 @@ static void help(void)
            "info    prints the header: stage, seed, duration, players, winner, sizes.\n"
            "verify  re-simulates every tick from the recorded inputs (no GL) and checks\n"
            "        every state-hash checkpoint and the final hash.  On a mismatch it\n"
-           "        prints the first checkpoint tick that differs and exits 1.\n\n"
+           "        prints the first checkpoint tick that differs and exits 1; a replay\n"
+           "        recorded by another version of the game is refused before that.\n\n"
            "  --hashes OUT  also write \"tick hash\" for every tick to OUT ('-' for stdout)\n"
            "  --quiet       no progress line\n");
 }
@@ -54,6 +55,11 @@ static int info(const char *path)
     winner_text(rp.winner, rp.rounds, win, sizeof win);
     printf("file         %s (%lld bytes, inputs %zu bytes)\n", path, n, rp.input_bytes);
     printf("format       version %d\n", rp.version);
+    if (rp.game_version)
+        printf("game         version %lu (this build: %d%s)\n", (unsigned long)rp.game_version, G_GAME_VERSION,
+               rp.game_version == G_GAME_VERSION ? "" : "; verify refuses it");
+    else
+        printf("game         none recorded (format 1: taken as this build's, %d)\n", G_GAME_VERSION);
     printf("stage        %d (%s)\n", rp.stage, g_stages[rp.stage].name);
     printf("seed         %" PRIu64 "\n", rp.seed);
     printf("duration     %" PRIu64 " ticks, %s\n", rp.ticks, dur);

@@ -165,7 +165,7 @@ static svc_store *open_queue(const svc_config *cfg, rs_err *err)
     const char *db = !strncmp(cfg->queue, "sqlite:", 7) ? cfg->queue + 7 : cfg->queue;
     if (!pg && *db && !rs_mkdirs_for(db, err))
         return NULL;
-    return svc_store_open(cfg->queue, err);
+    return svc_store_open(cfg->queue, cfg->lease, err);
 }
 
 /* Names people read in logs and lists: 1..64 of letters, digits, . _ - @,

@@ -52,6 +52,7 @@ static const struct {
     {SVC_ERR_GONE, 410},      {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
     {SVC_ERR_NOMEM, 500},     {SVC_ERR_AUTH, 401},      {SVC_ERR_QUOTA, 429},     {SVC_ERR_BAD_REQUEST, 400},
     {SVC_ERR_HOST, 421},      {SVC_ERR_ORIGIN, 403},    {SVC_ERR_CODING, 501},    {SVC_ERR_BUSY, 503},
+    {SVC_ERR_DESYNC, 400},    {SVC_ERR_GAME_VERSION, 400},
 };
 
 unsigned svc_http_status(int code)
@@ -62,6 +63,35 @@ unsigned svc_http_status(int code)
     return RS_ERR_MODULE(code) == RS_ERR_MOD_SVC_STORE ? 503 : 500;
 }
 
+/* The replay plays back as recorded: the same game rules, and every
+ * checkpoint and the final hash reproduced by re-simulating it (what
+ * `ringside replay verify` does; about 15 million ticks/s, so a 30-minute
+ * replay costs a few hundredths of a second of this request's thread). */
+static bool verify_upload(const rp_replay *rp, const char *name, rs_err *err)
+{
+    rs_err verr = {0};
+    if (!rp_check_game(rp, name, &verr))
+        return rs_fail(err, SVC_ERR_GAME_VERSION, "%s", verr.msg);
+    rp_verify_result res;
+    if (!rp_verify(rp, NULL, NULL, NULL, &res, &verr))
+        return rs_fail(err, SVC_ERR_REPLAY, "%s: %s", name, verr.msg);
+    if (res.header_mismatch)
+        return rs_fail(err, SVC_ERR_DESYNC,
+                       "%s: the header says winner %d, rounds %d-%d, but the simulation gives winner %d, rounds %d-%d",
+                       name, rp->winner, rp->rounds[0], rp->rounds[1], res.winner, res.rounds[0], res.rounds[1]);
+    if (!res.ok)
+        return rs_fail(err, SVC_ERR_DESYNC,
+                       "%s: desync at tick %" PRIu64 ": state hash %016" PRIx64 ", recorded %016" PRIx64
+                       " (last matching checkpoint: tick %" PRIu64 "; the inputs diverge in ticks %" PRIu64 "..%" PRIu64 ")",
+                       name, res.desync_tick, res.got, res.want, res.last_good_tick, res.last_good_tick + 1,
+                       res.desync_tick);
+    return true;
+}
+
+/* DESIGN: cheapest first.  Size, then the declared length (before decoding,
+ * which allocates 2 bytes a tick), then the parse, then the re-simulation:
+ * an oversized or overlong upload costs no simulation, and a desynced or
+ * foreign replay is refused here instead of after minutes of rendering. */
 bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, const char *name, svc_job *j,
                       rs_err *err)
 {
@@ -84,15 +114,18 @@ bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, co
     if (!rp_decode(data, len, name, &rp, &perr))
         return rs_fail(err, SVC_ERR_REPLAY, "%s", perr.msg);
     j->frames_total = (int64_t)rp.ticks;
-    rp_free(&rp);
+    bool ok = true;
     if (j->frames_total == 0)
-        return rs_fail(err, SVC_ERR_REPLAY, "%s: the replay has no ticks: nothing to render", name);
+        ok = rs_fail(err, SVC_ERR_REPLAY, "%s: the replay has no ticks: nothing to render", name);
     /* a small file can describe days of play (inputs are run-length coded):
      * one job must not hold a worker for that long */
-    if (j->frames_total > (int64_t)cfg->max_seconds * 60)
-        return rs_fail(err, SVC_ERR_TOO_LONG, "%s: the replay lasts %lld s; this service renders at most %d s (max_seconds)", name,
-                       (long long)((j->frames_total + 59) / 60), cfg->max_seconds);
-    return true;
+    else if (j->frames_total > (int64_t)cfg->max_seconds * 60)
+        ok = rs_fail(err, SVC_ERR_TOO_LONG, "%s: the replay lasts %lld s; this service renders at most %d s (max_seconds)",
+                     name, (long long)((j->frames_total + 59) / 60), cfg->max_seconds);
+    else
+        ok = verify_upload(&rp, name, err);
+    rp_free(&rp);
+    return ok;
 }
 
 int svc_parse_range(const char *h, uint64_t len, uint64_t *first, uint64_t *last)

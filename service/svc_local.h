@@ -63,6 +63,8 @@ typedef struct svc_daemon {
     X(TOO_LARGE, "the upload is over max_upload")                               \
     X(TOO_LONG, "the replay lasts longer than max_seconds")                     \
     X(REPLAY, "the upload is not a replay this service can render")             \
+    X(DESYNC, "the replay's inputs do not reproduce its recorded state hashes")  \
+    X(GAME_VERSION, "the replay was recorded by another version of the game")   \
     X(BAD_BODY, "a malformed request body")                                     \
     X(BAD_PARAM, "a bad request parameter (size, format, limit, before)")       \
     X(NOT_FOUND, "no such job or resource, or the file does not exist yet")     \

@@ -177,7 +177,7 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
         if (*db && (lock_fd = lock_sqlite(db, err)) < 0)
             goto out;
     }
-    if (!(d.store = svc_store_open(d.cfg.queue, err)) || !(d.http_store = svc_store_open(d.cfg.queue, err)))
+    if (!(d.store = svc_store_open(d.cfg.queue, d.cfg.lease, err)) || !(d.http_store = svc_store_open(d.cfg.queue, d.cfg.lease, err)))
         goto out;
     if (!check_tokens(&d, err))
         goto out;

@@ -42,10 +42,10 @@ const char *svc_store_error_text(int code)
     return rs_err_text_of(code, RS_ERR_MOD_SVC_STORE, text, (int)(sizeof text / sizeof text[0]));
 }
 
-svc_store *svc_store_open(const char *spec, rs_err *err)
+svc_store *svc_store_open(const char *spec, int lease_s, rs_err *err)
 {
     if (has_prefix(spec, "postgres://") || has_prefix(spec, "postgresql://"))
-        return svc_store_pg_open(spec, err);
+        return svc_store_pg_open(spec, lease_s, err);
     if (has_prefix(spec, "sqlite:"))
         spec += strlen("sqlite:");
     else {

@@ -289,10 +289,14 @@ struct svc_store {
  * "postgres://..." or "postgresql://...": PostgreSQL (libpq conninfo URI).
  * Creates the schema if it is missing, and brings a queue made before
  * units existed up to date (its queued and running jobs become WHOLE
- * units).  NULL with err filled on failure. */
-svc_store *svc_store_open(const char *spec, rs_err *err);
+ * units).  lease_s: the lease of the daemon using it (PostgreSQL's
+ * timeouts derive from it).  NULL with err filled on failure. */
+svc_store *svc_store_open(const char *spec, int lease_s, rs_err *err);
 svc_store *svc_store_sqlite_open(const char *path, rs_err *err);
-svc_store *svc_store_pg_open(const char *conninfo, rs_err *err);
+/* lease_s (the daemon's lease): the connection gives up on a silent or
+ * stalled server well within it (keepalives, TCP user timeout, connect and
+ * statement timeouts; each overridable in the URI). */
+svc_store *svc_store_pg_open(const char *conninfo, int lease_s, rs_err *err);
 
 /* The standard reason texts, shared so every backend words them alike. */
 #define SVC_LEASE_EXPIRED "lease expired (worker or daemon lost)"

@@ -32,13 +32,17 @@
 #include "svc_store_sql.h"
 
 #if defined(RS_HAVE_PQ)
+#include <errno.h>
 #include <limits.h>
+#include <poll.h>
+#include <time.h>
 
 #include <libpq-fe.h>
 
 typedef struct pg_conn {
     PGconn *conn;
     bool in_tx;      /* inside BEGIN..COMMIT: a lost connection is not retried */
+    int wait_ms;     /* longest wait for an answer (lease_defaults) */
     char label[256]; /* "postgres host:port/db": names the server in messages, never the password */
 } pg_conn;
 
@@ -179,6 +183,45 @@ static void d_res_free(sq_res *r)
 
 /* --- the driver --- */
 
+static int64_t now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
+}
+
+/* PQexecParams, but waiting at most s->wait_ms for the answer: a server
+ * that stopped answering (stalled, or a partition that TCP has not noticed
+ * yet) holds no thread longer than that.  Its connection is then dropped
+ * (PQresetStart: a new one is begun, the next call completes or fails it
+ * within connect_timeout) and *late is set.  NULL or the last result. */
+static PGresult *exec_within(pg_conn *s, const char *text, int nargs, const Oid *types, const char *const *vals,
+                             const int *lens, const int *fmts, bool *late)
+{
+    *late = false;
+    if (!PQsendQueryParams(s->conn, text, nargs, types, vals, lens, fmts, 1))
+        return NULL;
+    int64_t deadline = now_ms() + s->wait_ms;
+    while (PQisBusy(s->conn)) {
+        int64_t left = deadline - now_ms();
+        if (left <= 0) {
+            *late = true;
+            PQresetStart(s->conn);
+            return NULL;
+        }
+        struct pollfd p = {.fd = PQsocket(s->conn), .events = POLLIN};
+        int n = poll(&p, 1, (int)left);
+        if ((n < 0 && errno != EINTR) || (n > 0 && !PQconsumeInput(s->conn)))
+            break; /* the connection failed: PQgetResult says how */
+    }
+    PGresult *last = NULL, *r;
+    while ((r = PQgetResult(s->conn)) != NULL) {
+        PQclear(last);
+        last = r;
+    }
+    return last;
+}
+
 static int64_t d_exec(void *cp, const char *what, const char *sql, const sq_val *args, int nargs, sq_res *out,
                       rs_err *err)
 {
@@ -226,7 +269,13 @@ static int64_t d_exec(void *cp, const char *what, const char *sql, const sq_val 
         }
     }
     for (int tries = 0;; tries++) {
-        PGresult *r = PQexecParams(s->conn, text, nargs, types, vals, lens, fmts, 1);
+        bool late;
+        PGresult *r = exec_within(s, text, nargs, types, vals, lens, fmts, &late);
+        if (late) {
+            rs_fail(err, SVC_STORE_ERR_CONNECTION, "%s: %s: no answer in %.1f s (the server is stalled or unreachable); "
+                    "the connection was dropped", s->label, what, s->wait_ms / 1000.0);
+            return -1;
+        }
         ExecStatusType st = PQresultStatus(r); /* PGRES_FATAL_ERROR for NULL */
         if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK) {
             sq_res res = {0};
@@ -453,18 +502,49 @@ static bool create_schema(pg_conn *s, rs_err *err)
     return true;
 }
 
-svc_store *svc_store_pg_open(const char *conninfo, rs_err *err)
+/* Connection defaults from the lease L (seconds), as libpq keyword values.
+ *
+ * DESIGN: a daemon's store handle must notice a server it cannot reach
+ * well before a lease runs out (heartbeats come every L/6 s), not after
+ * the minutes TCP takes to give up: connecting gives up after L/3 s
+ * (at least 2), a statement after L/3 s (server side), unacknowledged data
+ * after L/3 s (TCP_USER_TIMEOUT), and an idle connection whose server
+ * vanished is found by keepalives in L/6 + 3 * L/12 s.  Each is a default:
+ * the URI's own setting wins (its settings come after these), and a URI
+ * with its own "options" replaces the statement timeout with them.  (A
+ * server that stops answering altogether -- stalled, or cut off before TCP
+ * notices -- is covered by exec_within's own deadline, L/3 + 1 s.) */
+typedef struct pg_defaults {
+    char connect[16], idle[16], interval[16], user_timeout[16], options[64];
+} pg_defaults;
+
+static void lease_defaults(int lease_s, pg_defaults *p)
+{
+    int third = lease_s / 3 > 1 ? lease_s / 3 : 1;
+    snprintf(p->connect, sizeof p->connect, "%d", third > 2 ? third : 2);
+    snprintf(p->idle, sizeof p->idle, "%d", lease_s / 6 > 1 ? lease_s / 6 : 1);
+    snprintf(p->interval, sizeof p->interval, "%d", lease_s / 12 > 1 ? lease_s / 12 : 1);
+    snprintf(p->user_timeout, sizeof p->user_timeout, "%d", third * 1000);
+    snprintf(p->options, sizeof p->options, "-c statement_timeout=%d", third * 1000);
+}
+
+svc_store *svc_store_pg_open(const char *conninfo, int lease_s, rs_err *err)
 {
     pg_conn *s = calloc(1, sizeof *s);
     if (!s) {
         rs_fail(err, SVC_STORE_ERR_NOMEM, "out of memory");
         return NULL;
     }
-    /* Defaults the URI may override (its settings come after these): give
-     * up on an unreachable server in seconds, not the minutes TCP would
-     * take, and name ourselves in pg_stat_activity. */
-    const char *const keys[] = {"connect_timeout", "fallback_application_name", "dbname", NULL};
-    const char *const vals[] = {"10", "ringside", conninfo, NULL};
+    pg_defaults def;
+    lease_defaults(lease_s, &def);
+    /* the server's statement timeout (L/3) answers first when it can answer at all */
+    s->wait_ms = (lease_s / 3 > 1 ? lease_s / 3 : 1) * 1000 + 1000;
+    /* defaults first, the URI (dbname, expanded) after them: it overrides */
+    const char *const keys[] = {"connect_timeout", "keepalives", "keepalives_idle", "keepalives_interval",
+                                "keepalives_count", "tcp_user_timeout", "options", "fallback_application_name",
+                                "dbname", NULL};
+    const char *const vals[] = {def.connect, "1", def.idle, def.interval, "3", def.user_timeout, def.options,
+                                "ringside", conninfo, NULL};
     s->conn = PQconnectdbParams(keys, vals, 1);
     make_label(s);
     if (!s->conn) {
@@ -489,9 +569,10 @@ fail:
 
 #else /* !RS_HAVE_PQ */
 
-svc_store *svc_store_pg_open(const char *conninfo, rs_err *err)
+svc_store *svc_store_pg_open(const char *conninfo, int lease_s, rs_err *err)
 {
     (void)conninfo; /* may hold a password: not repeated */
+    (void)lease_s;
     rs_fail(err, SVC_STORE_ERR_NOT_BUILT, "postgres: this ringside was built without libpq (install libpq-dev and rebuild)");
     return NULL;
 }

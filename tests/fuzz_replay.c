@@ -1,7 +1,10 @@
 /* libFuzzer target for the replay reader: `make fuzz` builds it,
  * `make fuzz-run FUZZ_SECONDS=600` runs it on the demo replays as seeds.
- * A decoded replay is also verified, so the simulation sees every input
- * the parser accepts, and whatever is accepted must survive re-encoding. */
+ * The seeds hold both formats (the format-2 demos, with the game version,
+ * and tests/golden/dojo-format1.rsr without).  A decoded replay is also
+ * verified (as this build's game, whatever game version it records, so the
+ * simulation sees every input the parser accepts), and whatever is accepted
+ * must survive re-encoding in its own format with its own game version. */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -41,7 +44,13 @@ static void one(const uint8_t *data, size_t size)
     if (rp_decode(data, size, "fuzz", &rp, &err)) {
         if (rp.ticks <= 20000) { /* keep each run fast */
             rp_verify_result res;
+            uint32_t game = rp.game_version;
+            bool refused = !rp_verify(&rp, NULL, NULL, NULL, &res, &err) && err.code == RP_ERR_GAME_VERSION;
+            if (refused != (game != 0 && game != G_GAME_VERSION))
+                __builtin_trap(); /* refused for the game version exactly when it is another one */
+            rp.game_version = 0;
             rp_verify(&rp, NULL, NULL, NULL, &res, &err);
+            rp.game_version = game;
         }
         uint8_t *buf;
         size_t n;
@@ -49,6 +58,8 @@ static void one(const uint8_t *data, size_t size)
             rp_replay again;
             /* what we accept, we re-encode to something we accept */
             if (!rp_decode(buf, n, "fuzz-reencoded", &again, &err))
+                __builtin_trap();
+            if (again.version != rp.version || again.game_version != rp.game_version)
                 __builtin_trap();
             rp_free(&again);
             free(buf);

@@ -3,7 +3,9 @@
  *   simhash --flip TICK BIT IN OUT    writes IN with one input bit flipped at
  *                                     TICK (1-based, player 1), re-encoded with
  *                                     a valid checksum: a replay that desyncs
- *   simhash --winner W IN OUT         writes IN claiming winner W in its header */
+ *   simhash --winner W IN OUT         writes IN claiming winner W in its header
+ *   simhash --game-version V IN OUT   writes IN as recorded by game version V
+ *                                     (0: as format 1, which records none) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,18 +44,23 @@ int main(int argc, char **argv)
         rp_free(&rp);
         return ok ? 0 : 1;
     }
-    if (argc == 5 && !strcmp(argv[1], "--winner")) {
+    if (argc == 5 && (!strcmp(argv[1], "--winner") || !strcmp(argv[1], "--game-version"))) {
         if (!rp_read(argv[3], &rp, &err)) {
             fprintf(stderr, "simhash: %s\n", err.msg);
             return 1;
         }
-        rp.winner = atoi(argv[2]);
+        if (!strcmp(argv[1], "--winner"))
+            rp.winner = atoi(argv[2]);
+        else {
+            rp.game_version = (uint32_t)strtoul(argv[2], NULL, 10);
+            rp.version = rp.game_version ? RP_VERSION : 1;
+        }
         bool ok = rp_write(argv[4], &rp, &err);
         if (!ok)
             fprintf(stderr, "simhash: %s\n", err.msg);
         rp_free(&rp);
         return ok ? 0 : 1;
     }
-    fprintf(stderr, "usage: simhash REPLAY | simhash --flip TICK BIT IN OUT | simhash --winner W IN OUT\n");
+    fprintf(stderr, "usage: simhash REPLAY | simhash --flip TICK BIT IN OUT | simhash --winner W IN OUT | simhash --game-version V IN OUT\n");
     return 2;
 }

@@ -10,6 +10,7 @@
 
 #include "../runtime/game/g_ai.h"
 #include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 #include "t.h"
@@ -109,10 +110,10 @@ static void t_corruption_cases(void)
     uint8_t *g;
     size_t n;
     encode(&rp, &g, &n);
-    const uint8_t v2[2] = {2, 0}, zero8[8] = {0}, big8[8] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0, 0};
+    const uint8_t v3[2] = {3, 0}, zero4[4] = {0}, zero8[8] = {0}, big8[8] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0, 0};
     const uint8_t st99[4] = {99, 0, 0, 0}, iv0[2] = {0, 0}, k3 = 3, w7 = 7, flag[2] = {1, 0}, r9 = 9;
     expect_bad(g, n, 0, "RSRQ", 4, false, RP_ERR_MAGIC, "not a ringside replay", "byte 0");
-    expect_bad(g, n, 4, v2, 2, false, RP_ERR_VERSION, "format version 2 at byte 4", "this build reads 1");
+    expect_bad(g, n, 4, v3, 2, false, RP_ERR_VERSION, "format version 3 at byte 4", "this build reads 1 and 2");
     expect_bad(g, n, 100, "\xAA", 1, false, RP_ERR_CHECKSUM, "checksum mismatch", "file damaged");
     expect_bad(g, n, 6, flag, 2, true, RP_ERR_FIELD, "unknown flags", "byte 6");
     expect_bad(g, n, 8, st99, 4, true, RP_ERR_FIELD, "stage id 99 at byte 8", NULL);
@@ -123,11 +124,14 @@ static void t_corruption_cases(void)
     expect_bad(g, n, 32, &w7, 1, true, RP_ERR_FIELD, "winner 7 at byte 32", NULL);
     expect_bad(g, n, 33, &r9, 1, true, RP_ERR_FIELD, "rounds won 9 at byte 33", NULL);
     expect_bad(g, n, 35, &k3, 1, true, RP_ERR_FIELD, "reserved byte 35 is 3", NULL);
+    expect_bad(g, n, 36, zero4, 4, true, RP_ERR_FIELD, "game version 0 at byte 36", NULL);
+    const uint8_t long_in[4] = {0xff, 0xff, 0, 0};
+    expect_bad(g, n, 40, long_in, 4, true, RP_ERR_FIELD, "input section length 65535 at byte 40", NULL);
     /* input section: a run past the tick count, opposite directions */
     const uint8_t huge_run[5] = {0xff, 0xff, 0xff, 0x7f, 0x00};
-    expect_bad(g, n, 40, huge_run, 4, true, RP_ERR_FIELD, "goes past the tick count", "byte 40");
+    expect_bad(g, n, 44, huge_run, 4, true, RP_ERR_FIELD, "goes past the tick count", "byte 44");
     const uint8_t updown[3] = {0x01, 0x03, 0x00}; /* run 1, p1 = up|down */
-    expect_bad(g, n, 40, updown, 3, true, RP_ERR_FIELD, "holds opposite directions", "byte 41");
+    expect_bad(g, n, 44, updown, 3, true, RP_ERR_FIELD, "holds opposite directions", "byte 45");
     /* truncated: everything from a valid prefix (fails at the CRC or a
      * section check, never reads past the end) */
     rp_replay out;
@@ -360,6 +364,101 @@ static void t_demos_verify(void)
     }
 }
 
+/* A format-1 file (the demos before the game version: tests/golden keeps
+ * dojo as it was) reads as the same match as its format-2 successor,
+ * records no game version, verifies, and re-encodes to itself byte for
+ * byte; its own field offsets (input section at 40) are still checked. */
+static void t_format1_still_read(void)
+{
+    size_t n1;
+    rs_err e = {0};
+    uint8_t *f1 = (uint8_t *)rs_read_file(RS_SOURCE_DIR "/tests/golden/dojo-format1.rsr", RP_MAX_FILE, &n1, &e);
+    T_ASSERTF(f1, "%s", e.msg);
+    rp_replay a, b;
+    T_ASSERTF(rp_decode(f1, n1, "v1.rsr", &a, &e), "%s", e.msg);
+    T_ASSERTF(rp_read(RS_SOURCE_DIR "/demos/dojo.rsr", &b, &e), "%s", e.msg);
+    T_EQ(a.version, 1);
+    T_EQ(a.game_version, 0);
+    T_EQ(b.version, RP_VERSION);
+    T_EQ(b.game_version, G_GAME_VERSION);
+    T_ASSERT(a.stage == b.stage && a.seed == b.seed && a.ticks == b.ticks && a.winner == b.winner &&
+             a.final_hash == b.final_hash && a.ncheck == b.ncheck && a.input_bytes == b.input_bytes);
+    T_ASSERT(!memcmp(a.inputs, b.inputs, (size_t)a.ticks * 2) && !memcmp(a.checkpoints, b.checkpoints, a.ncheck * 8));
+    rp_verify_result res;
+    T_ASSERTF(rp_verify(&a, NULL, NULL, NULL, &res, &e) && res.ok, "%s", e.msg);
+    uint8_t *re;
+    size_t rn;
+    encode(&a, &re, &rn);
+    T_ASSERT(rn == n1 && !memcmp(re, f1, n1));
+    const uint8_t huge_run[5] = {0xff, 0xff, 0xff, 0x7f, 0x00};
+    expect_bad(f1, n1, 40, huge_run, 4, true, RP_ERR_FIELD, "goes past the tick count", "byte 40");
+    free(re);
+    free(f1);
+    rp_free(&a);
+    rp_free(&b);
+}
+
+/* A replay of other game rules is refused before any simulation, with its
+ * own id and both versions named; the version survives a round trip; a
+ * render's tick check that desyncs on one names the version as the cause. */
+static void t_other_game_version(void)
+{
+    rp_replay rp, back;
+    record(&rp, 5, 0, 3000);
+    rp.game_version = G_GAME_VERSION + 1;
+    uint8_t *buf;
+    size_t n;
+    encode(&rp, &buf, &n);
+    rs_err e = {0};
+    T_ASSERTF(rp_decode(buf, n, "x.rsr", &back, &e), "%s", e.msg);
+    T_EQ(back.game_version, G_GAME_VERSION + 1);
+    rp_verify_result res;
+    T_ASSERT(!rp_verify(&back, NULL, NULL, NULL, &res, &e));
+    T_EQ(e.code, RP_ERR_GAME_VERSION);
+    char want[128];
+    snprintf(want, sizeof want, "recorded by another version of the game (replay: %d, this build: %d)",
+             G_GAME_VERSION + 1, G_GAME_VERSION);
+    T_ASSERTF(!strcmp(e.msg, want), "%s", e.msg);
+    T_ASSERT(!rp_check_game(&back, "x.rsr", &e));
+    T_CONTAINS(e.msg, "x.rsr: recorded by another version of the game");
+    back.inputs[2 * (1234 - 1)] ^= G_IN_GUARD;
+    g_state st;
+    g_init(&st, back.stage, back.seed);
+    size_t next = 0;
+    uint64_t t = 0;
+    for (bool ok = true; ok && t < back.ticks; t++) {
+        g_step(&st, &back.inputs[2 * t], NULL);
+        ok = rp_check_tick(&back, &st, t + 1, &next, "x.rsr", &e);
+    }
+    T_EQ(t, 1260);
+    T_EQ(e.code, RP_ERR_GAME_VERSION);
+    T_CONTAINS(e.msg, "x.rsr: desync at tick 1260: ");
+    T_CONTAINS(e.msg, want);
+    free(buf);
+    rp_free(&back);
+    rp_free(&rp);
+}
+
+/* G_GAME_VERSION must change when the rules do: a short CPU match's final
+ * hash is pinned to it.  When this fails, the rules changed: bump
+ * G_GAME_VERSION (runtime/game/g_game.h), put the new pair here, and run
+ * make demo-replays. */
+static void t_game_version_pinned_to_rules(void)
+{
+    static const struct {
+        int game_version;
+        uint64_t hash;
+    } pin = {1, 0x56d8bf9bdcd7e1d4ull};
+    rp_replay rp;
+    record(&rp, 1, 0, 600);
+    T_ASSERTF(G_GAME_VERSION != pin.game_version || rp.final_hash == pin.hash,
+              "the rules changed (hash %016llx, pinned %016llx) but G_GAME_VERSION is still %d: bump it",
+              (unsigned long long)rp.final_hash, (unsigned long long)pin.hash, G_GAME_VERSION);
+    T_ASSERTF(G_GAME_VERSION == pin.game_version, "G_GAME_VERSION %d: pin its hash %016llx here", G_GAME_VERSION,
+              (unsigned long long)rp.final_hash);
+    rp_free(&rp);
+}
+
 /* rp_check_tick, tick by tick, agrees with rp_verify: a clean replay passes
  * every tick; a flipped input fails at the first checkpoint after it, with
  * RP_ERR_DESYNC and a message naming the file and the tick. */
@@ -403,4 +502,6 @@ T_MAIN({"roundtrip", t_roundtrip}, {"three_minutes_under_16k", t_three_minutes_u
        {"write_read_back_and_failures", t_write_read_back_and_failures}, {"short_recording", t_short_recording},
        {"header_result_checked", t_header_result_checked}, {"empty_recording_refused", t_empty_recording_refused},
        {"error_ids_have_texts", t_error_ids_have_texts}, {"demos_verify", t_demos_verify},
-       {"check_tick_agrees_with_verify", t_check_tick_agrees_with_verify})
+       {"check_tick_agrees_with_verify", t_check_tick_agrees_with_verify},
+       {"format1_still_read", t_format1_still_read}, {"other_game_version", t_other_game_version},
+       {"game_version_pinned_to_rules", t_game_version_pinned_to_rules})

@@ -29,7 +29,8 @@ t_demos_are_current() {
 t_info() {
     "$RS_BIN" record --ai --quiet --seed 3 --stage harbor -o m.rsr 2>/dev/null || return 1
     "$RS_BIN" replay info m.rsr >i.txt || return 1
-    for k in "stage        1 (harbor)" "seed         3" "players      P1 cpu, P2 cpu" "format       version 1" \
+    for k in "stage        1 (harbor)" "seed         3" "players      P1 cpu, P2 cpu" "format       version 2" \
+        "game         version 1 (this build: 1)" \
         "every 60 ticks"; do
         grep -q "$k" i.txt || { echo "info lacks '$k'"; cat i.txt; return 1; }
     done
@@ -87,8 +88,9 @@ t_bad_files() {
     expect_fail 1 "trunc.rsr: checksum mismatch at byte 96" "$RS_BIN" replay verify trunc.rsr || return 1
     : >empty.rsr
     expect_fail 1 "empty.rsr: not a ringside replay: expected \"RSRP\" at byte 0" "$RS_BIN" replay info empty.rsr || return 1
-    printf 'RSRP\002\000' >v2.rsr
-    expect_fail 1 "v2.rsr: format version 2 at byte 4 is not supported" "$RS_BIN" replay info v2.rsr || return 1
+    printf 'RSRP\003\000' >v3.rsr
+    expect_fail 1 "v3.rsr: format version 3 at byte 4 is not supported \\(this build reads 1 and 2\\)" \
+        "$RS_BIN" replay info v3.rsr || return 1
     # one flipped bit in the middle: the checksum catches it
     size=$(wc -c <good.rsr)
     dd if=good.rsr of=flip.rsr bs=1 count=$((size / 2)) 2>/dev/null
@@ -99,6 +101,28 @@ t_bad_files() {
     mkdir dir.rsr
     expect_fail 1 "dir.rsr: read error" "$RS_BIN" replay info dir.rsr || return 1
     for f in err.txt; do [ "$(wc -l <$f)" = 1 ] || { cat $f; return 1; }; done
+}
+
+# Format 1 (no game version) is still read: the demos as they were before
+# format 2 verify, and are the same match as today's demos.
+t_format1_verifies() {
+    "$RS_BIN" replay verify --quiet --hashes v1.txt "$SRC/tests/golden/dojo-format1.rsr" 2>v.txt || { cat v.txt; return 1; }
+    "$RS_BIN" replay verify --quiet --hashes v2.txt "$SRC/demos/dojo.rsr" 2>/dev/null || return 1
+    cmp v1.txt v2.txt || { echo "format 1 and 2 dojo differ"; return 1; }
+    "$RS_BIN" replay info "$SRC/tests/golden/dojo-format1.rsr" >i.txt || return 1
+    grep -q "^game         none recorded (format 1: taken as this build's, 1)" i.txt || { cat i.txt; return 1; }
+    "$BIN_DIR/tests/simhash-O2" --game-version 0 "$SRC/demos/dojo.rsr" back.rsr || return 1
+    cmp back.rsr "$SRC/tests/golden/dojo-format1.rsr" || { echo "format 2 -> 1 is not the old file"; return 1; }
+}
+
+# Three failures, three messages: another game version, damage, desync.
+t_game_version_told_apart() {
+    "$BIN_DIR/tests/simhash-O2" --game-version 9 "$SRC/demos/dojo.rsr" other.rsr || return 1
+    expect_fail 1 "^ringside replay: other.rsr: recorded by another version of the game \\(replay: 9, this build: 1\\)$" \
+        "$RS_BIN" replay verify --quiet other.rsr || return 1
+    "$RS_BIN" replay info other.rsr | grep -q "^game         version 9 (this build: 1; verify refuses it)" || return 1
+    "$BIN_DIR/tests/simhash-O2" --flip 1234 6 other.rsr both.rsr || return 1
+    expect_fail 1 "both.rsr: recorded by another version of the game" "$RS_BIN" replay verify --quiet both.rsr || return 1
 }
 
 t_usage() {
@@ -126,5 +150,5 @@ t_bench_sim_short() {
 }
 
 t_run record_is_reproducible demos_are_current info seconds_exact hashes_same_at_O0_O2_and_in_ringside \
-    hashes_same_with_clang header_tampering_is_reported flipped_bit_reports_tick bad_files usage disk_full_keeps_nothing bench_sim_short
+    hashes_same_with_clang header_tampering_is_reported flipped_bit_reports_tick bad_files format1_verifies game_version_told_apart usage disk_full_keeps_nothing bench_sim_short
 t_done

@@ -815,6 +815,40 @@ static void t_upload_valid(void)
     free(buf);
 }
 
+/* The upload is re-simulated: a flipped input is refused naming its
+ * checkpoint tick, a replay of other game rules naming both versions, each
+ * with its own id; a format-1 replay (no game version) is accepted. */
+static void t_upload_verified(void)
+{
+    svc_config cfg;
+    svc_config_defaults(&cfg);
+    size_t n;
+    uint8_t *buf = make_replay(1000, &n);
+    rp_replay rp;
+    rs_err e = {0};
+    T_ASSERTF(rp_decode(buf, n, "mem", &rp, &e), "%s", e.msg);
+    free(buf);
+    rp.inputs[2 * (70 - 1)] ^= G_IN_GUARD;
+    T_ASSERTF(rp_encode(&rp, &buf, &n, &e), "%s", e.msg);
+    T_EQ(upload(&cfg, buf, n, SVC_ERR_DESYNC,
+                "clip.rsr: desync at tick 120: "), 0);
+    free(buf);
+    rp.inputs[2 * (70 - 1)] ^= G_IN_GUARD;
+    rp.game_version = G_GAME_VERSION + 1;
+    T_ASSERTF(rp_encode(&rp, &buf, &n, &e), "%s", e.msg);
+    char want[160];
+    snprintf(want, sizeof want, "clip.rsr: recorded by another version of the game (replay: %d, this build: %d)",
+             G_GAME_VERSION + 1, G_GAME_VERSION);
+    T_EQ(upload(&cfg, buf, n, SVC_ERR_GAME_VERSION, want), 0);
+    free(buf);
+    rp.game_version = 0;
+    rp.version = 1;
+    T_ASSERTF(rp_encode(&rp, &buf, &n, &e), "%s", e.msg);
+    T_EQ(upload(&cfg, buf, n, 0, NULL), 1000);
+    free(buf);
+    rp_free(&rp);
+}
+
 /* Every prefix of a good replay is a broken upload: refused with 400, and
  * never read past its end (each copy is exactly k bytes, for ASan). */
 static void t_upload_truncations(void)
@@ -884,6 +918,7 @@ static void t_http_status_table(void)
         {SVC_ERR_AUTH, 401},     {SVC_ERR_QUOTA, 429},
         {SVC_ERR_NOMEM, 500},    {SVC_ERR_BAD_REQUEST, 400}, {SVC_ERR_HOST, 421},   {SVC_ERR_ORIGIN, 403},
         {SVC_ERR_CODING, 501},   {SVC_ERR_BUSY, 503},
+        {SVC_ERR_DESYNC, 400},   {SVC_ERR_GAME_VERSION, 400},
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
@@ -965,4 +1000,5 @@ T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t
        {"range_cases", t_range_cases}, {"range_random", t_range_random}, {"upload_refusals", t_upload_refusals},
        {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
+       {"upload_verified", t_upload_verified},
        {"http_status_table", t_http_status_table})

@@ -91,7 +91,7 @@ static const char *pg_spec(void)
 static svc_store *open_ok(const char *spec)
 {
     rs_err e = {0};
-    svc_store *s = svc_store_open(spec, &e);
+    svc_store *s = svc_store_open(spec, 30, &e);
     T_ASSERTF(s, "open %s: %s", spec, e.msg);
     return s;
 }
@@ -672,7 +672,7 @@ static void concurrent_claim(const char *spec)
         if (kid[k] == 0) {
             close(fd[0]);
             rs_err e = {0};
-            svc_store *w = svc_store_open(spec, &e);
+            svc_store *w = svc_store_open(spec, 30, &e);
             if (!w) {
                 fprintf(stderr, "    worker %d: open: %s\n", k, e.msg);
                 _exit(2);
@@ -782,7 +782,7 @@ static void open_race(const char *spec)
             while (read(gate[0], &c, 1) < 0 && errno == EINTR) {
             }
             rs_err e = {0};
-            svc_store *s = svc_store_open(spec, &e);
+            svc_store *s = svc_store_open(spec, 30, &e);
             if (!s) {
                 fprintf(stderr, "    opener %d: %s\n", k, e.msg);
                 _exit(1);
@@ -1111,7 +1111,7 @@ static void split_concurrent(const char *spec)
         T_ASSERT(kid[k] >= 0);
         if (kid[k] == 0) {
             rs_err e = {0};
-            svc_store *w = svc_store_open(spec, &e);
+            svc_store *w = svc_store_open(spec, 30, &e);
             if (!w)
                 _exit(2);
             char owner[32];
@@ -1326,7 +1326,7 @@ BOTH(tokens)
 static void expect_open_fail(const char *spec, int code, const char *want)
 {
     rs_err e = {0};
-    svc_store *s = svc_store_open(spec, &e);
+    svc_store *s = svc_store_open(spec, 30, &e);
     T_ASSERTF(!s, "%s opened", spec);
     T_ASSERTF(e.code == code, "%s: %s, want %s (%s)", spec, svc_store_error_text(e.code), svc_store_error_text(code),
               e.msg);
@@ -1384,14 +1384,14 @@ static void t_pg_unreachable(void)
     for (int i = 0; i < 2; i++) {
         snprintf(uri, sizeof uri, forms[i], port);
         rs_err e = {0};
-        T_ASSERT(!svc_store_open(uri, &e));
+        T_ASSERT(!svc_store_open(uri, 30, &e));
         T_EQ(e.code, SVC_STORE_ERR_OPEN);
         T_CONTAINS(e.msg, where);
         T_ASSERTF(!strstr(e.msg, "s3cret-pw"), "password in '%s'", e.msg);
     }
     /* libpq quotes a malformed URI whole */
     rs_err e = {0};
-    T_ASSERT(!svc_store_open("postgresql://ringside:s3cret-pw@[::1/ringside", &e));
+    T_ASSERT(!svc_store_open("postgresql://ringside:s3cret-pw@[::1/ringside", 30, &e));
     T_EQ(e.code, SVC_STORE_ERR_OPEN);
     T_ASSERT(e.msg[0]);
     T_ASSERTF(!strstr(e.msg, "s3cret-pw"), "password in '%s'", e.msg);
@@ -1399,7 +1399,7 @@ static void t_pg_unreachable(void)
     snprintf(uri, sizeof uri, "postgresql://ringside:s3cret-pw@127.0.0.1:%d/ringside", port);
     expect_open_fail(uri, SVC_STORE_ERR_NOT_BUILT, "built without libpq (install libpq-dev and rebuild)");
     rs_err e = {0};
-    svc_store_open(uri, &e);
+    svc_store_open(uri, 30, &e);
     T_ASSERT(!strstr(e.msg, "s3cret-pw"));
     (void)where;
 #endif

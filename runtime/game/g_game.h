@@ -20,6 +20,14 @@
 
 #define G_HZ 60
 
+/* The game's rules version: bumped whenever a change to the simulation can
+ * change the state hash of any replay (moves, physics, AI, stages, the
+ * serialisation).  Replays record it (docs/replay-format.md), so a replay
+ * of other rules is told apart from a damaged or desynced one;
+ * tests/test_replay.c pins a short match's hash to it and fails when the
+ * rules change and this number does not. */
+#define G_GAME_VERSION 1
+
 /* One player's arcade panel for one tick: 8-way stick + 3 buttons + start.
  * A stick with both up and down (or left and right) is not a valid input:
  * input devices resolve it to neutral on that axis, the replay reader

@@ -94,8 +94,10 @@ static void encode_inputs(wbuf *w, const rp_replay *rp)
 bool rp_encode(const rp_replay *rp, uint8_t **out, size_t *len, rs_err *err)
 {
     wbuf w = {0};
+    /* the format the struct says: a format-1 replay re-encodes as it was read */
+    bool v1 = rp->version == 1;
     wb_put(&w, RP_MAGIC, 4);
-    wb_u(&w, RP_VERSION, 2);
+    wb_u(&w, v1 ? 1 : RP_VERSION, 2);
     wb_u(&w, 0, 2); /* flags */
     wb_u(&w, (uint64_t)rp->stage, 4);
     wb_u(&w, rp->seed, 8);
@@ -107,6 +109,8 @@ bool rp_encode(const rp_replay *rp, uint8_t **out, size_t *len, rs_err *err)
     wb_u(&w, (uint64_t)rp->rounds[0], 1);
     wb_u(&w, (uint64_t)rp->rounds[1], 1);
     wb_u(&w, 0, 1); /* reserved */
+    if (!v1)
+        wb_u(&w, rp->game_version, 4);
     wbuf in = {0};
     encode_inputs(&in, rp);
     wb_u(&w, in.n, 4);
@@ -191,13 +195,15 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
         return rs_fail(err, RP_ERR_MAGIC, "%s: not a ringside replay: expected \"RSRP\" at byte 0", name);
     if (!rd_u(&r, 4, &v, "magic") || !rd_u(&r, 2, &v, "format version"))
         return false;
-    if (v != RP_VERSION)
-        return rs_fail(err, RP_ERR_VERSION, "%s: format version %llu at byte 4 is not supported (this build reads %d)",
+    if (v != 1 && v != RP_VERSION)
+        return rs_fail(err, RP_ERR_VERSION, "%s: format version %llu at byte 4 is not supported (this build reads 1 and %d)",
                        name, (unsigned long long)v, RP_VERSION);
     rp->version = (int)v;
+    size_t header = v == 1 ? RP_HEADER_BYTES_V1 : RP_HEADER_BYTES;
     /* the checksum covers everything, so check it before trusting any field */
-    if (len < RP_HEADER_BYTES + 4 + 4 + 8 + 4)
-        return rs_fail(err, RP_ERR_TRUNCATED, "%s: truncated: %zu bytes, a replay has at least %d", name, len, RP_HEADER_BYTES + 20);
+    if (len < header + 4 + 4 + 8 + 4)
+        return rs_fail(err, RP_ERR_TRUNCATED, "%s: truncated: %zu bytes, a version %d replay has at least %zu", name, len,
+                       rp->version, header + 20);
     uint32_t stored = (uint32_t)buf[len - 4] | (uint32_t)buf[len - 3] << 8 | (uint32_t)buf[len - 2] << 16 |
                       (uint32_t)buf[len - 1] << 24;
     uint32_t crc = rs_crc32(0, buf, len - 4);
@@ -252,16 +258,24 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
         return false;
     if (v != 0)
         return BAD("%s: reserved byte 35 is %llu (expected 0)", name, (unsigned long long)v);
+    if (rp->version >= 2) {
+        if (!rd_u(&r, 4, &v, "game version"))
+            return false;
+        if (v == 0)
+            return BAD("%s: game version 0 at byte 36 (expected 1 or more)", name);
+        rp->game_version = (uint32_t)v;
+    }
+    size_t len_at = r.o;
     if (!rd_u(&r, 4, &v, "input section length"))
         return false;
     size_t body_end = len - 4;
     if (v > body_end - r.o)
-        return BAD("%s: input section length %llu at byte 36 runs past the end of the file (%zu bytes left)", name,
-                   (unsigned long long)v, body_end - r.o);
+        return BAD("%s: input section length %llu at byte %zu runs past the end of the file (%zu bytes left)", name,
+                   (unsigned long long)v, len_at, body_end - r.o);
     /* each run is at least 3 bytes and covers at least one tick */
     if (v < 3 || v > 3 * rp->ticks)
-        return BAD("%s: input section length %llu at byte 36 does not fit %llu ticks", name, (unsigned long long)v,
-                   (unsigned long long)rp->ticks);
+        return BAD("%s: input section length %llu at byte %zu does not fit %llu ticks", name, (unsigned long long)v,
+                   len_at, (unsigned long long)rp->ticks);
     rp->input_bytes = (size_t)v;
     size_t in_end = r.o + (size_t)v;
     rp->inputs = malloc((size_t)rp->ticks * 2);
@@ -354,7 +368,7 @@ bool rp_read(const char *path, rp_replay *rp, rs_err *err)
 
 static bool same(const rp_replay *a, const rp_replay *b)
 {
-    return a->stage == b->stage && a->seed == b->seed && a->ticks == b->ticks && a->interval == b->interval &&
+    return a->version == b->version && a->game_version == b->game_version && a->stage == b->stage && a->seed == b->seed && a->ticks == b->ticks && a->interval == b->interval &&
            a->kind[0] == b->kind[0] && a->kind[1] == b->kind[1] && a->winner == b->winner &&
            a->rounds[0] == b->rounds[0] && a->rounds[1] == b->rounds[1] && a->ncheck == b->ncheck &&
            a->final_hash == b->final_hash && !memcmp(a->inputs, b->inputs, (size_t)a->ticks * 2) &&
@@ -395,6 +409,7 @@ void rp_rec_init(rp_recorder *r, int stage, uint64_t seed, int kind1, int kind2)
 {
     memset(r, 0, sizeof *r);
     r->rp.version = RP_VERSION;
+    r->rp.game_version = G_GAME_VERSION;
     r->rp.stage = stage;
     r->rp.seed = seed;
     r->rp.interval = RP_DEFAULT_INTERVAL;
@@ -458,11 +473,21 @@ bool rp_rec_save(rp_recorder *r, const char *path, rs_err *err)
 
 /* ---------- verification ---------- */
 
+bool rp_check_game(const rp_replay *rp, const char *name, rs_err *err)
+{
+    if (rp->game_version == 0 || rp->game_version == G_GAME_VERSION)
+        return true;
+    return rs_fail(err, RP_ERR_GAME_VERSION, "%s%srecorded by another version of the game (replay: %lu, this build: %d)",
+                   name ? name : "", name ? ": " : "", (unsigned long)rp->game_version, G_GAME_VERSION);
+}
+
 bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t, uint64_t, void *), void *user,
                rp_verify_result *res, rs_err *err)
 {
     memset(res, 0, sizeof *res);
     res->winner = -1;
+    if (!rp_check_game(rp, NULL, err))
+        return false;
     g_state st;
     g_init(&st, rp->stage, rp->seed);
     size_t next = 0;
@@ -522,8 +547,16 @@ bool rp_check_tick(const rp_replay *rp, const g_state *st, uint64_t done, size_t
         return true;
     if (h == want) /* the checkpoint matched, the final hash (same tick) did not */
         want = rp->final_hash;
-    return rs_fail(err, RP_ERR_DESYNC,
-                   "%s: desync at tick %llu: the game's state hash %016llx is not the replay's %016llx (its inputs "
-                   "no longer reproduce the recorded match)",
-                   name, (unsigned long long)done, (unsigned long long)h, (unsigned long long)want);
+    rs_fail(err, RP_ERR_DESYNC,
+            "%s: desync at tick %llu: the game's state hash %016llx is not the replay's %016llx (its inputs "
+            "no longer reproduce the recorded match)",
+            name, (unsigned long long)done, (unsigned long long)h, (unsigned long long)want);
+    rs_err why = {0};
+    if (!rp_check_game(rp, NULL, &why) && err) { /* the likely reason, in place of the generic one */
+        char *paren = strstr(err->msg, " (its inputs");
+        if (paren)
+            snprintf(paren, sizeof err->msg - (size_t)(paren - err->msg), ": %s", why.msg);
+        err->code = RP_ERR_GAME_VERSION;
+    }
+    return false;
 }

@@ -17,8 +17,9 @@
 #include "../util/rs_err.h"
 
 #define RP_MAGIC "RSRP"
-#define RP_VERSION 1
-#define RP_HEADER_BYTES 36
+#define RP_VERSION 2         /* what the recorder writes; the reader also takes 1 */
+#define RP_HEADER_BYTES 40    /* version 2; version 1 has no game version: 36 */
+#define RP_HEADER_BYTES_V1 36
 #define RP_MAX_FILE (64u << 20)
 #define RP_MAX_TICKS (7ull * 24 * 3600 * G_HZ) /* a week of play */
 #define RP_DEFAULT_INTERVAL 60
@@ -35,7 +36,8 @@
     X(NOMEM, "out of memory")                                                          \
     X(WRITE, "writing the replay (or a hash list) failed, or its read-back differs")   \
     X(RECORD, "nothing to save, or a recording longer than the tick limit")            \
-    X(DESYNC, "the inputs no longer reproduce the recorded state hashes")
+    X(DESYNC, "the inputs no longer reproduce the recorded state hashes")                \
+    X(GAME_VERSION, "recorded by another version of the game")
 
 typedef enum rp_error {
     RP_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_RP),
@@ -50,7 +52,9 @@ const char *rp_error_text(int code);
 enum { RP_HUMAN = 0, RP_CPU = 1 };
 
 typedef struct rp_replay {
-    int version;
+    int version;          /* format version: 1 or 2; rp_encode writes this one */
+    uint32_t game_version; /* G_GAME_VERSION it was recorded with; 0 in a format-1
+                              file, which records none (taken as this build's) */
     int stage;
     uint64_t seed;
     uint64_t ticks;
@@ -89,6 +93,12 @@ bool rp_write(const char *path, const rp_replay *rp, rs_err *err);
 void rp_free(rp_replay *rp);
 
 /* --- verification: simulation only, no GL --- */
+/* The replay was recorded by this build's game rules (G_GAME_VERSION), or
+ * records none (format 1).  Otherwise fails with RP_ERR_GAME_VERSION:
+ * "NAME: recorded by another version of the game (replay: X, this build: Y)"
+ * (no "NAME: " when name is NULL). */
+bool rp_check_game(const rp_replay *rp, const char *name, rs_err *err);
+
 typedef struct rp_verify_result {
     bool ok;
     uint64_t desync_tick;   /* first checkpoint tick whose hash differs (0 if none) */
@@ -99,8 +109,9 @@ typedef struct rp_verify_result {
     bool header_mismatch;   /* every hash matched, but the header's winner or rounds do not */
 } rp_verify_result;
 
-/* Steps the game through every tick; checks every checkpoint and the final
- * hash.  hashes (optional) gets "tick hash" per tick.  progress (optional)
+/* Checks the game version (rp_check_game: returns false, nothing
+ * simulated), then steps the game through every tick; checks every
+ * checkpoint and the final hash.  hashes (optional) gets "tick hash" per tick.  progress (optional)
  * is called every 2^16 ticks. */
 bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t done, uint64_t total, void *user),
                void *user, rp_verify_result *res, rs_err *err);
@@ -112,7 +123,9 @@ bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t done
  * checkpoints passed: start it at 0 and call once per tick, in order.
  * Ticks with nothing due pass without hashing.  A mismatch fails with
  * RP_ERR_DESYNC: "NAME: desync at tick T: the game's state hash ... is not
- * the replay's ...". */
+ * the replay's ...", or RP_ERR_GAME_VERSION with the same words and
+ * rp_check_game's when the replay was recorded by other game rules (a
+ * renderer may go on with such a replay as long as it reproduces). */
 bool rp_check_tick(const rp_replay *rp, const g_state *st, uint64_t done, size_t *next, const char *name,
                    rs_err *err);
 

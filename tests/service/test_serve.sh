@@ -235,20 +235,6 @@ t_ctrl_c_to_the_whole_group() {
     grep -q "job $id: done" d.log || { echo "the running job did not finish in the grace period"; cat d.log; return 1; }
 }
 
-t_desynced_replay_fails_with_its_tick() {
-    "$RS_BIN" record --ai --quiet --seconds 4 --seed 8 -o ok.rsr || return 1
-    "$SVC_BIN_DIR/tests/simhash-O2" --flip 70 6 ok.rsr bad.rsr || return 1
-    svc_start d $SVC_FAST || return 1
-    id=$(svc_submit bad.rsr) || return 1
-    svc_wait_state "$id" failed 60 || return 1
-    [ "$(svc_field "$id" desync_tick)" = 120 ] || { curl -s "$SVC_URL/jobs/$id"; return 1; }
-    svc_field "$id" error | grep -q "bad.rsr: desync at tick 120" || { svc_field "$id" error; return 1; }
-    # a desync is the replay's fault: not retried
-    [ "$(svc_field "$id" attempts)" = 1 ] || return 1
-    [ "$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/$id/video")" = 404 ] || return 1
-    svc_stop
-}
-
 t_cancel_queued_and_running() {
     "$RS_BIN" record --ai --quiet --seconds 20 --seed 6 -o long.rsr || return 1
     svc_start d $SVC_FAST || return 1
@@ -361,6 +347,6 @@ t_range_requests() {
 t_run ${T_ONLY:-readme_flow twenty_concurrent_jobs worker_killed_mid_render daemon_killed_and_restarted \
     sigterm_lets_running_jobs_finish sigterm_after_grace_requeues ctrl_c_to_the_whole_group \
     local_problems_do_not_burn_attempts bad_uploads_get_4xx \
-    desynced_replay_fails_with_its_tick cancel_queued_and_running watchdog_kills_a_stalled_render \
+    cancel_queued_and_running watchdog_kills_a_stalled_render \
     retry_cap_dead_letters config_file_and_errors range_requests}
 t_done
