@@ -3,6 +3,7 @@
 //
 //   node tests/service/dashboard.mjs --url http://127.0.0.1:PORT --replay FILE.rsr \
 //        --shot OUT.png [--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]
+//        [--token TOKEN --form-shot FORM.png]
 //
 // Opens the page in headless Chromium, uploads the replay, waits for the job's
 // row to reach data-state="done" (failing fast on "failed"/"cancelled"), checks
@@ -10,6 +11,14 @@
 // metadata (videoWidth > 0, duration > 0), saves a full-page screenshot and
 // prints one result line.  Exit 0 on success, 1 on any failure (with the reason),
 // 2 on bad usage.
+//
+// Without --token the daemon must need no token: the page must never show the
+// token form, and the player plays the plain /jobs/N/video URL.  With --token
+// (a valid token of a daemon that needs one) the page must first show the
+// token form instead of the job list; a made-up token must be refused with
+// the server's message under the form (screenshot FORM.png); TOKEN must bring
+// the list; then the upload as above, the video from a blob: URL, the hashes
+// download; a reload must keep the token, and "forget token" bring the form back.
 //
 // Needs playwright-core (cd tests/service && npm ci) and a Chromium binary
 // (default /usr/bin/chromium, Debian's; or $CHROMIUM / --chromium).  The default
@@ -20,11 +29,11 @@ import fs from 'node:fs';
 import path from 'node:path';
 
 const USAGE = 'usage: node tests/service/dashboard.mjs --url URL --replay FILE --shot OUT.png ' +
-  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]';
+  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH] [--token TOKEN --form-shot FORM.png]';
 
 function parseArgs(argv) {
   const o = { timeout: 120, size: '320x180', format: 'webm', chromium: process.env.CHROMIUM || '/usr/bin/chromium' };
-  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium']);
+  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot']);
   for (let i = 0; i < argv.length; i++) {
     let a = argv[i], v;
     if (a === '-h' || a === '--help') { console.log(USAGE); process.exit(0); }
@@ -37,6 +46,7 @@ function parseArgs(argv) {
     o[a] = v;
   }
   for (const k of ['url', 'replay', 'shot']) if (!o[k]) usage(`--${k} is required`);
+  if (!o.token !== !o['form-shot']) usage('--token and --form-shot go together');
   o.timeout = Number(o.timeout);
   if (!(o.timeout > 0)) usage('--timeout must be a positive number of seconds');
   if (!/^\d+x\d+$/.test(o.size)) usage('--size must be WxH');
@@ -48,6 +58,72 @@ function usage(msg) { console.error(`dashboard: ${msg}\n${USAGE}`); process.exit
 class Fail extends Error {}
 const fail = (msg) => { throw new Fail(msg); };
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// the page's state as the test sees it
+const visible = (page, sel) => page.locator(sel).isVisible();
+async function waitFor(page, what, cond, ctx) {
+  for (;;) {
+    ctx.checkPageErrors();
+    ctx.checkTime(`waiting for ${what}`);
+    if (await cond()) return;
+    await sleep(100);
+  }
+}
+const randomToken = () => 'rs_' + Array.from({ length: 43 }, () =>
+  'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_'[Math.floor(Math.random() * 64)]).join('');
+
+// the token form, as a first visit to a daemon that needs a token meets it
+async function tokenForm(page, opt, ctx) {
+  await waitFor(page, 'the token form', () => visible(page, '#token-section'), ctx);
+  for (const sel of ['#upload-section', '#jobs-section', '#player-section', '#token-forget']) {
+    if (await visible(page, sel)) fail(`${sel} shows beside the token form`);
+  }
+  if (await page.getAttribute('#token-input', 'type') !== 'password') fail('#token-input is not a password field');
+  // a made-up token: refused, with the server's message, and not kept
+  await page.fill('#token-input', randomToken());
+  await page.click('#token-save');
+  await waitFor(page, 'the refusal of a made-up token',
+    async () => /unknown token/.test(await page.textContent('#token-error')), ctx);
+  if (!(await visible(page, '#token-section')) || await visible(page, '#jobs-section')) {
+    fail('a made-up token took the token form away');
+  }
+  if (await page.evaluate(() => localStorage.getItem('ringside.token')) !== null) fail('the refused token was kept');
+  fs.mkdirSync(path.dirname(path.resolve(opt['form-shot'])), { recursive: true });
+  await page.screenshot({ path: opt['form-shot'], fullPage: true });
+  // the right one: the list comes, the token is kept
+  await page.fill('#token-input', opt.token);
+  await page.click('#token-save');
+  await waitFor(page, 'the job list after saving the token',
+    async () => await visible(page, '#jobs-section') && !(await visible(page, '#token-section')), ctx);
+  if (!(await visible(page, '#token-forget'))) fail('no visible "forget token" with a token stored');
+  if (await page.evaluate(() => localStorage.getItem('ringside.token')) !== opt.token) fail('the token was not stored');
+}
+
+// reload keeps the token (the job's row comes back), "forget token" brings the form back
+async function reloadAndForget(page, id, ctx) {
+  await page.reload({ waitUntil: 'load' });
+  await waitFor(page, `job ${id}'s row after a reload`,
+    () => page.locator(`#jobs tr[data-job-id="${id}"]`).isVisible(), ctx);
+  if (await visible(page, '#token-section')) fail('the token form shows after a reload');
+  await page.click('#token-forget');
+  await waitFor(page, 'the token form after "forget token"', () => visible(page, '#token-section'), ctx);
+  if (await page.locator('#jobs tr').count() !== 0) fail('the job list stays after "forget token"');
+  if (await visible(page, '#token-forget')) fail('"forget token" still shows with no token');
+  if (await page.evaluate(() => localStorage.getItem('ringside.token')) !== null) fail('"forget token" left the token stored');
+}
+
+// the hashes link with a token: fetched with the header, saved from a blob: URL
+async function downloadHashes(page, id) {
+  const [dl] = await Promise.all([
+    page.waitForEvent('download', { timeout: 10_000 }),
+    page.click(`#jobs tr[data-job-id="${id}"] a.download-hashes`),
+  ]);
+  const file = await dl.path();
+  const text = fs.readFileSync(file, 'utf8');
+  if (dl.suggestedFilename() !== `job-${id}.hashes.txt` || !/^0 [0-9a-f]{16}\n/.test(text)) {
+    fail(`the hashes download of job ${id} is ${dl.suggestedFilename()}: ${text.slice(0, 120)}`);
+  }
+}
 
 async function main() {
   const opt = parseArgs(process.argv.slice(2));
@@ -74,10 +150,11 @@ async function main() {
   });
   const pageErrors = [];
   try {
-    const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+    const page = await browser.newPage({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
     page.setDefaultTimeout(Math.max(1000, Math.min(30_000, left())));
     page.on('pageerror', (e) => pageErrors.push(String(e && e.message || e)));
     const checkPageErrors = () => { if (pageErrors.length) fail(`JavaScript error in the page: ${pageErrors[0]}`); };
+    const ctx = { checkPageErrors, checkTime };
 
     // 1. open the page
     let resp;
@@ -87,9 +164,11 @@ async function main() {
       fail(`cannot open ${opt.url}/: ${e.message.split('\n')[0]}`);
     }
     if (!resp || !resp.ok()) fail(`GET ${opt.url}/ answered ${resp ? resp.status() : 'nothing'}`);
-    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-button', '#upload-status', '#jobs', '#player']) {
+    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-button', '#upload-status', '#jobs', '#player',
+      '#token-section', '#token-input', '#token-save', '#token-error', '#token-forget']) {
       if (await page.locator(sel).count() !== 1) fail(`page has no single ${sel}`);
     }
+    if (opt.token) await tokenForm(page, opt, ctx);
 
     // 2. fill in the form
     await page.setInputFiles('#upload-file', opt.replay);
@@ -179,25 +258,39 @@ async function main() {
       checkTime(`waiting for job ${id}'s video to load`);
       meta = await page.evaluate(() => {
         const v = document.getElementById('player');
+        const cap = document.getElementById('player-caption');
         return { fired: window.__rsMeta, w: v.videoWidth, h: v.videoHeight, d: v.duration, src: v.currentSrc,
-          err: v.error ? `code ${v.error.code} ${v.error.message || ''}`.trim() : null };
+          err: v.error ? `code ${v.error.code} ${v.error.message || ''}`.trim() : null,
+          capErr: cap.classList.contains('error') ? cap.textContent : null };
       });
       if (meta.err) fail(`the player cannot load ${meta.src}: ${meta.err}`);
+      if (meta.capErr) fail(`the player says: ${meta.capErr}`);
       if (meta.fired > 0 && meta.w > 0 && meta.d > 0) break;
       await sleep(100);
     }
-    if (!/\/jobs\/\d+\/video$/.test(new URL(meta.src).pathname)) fail(`the player loaded ${meta.src}, not /jobs/${id}/video`);
+    if (opt.token) {
+      if (!meta.src.startsWith('blob:')) fail(`with a token the player loaded ${meta.src}, not a blob: URL`);
+      await downloadHashes(page, id);
+    } else {
+      if (!/\/jobs\/\d+\/video$/.test(new URL(meta.src).pathname)) fail(`the player loaded ${meta.src}, not /jobs/${id}/video`);
+      if (await visible(page, '#token-section') || await visible(page, '#token-forget')) {
+        fail('the token form or "forget token" shows on a daemon that needs no token');
+      }
+    }
 
     // 6. screenshot
     fs.mkdirSync(path.dirname(path.resolve(opt.shot)), { recursive: true });
     await page.screenshot({ path: opt.shot, fullPage: true });
     checkPageErrors();
+    if (opt.token) await reloadAndForget(page, id, ctx);
+    checkPageErrors();
 
     const secs = ((tDone - tUpload) / 1000).toFixed(1);
     const dur = Number.isFinite(meta.d) ? meta.d.toFixed(2) : String(meta.d);
-    console.log(`dashboard ok: job ${id} done in ${secs} s (total ${((Date.now() - t0) / 1000).toFixed(1)} s), ` +
-      `video ${meta.w}x${meta.h} ${opt.format}, duration ${dur} s, progress ${samples} samples ${increases} rises, ` +
-      `shot ${opt.shot}`);
+    console.log(`dashboard ok${opt.token ? ' with a token' : ''}: job ${id} done in ${secs} s ` +
+      `(total ${((Date.now() - t0) / 1000).toFixed(1)} s), ` +
+      `video ${meta.w}x${meta.h} ${opt.format} from ${meta.src.split(':')[0]}:, duration ${dur} s, ` +
+      `progress ${samples} samples ${increases} rises, shot ${opt.shot}${opt.token ? ` and ${opt['form-shot']}` : ''}`);
   } finally {
     await browser.close().catch(() => {});
   }

@@ -1,21 +1,28 @@
 #!/bin/sh
 # The dashboard in a real browser: headless Chromium (Debian's), driven by
 # playwright-core (tests/service/dashboard.mjs), uploads a replay, watches
-# the progress bar reach done and plays the video.  The screenshot lands in
-# $RS_TEST_OUT/dashboard.png.
+# the progress bar reach done and plays the video: once on a loopback daemon
+# that needs no token, once on one that does (the token form, a refused
+# token, the video from a blob: URL, reload, "forget token").  Screenshots
+# land in $RS_TEST_OUT/dashboard*.png.
 here=$(cd "$(dirname "$0")/.." && pwd)
 : "${RS_BIN:=$(dirname "$here")/build/ringside}"
 . "$here/lib.sh"
 . "$here/service/svc_lib.sh"
 trap 'exit 143' TERM INT HUP
 
-t_upload_progress_and_watch() {
+# node, Chromium and playwright-core, or the case is skipped (sets chromium)
+need_browser() {
     command -v node >/dev/null 2>&1 || t_skip_case "node is not installed (the browser test runs playwright-core on Node.js)"
     chromium=$(command -v chromium) || t_skip_case "chromium is not installed (tools/deps.sh service installs it)"
     if [ ! -d "$here/service/node_modules/playwright-core" ]; then
         (cd "$here/service" && npm ci --no-audit --no-fund --loglevel=error) >npm.log 2>&1 ||
             { cat npm.log; echo "npm ci failed (the npm registry must be reachable)"; return 1; }
     fi
+}
+
+t_upload_progress_and_watch() {
+    need_browser || return 1
     "$RS_BIN" record --ai --quiet --seconds 5 --seed 12 --stage temple -o match.rsr || return 1
     svc_start d $SVC_FAST --render-size 320x180 --max-size 640x360 || return 1
     shot=${RS_TEST_OUT:-.}/dashboard.png
@@ -25,5 +32,20 @@ t_upload_progress_and_watch() {
     svc_stop
 }
 
+t_token_form_list_and_watch() {
+    need_browser || return 1
+    "$RS_BIN" record --ai --quiet --seconds 3 --seed 12 --stage temple -o match.rsr || return 1
+    tok=$("$RS_BIN" serve token add alice --data d 2>add.err) || { cat add.err; return 1; }
+    svc_start d $SVC_FAST --render-size 320x180 --max-size 640x360 || return 1
+    grep -q "API tokens required" d.log || { cat d.log; return 1; }
+    out=${RS_TEST_OUT:-.}
+    node "$here/service/dashboard.mjs" --url "$SVC_URL" --replay match.rsr --size 320x180 --format webm \
+        --token "$tok" --form-shot "$out/dashboard-token-form.png" --shot "$out/dashboard-token-list.png" \
+        --chromium "$chromium" --timeout 90 || { tail -20 d.log; return 1; }
+    [ -s "$out/dashboard-token-form.png" ] && [ -s "$out/dashboard-token-list.png" ] || { echo "no screenshots"; return 1; }
+    svc_stop
+}
+
 t_run upload_progress_and_watch
+t_run token_form_list_and_watch
 t_done
