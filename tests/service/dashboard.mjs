@@ -3,7 +3,7 @@
 //
 //   node tests/service/dashboard.mjs --url http://127.0.0.1:PORT --replay FILE.rsr \
 //        --shot OUT.png [--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]
-//        [--token TOKEN --form-shot FORM.png]
+//        [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]
 //
 // Opens the page in headless Chromium, uploads the replay, waits for the job's
 // row to reach data-state="done" (failing fast on "failed"/"cancelled"), checks
@@ -19,6 +19,9 @@
 // the server's message under the form (screenshot FORM.png); TOKEN must bring
 // the list; then the upload as above, the video from a blob: URL, the hashes
 // download; a reload must keep the token, and "forget token" bring the form back.
+// With --quota-token (a token whose quota any upload passes, of another name)
+// that token must then see an empty list (not TOKEN's job) and the upload's
+// 429 message must show as the upload's error.
 //
 // Needs playwright-core (cd tests/service && npm ci) and a Chromium binary
 // (default /usr/bin/chromium, Debian's; or $CHROMIUM / --chromium).  The default
@@ -29,11 +32,11 @@ import fs from 'node:fs';
 import path from 'node:path';
 
 const USAGE = 'usage: node tests/service/dashboard.mjs --url URL --replay FILE --shot OUT.png ' +
-  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH] [--token TOKEN --form-shot FORM.png]';
+  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH] [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]';
 
 function parseArgs(argv) {
   const o = { timeout: 120, size: '320x180', format: 'webm', chromium: process.env.CHROMIUM || '/usr/bin/chromium' };
-  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot']);
+  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot', 'quota-token']);
   for (let i = 0; i < argv.length; i++) {
     let a = argv[i], v;
     if (a === '-h' || a === '--help') { console.log(USAGE); process.exit(0); }
@@ -47,6 +50,7 @@ function parseArgs(argv) {
   }
   for (const k of ['url', 'replay', 'shot']) if (!o[k]) usage(`--${k} is required`);
   if (!o.token !== !o['form-shot']) usage('--token and --form-shot go together');
+  if (o['quota-token'] && !o.token) usage('--quota-token needs --token');
   o.timeout = Number(o.timeout);
   if (!(o.timeout > 0)) usage('--timeout must be a positive number of seconds');
   if (!/^\d+x\d+$/.test(o.size)) usage('--size must be WxH');
@@ -61,10 +65,14 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 // the page's state as the test sees it
 const visible = (page, sel) => page.locator(sel).isVisible();
-async function waitFor(page, what, cond, ctx) {
+// each of these steps takes well under a second when it works
+const STEP_MS = 15_000;
+async function waitFor(page, what, cond, ctx, detail) {
+  const end = Date.now() + STEP_MS;
   for (;;) {
     ctx.checkPageErrors();
     ctx.checkTime(`waiting for ${what}`);
+    if (Date.now() > end) fail(`${what}: not within ${STEP_MS / 1000} s${detail ? ` (${detail()})` : ''}`);
     if (await cond()) return;
     await sleep(100);
   }
@@ -110,6 +118,25 @@ async function reloadAndForget(page, id, ctx) {
   if (await page.locator('#jobs tr').count() !== 0) fail('the job list stays after "forget token"');
   if (await visible(page, '#token-forget')) fail('"forget token" still shows with no token');
   if (await page.evaluate(() => localStorage.getItem('ringside.token')) !== null) fail('"forget token" left the token stored');
+}
+
+// another token over its quota: its own (empty) list, the 429 as the upload's error
+async function overQuota(page, opt, ctx) {
+  await page.fill('#token-input', opt['quota-token']);
+  await page.click('#token-save');
+  await waitFor(page, 'the job list of the quota token', () => visible(page, '#jobs-section'), ctx);
+  await waitFor(page, 'the empty list note', () => visible(page, '#empty'), ctx);
+  if (await page.locator('#jobs tr').count() !== 0) fail('the quota token sees another token\'s jobs');
+  await page.setInputFiles('#upload-file', opt.replay);
+  await page.selectOption('#upload-size', opt.size);
+  await page.selectOption('#upload-format', opt.format);
+  await page.click('#upload-button');
+  let st = '';
+  await waitFor(page, 'the 429 under the upload', async () => {
+    st = await page.textContent('#upload-status');
+    if (/queued as job/.test(st)) fail('an upload over the quota was queued');
+    return /^HTTP 429: .*quota/.test(st);
+  }, ctx, () => `the upload says '${st}'`);
 }
 
 // the hashes link with a token: fetched with the header, saved from a blob: URL
@@ -283,6 +310,7 @@ async function main() {
     await page.screenshot({ path: opt.shot, fullPage: true });
     checkPageErrors();
     if (opt.token) await reloadAndForget(page, id, ctx);
+    if (opt['quota-token']) await overQuota(page, opt, ctx);
     checkPageErrors();
 
     const secs = ((tDone - tUpload) / 1000).toFixed(1);
