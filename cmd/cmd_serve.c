@@ -16,7 +16,8 @@ static void help(void)
 {
     printf("usage: ringside serve [--config FILE] [--listen ADDR:PORT] [--workers N] [--data DIR]\n"
            "                      [--queue sqlite:PATH|postgres://...] [--output DIR] [--SETTING VALUE ...]\n"
-           "                      [--print-config]\n\n"
+           "                      [--print-config]\n"
+           "       ringside serve token add|list|revoke ...   (API tokens: 'ringside serve token --help')\n\n"
            "The replay-to-video service: an HTTP API and dashboard, a durable job queue and\n"
            "worker processes that run 'ringside render'.  Clients upload replays\n"
            "(POST /jobs), watch progress (GET /jobs/ID) and fetch videos (GET /jobs/ID/video);\n"

@@ -96,7 +96,10 @@ t_daemon_killed_and_restarted() {
     wait "$SVC_PID" 2>/dev/null
     # its render died with it (PR_SET_PDEATHSIG): no orphan writes a video
     sleep 0.5
-    if pgrep -f "ringside render d/work/job" >/dev/null; then echo "an orphan render survived"; return 1; fi
+    # (only renders running in this test's directory: other suites may run beside it)
+    for o in $(pgrep -f "ringside render d/work/job"); do
+        [ "$(readlink "/proc/$o/cwd" 2>/dev/null)" = "$PWD" ] && { echo "an orphan render survived: $o"; return 1; }
+    done
     svc_start d $SVC_FAST || return 1
     grep -q "re-queued (its daemon stopped; no attempt charged" d.log ||
         echo "(no job was running at the kill)"
