@@ -60,7 +60,7 @@ static const c_row rows[] = {
     {"cors_origins", C_STR, OFF(cors_origins), 0, 0, sizeof((svc_config *)0)->cors_origins - 1, "", NULL,
      "origins (scheme://host:port, comma-separated) whose web pages may call the API; default none but the "
      "dashboard's own"},
-    {"max_connections", C_INT, OFF(max_connections), 0, 16, 1000000, "10000", NULL,
+    {"max_connections", C_INT, OFF(max_connections), 0, 16, 1000000, "16384", NULL,
      "HTTP connections held at once, from all addresses"},
     {"max_connections_per_ip", C_INT, OFF(max_connections_per_ip), 0, 0, 1000000, "256", NULL,
      "HTTP connections from one address (0: no cap, for a daemon behind a reverse proxy)"},
