@@ -422,8 +422,26 @@ static enum MHD_Result reply_error(struct MHD_Connection *c, int id, const char 
     return reply_json(c, svc_http_status(id), &b);
 }
 
-/* An error answer with one more header (401's WWW-Authenticate, 429's
- * Retry-After). */
+/* An error answer with one more header (header NULL: none): 401's
+ * WWW-Authenticate, 429's Retry-After, 503's Retry-After. */
+static enum MHD_Result send_error(struct MHD_Connection *c, int id, const char *header, const char *value,
+                                  const char *msg)
+{
+    svc_buf b = {0};
+    svc_json_error(&b, msg);
+    struct MHD_Response *r = b.oom ? NULL : MHD_create_response_from_buffer(b.len, b.p, MHD_RESPMEM_MUST_COPY);
+    svc_buf_free(&b);
+    if (!r)
+        return MHD_NO;
+    MHD_add_response_header(r, "Content-Type", "application/json");
+    MHD_add_response_header(r, "Cache-Control", "no-store");
+    if (header)
+        MHD_add_response_header(r, header, value);
+    enum MHD_Result ret = queue(c, svc_http_status(id), r);
+    MHD_destroy_response(r);
+    return ret;
+}
+
 static enum MHD_Result reply_error_header(struct MHD_Connection *c, int id, const char *header, const char *value,
                                           const char *fmt, ...) RS_PRINTF(5, 6);
 static enum MHD_Result reply_error_header(struct MHD_Connection *c, int id, const char *header, const char *value,
@@ -434,18 +452,7 @@ static enum MHD_Result reply_error_header(struct MHD_Connection *c, int id, cons
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    svc_buf b = {0};
-    svc_json_error(&b, msg);
-    struct MHD_Response *r = b.oom ? NULL : MHD_create_response_from_buffer(b.len, b.p, MHD_RESPMEM_MUST_COPY);
-    svc_buf_free(&b);
-    if (!r)
-        return MHD_NO;
-    MHD_add_response_header(r, "Content-Type", "application/json");
-    MHD_add_response_header(r, "Cache-Control", "no-store");
-    MHD_add_response_header(r, header, value);
-    enum MHD_Result ret = queue(c, svc_http_status(id), r);
-    MHD_destroy_response(r);
-    return ret;
+    return send_error(c, id, header, value, msg);
 }
 
 static bool append(req *q, const char *data, size_t n, long limit)
@@ -1088,7 +1095,7 @@ static bool authorize(svc_daemon *d, struct MHD_Connection *c, const char *url, 
 
 /* --- the gate: what every request must pass before it is routed --- */
 
-/* A refusal at the gate, with an optional extra header. */
+/* A refusal at the gate, logged, with an optional extra header. */
 static enum MHD_Result refuse(struct MHD_Connection *c, int id, const char *header, const char *value, const char *fmt,
                               ...) RS_PRINTF(5, 6);
 static enum MHD_Result refuse(struct MHD_Connection *c, int id, const char *header, const char *value, const char *fmt,
@@ -1100,19 +1107,7 @@ static enum MHD_Result refuse(struct MHD_Connection *c, int id, const char *head
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     svc_log(SVC_LOG_INFO, -1, "request refused (%u): %s", svc_http_status(id), msg);
-    svc_buf b = {0};
-    svc_json_error(&b, msg);
-    struct MHD_Response *r = b.oom ? NULL : MHD_create_response_from_buffer(b.len, b.p, MHD_RESPMEM_MUST_COPY);
-    svc_buf_free(&b);
-    if (!r)
-        return MHD_NO;
-    MHD_add_response_header(r, "Content-Type", "application/json");
-    MHD_add_response_header(r, "Cache-Control", "no-store");
-    if (header)
-        MHD_add_response_header(r, header, value);
-    enum MHD_Result ret = queue(c, svc_http_status(id), r);
-    MHD_destroy_response(r);
-    return ret;
+    return send_error(c, id, header, value, msg);
 }
 
 /* The host of a Host header or an allowed_hosts entry, lower case, without

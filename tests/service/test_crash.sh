@@ -63,25 +63,6 @@ t_random_kills_charge_nothing_and_leave_nothing() {
     return $bad
 }
 
-t_failing_render_still_dead_letters() {
-    # a render that crashes every time (SIGKILL to the render process, not
-    # the daemon) is charged each time and ends failed after max_attempts
-    "$RS_BIN" record --ai --quiet --seconds 20 --seed 3 -o long.rsr || return 1
-    svc_start d $SVC_FAST --max-attempts 2 || return 1
-    id=$(svc_submit long.rsr) || return 1
-    for attempt in 1 2; do
-        i=0
-        until [ "$(svc_field "$id" attempts)" = $attempt ] && w=$(svc_worker_pid "$SVC_PID" "$id"); do
-            sleep 0.2; i=$((i + 1)); [ $i -lt 150 ] || { echo "attempt $attempt did not start"; return 1; }
-        done
-        sleep 0.3
-        kill -KILL "$w"
-    done
-    svc_wait_state "$id" failed 30 || return 1
-    svc_field "$id" error | grep -q "gave up after 2 attempts" || { svc_field "$id" error; return 1; }
-    svc_stop
-}
-
 t_lost_daemon_is_bounded() {
     # a job whose unit keeps losing its daemon is failed at SVC_LOST_MAX
     # lost leases, with a true reason (the count is made to look as if
@@ -129,6 +110,6 @@ t_retention_and_delete() {
     svc_stop
 }
 
-t_run ${T_ONLY:-random_kills_charge_nothing_and_leave_nothing failing_render_still_dead_letters lost_daemon_is_bounded \
+t_run ${T_ONLY:-random_kills_charge_nothing_and_leave_nothing lost_daemon_is_bounded \
     retention_and_delete}
 t_done
