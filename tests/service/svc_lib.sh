@@ -134,3 +134,16 @@ svc_no_leftovers() { # ID [OUTPUT_DIR]
         [ $i -lt 30 ] || { echo "job $1 left files:"; ls -laR "$out"; return 1; }
     done
 }
+
+# A case on a throwaway PostgreSQL server (tests/pg.sh): starts it, stops it
+# when the case ends (ON_EXIT, default pg_stop, runs then), skips the case
+# where PostgreSQL is not installed.  Sets PG_URI.
+svc_pg_case() {
+    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
+    SVC_ON_EXIT=${1:-pg_stop}
+    trap svc_cleanup EXIT
+    pg_start "$pgdir"
+    rc=$?
+    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
+    [ "$rc" = 0 ] || return 1
+}

@@ -9,13 +9,7 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 trap 'exit 143' TERM INT HUP
 
 t_two_daemons_share_one_queue() {
-    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
-    SVC_ON_EXIT=pg_stop
-    trap svc_cleanup EXIT
-    pg_start "$pgdir"
-    rc=$?
-    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
-    [ "$rc" = 0 ] || return 1
+    svc_pg_case || return 1
     svc_replays r 20 1 || return 1
     # two machines in miniature: own data directories, one queue, one
     # shared output directory
@@ -59,13 +53,7 @@ t_two_daemons_share_one_queue() {
 }
 
 t_lease_of_a_dead_daemon_expires() {
-    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
-    SVC_ON_EXIT=pg_stop
-    trap svc_cleanup EXIT
-    pg_start "$pgdir"
-    rc=$?
-    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
-    [ "$rc" = 0 ] || return 1
+    svc_pg_case || return 1
     "$RS_BIN" record --ai --quiet --seconds 8 --seed 4 -o long.rsr || return 1
     mkdir -p shared
     svc_start a $SVC_FAST --queue "$PG_URI" --output shared || return 1
@@ -86,13 +74,7 @@ t_lease_of_a_dead_daemon_expires() {
 # One split job, two daemons: each renders some of its segments; then one
 # dies mid-job and the other finishes it without redoing finished segments.
 t_segments_of_one_job_on_both_daemons() {
-    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
-    SVC_ON_EXIT=pg_stop
-    trap svc_cleanup EXIT
-    pg_start "$pgdir"
-    rc=$?
-    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
-    [ "$rc" = 0 ] || return 1
+    svc_pg_case || return 1
     "$RS_BIN" record --ai --quiet --stage dojo --seconds 6 --seed 21 -o six.rsr || return 1
     "$RS_BIN" render six.rsr -o direct.mp4 --render-size 160x90 --size 160x90 --hashes direct.hashes --quiet || return 1
     mkdir -p shared

@@ -18,14 +18,8 @@ pg_pids() {
 }
 
 t_stalled_server_does_not_stall_the_daemon() {
-    pgdir=$(mktemp -d "${TMPDIR:-/tmp}/ringside-pg-XXXXXX") || return 1
     pg_cont() { [ -n "${stopped:-}" ] && kill -CONT $stopped 2>/dev/null; pg_stop; }
-    SVC_ON_EXIT=pg_cont
-    trap svc_cleanup EXIT
-    pg_start "$pgdir"
-    rc=$?
-    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
-    [ "$rc" = 0 ] || return 1
+    svc_pg_case pg_cont || return 1
     "$RS_BIN" record --ai --quiet --seconds 2 --seed 4 -o g.rsr || return 1
     # lease 6: statements time out after 2 s, a call waits at most 3 s
     svc_start a $SVC_FAST --queue "$PG_URI" --lease 6 || return 1
