@@ -5,13 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_out.h"
 #include "cap_sink.h" /* CAP_ERRORS */
 
 bool cap_out_is_stream(const char *path)
 {
-    struct stat st; /* stat follows links: /dev/stdout is whatever fd 1 is */
-    return stat(path, &st) == 0 && (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode));
+    return rs_out_is_stream(path);
 }
 
 bool cap_out_open(cap_out *o, const char *path, rs_err *err)
@@ -19,16 +18,22 @@ bool cap_out_open(cap_out *o, const char *path, rs_err *err)
     memset(o, 0, sizeof *o);
     snprintf(o->path, sizeof o->path, "%s", path);
     o->device = cap_out_is_stream(path);
-    struct stat st;
-    if (!o->device && stat(path, &st) == 0 && !S_ISREG(st.st_mode))
-        return rs_fail(err, CAP_ERR_CREATE, "%s: exists and is not a regular file (nor a device or pipe to stream to)", path);
-    snprintf(o->tmp, sizeof o->tmp, o->device ? "%s" : "%s.part", path);
-    if (!o->device && !rs_mkdirs_for(path, err)) {
+    /* the folder must exist (named in the message, never the .part name);
+     * whether an existing output may be replaced is the command's check */
+    if (!o->device && !rs_out_check(path, true, err)) {
         if (err)
-            err->code = CAP_ERR_CREATE; /* rs_file's failure, as one of ours */
+            err->code = CAP_ERR_CREATE; /* rs_out's failure, as one of ours */
         return false;
     }
-    o->f = fopen(o->tmp, "wb");
+    snprintf(o->tmp, sizeof o->tmp, o->device ? "%s" : "%s.part", path);
+    if (!strcmp(path, "-")) { /* standard output: a copy of fd 1, so closing it leaves stdout alone */
+        int fd = dup(1);
+        o->f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+        if (!o->f && fd >= 0)
+            close(fd);
+    } else {
+        o->f = fopen(o->tmp, "wb");
+    }
     if (!o->f)
         return rs_fail(err, CAP_ERR_CREATE, "%s: cannot create: %s", o->tmp, strerror(errno));
     setvbuf(o->f, NULL, _IOFBF, 1 << 20);

@@ -1,6 +1,6 @@
 /* The output file of a sink: "<path>.part" until commit renames it, or the
- * path itself when it is a stream (/dev/null, /dev/full, a pipe such as
- * /dev/stdout): nothing to rename. */
+ * path itself when it is a stream ("-" for standard output, /dev/null,
+ * /dev/full, a pipe such as /dev/stdout): nothing to rename. */
 #ifndef CAP_OUT_H
 #define CAP_OUT_H
 
@@ -16,7 +16,7 @@ typedef struct cap_out {
 } cap_out;
 
 bool cap_out_open(cap_out *o, const char *path, rs_err *err);
-/* An existing character device, pipe or socket: written in place, never renamed. */
+/* "-", or an existing character device, pipe or socket: written in place, never renamed. */
 bool cap_out_is_stream(const char *path);
 bool cap_out_write(cap_out *o, const void *data, size_t n, rs_err *err);
 /* ok: flush, fsync, rename into place; !ok: close and remove. */

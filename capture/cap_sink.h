@@ -83,12 +83,21 @@ struct cap_sink {
      * timestamps start at index_base too, the first frame is a keyframe
      * and no frame refers outside the file (closed GOP) */
     bool segment;
+    /* the container, lower case with its dot (".mp4", ".nut"), from the
+     * name's extension or --format: sinks go by it, not by the name */
+    char ext[8];
 };
 
 /* Picks the sink from the output's extension (.y4m, .mp4, .mkv, .webm,
- * name%06d.png|.exr|.tif) and checks it can work (the encoder exists) before
- * anything is rendered.  Does not create the file yet: that is open(). */
+ * name%06d.png|.exr|.tif, any case) and checks it can work (the encoder
+ * exists) before anything is rendered.  Does not create the file yet: that
+ * is open(). */
 bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err);
+/* The same, with the container named by format ("y4m", "nut", "mkv",
+ * "mp4", "webm"; NULL: from the extension).  path "-" is standard output:
+ * Y4M unless format says otherwise; MP4 is refused there (its index is
+ * written last, by seeking back). */
+bool cap_sink_for_format(const char *path, const char *format, int w, int h, cap_sink *s, rs_err *err);
 
 /* Human-readable list of what this build can write. */
 const char *cap_sink_formats(void);

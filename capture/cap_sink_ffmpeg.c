@@ -20,6 +20,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "cap_out.h"
 #include "cap_sink.h"
 
 typedef struct ff_impl {
@@ -29,11 +30,12 @@ typedef struct ff_impl {
     AVFrame *frame;
     AVPacket *pkt;
     char part[1100];
+    bool stream; /* "-" (fd 1), a device or a pipe: written in place, no .part, no rename */
 } ff_impl;
 
 static const char *container(const char *ext)
 {
-    return !strcmp(ext, ".mkv") ? "matroska" : !strcmp(ext, ".webm") ? "webm" : "mp4";
+    return !strcmp(ext, ".mkv") ? "matroska" : !strcmp(ext, ".webm") ? "webm" : !strcmp(ext, ".nut") ? "nut" : "mp4";
 }
 
 static const char *encoder_name(const char *ext)
@@ -90,8 +92,9 @@ static bool ff_open(cap_sink *s, rs_err *err)
     if (!f)
         return rs_fail(err, CAP_ERR_NOMEM, "out of memory");
     s->impl = f;
-    const char *ext = ext_of(s->path);
-    snprintf(f->part, sizeof f->part, "%s.part", s->path);
+    const char *ext = s->ext[0] ? s->ext : ext_of(s->path);
+    f->stream = cap_out_is_stream(s->path);
+    snprintf(f->part, sizeof f->part, !strcmp(s->path, "-") ? "pipe:1" : f->stream ? "%s" : "%s.part", s->path);
     const AVCodec *codec = avcodec_find_encoder_by_name(encoder_name(ext));
     int r = avformat_alloc_output_context2(&f->fmt, NULL, container(ext), f->part);
     if (r < 0 || !codec) {
@@ -210,9 +213,9 @@ static bool ff_close(cap_sink *s, bool ok, rs_err *err)
         if (good && perr < 0)
             good = fail_av(err, CAP_ERR_WRITE, s->path, "write failed", perr);
     }
-    if (good && rename(f->part, s->path) != 0)
+    if (good && !f->stream && rename(f->part, s->path) != 0)
         good = rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename %s into place", s->path, f->part);
-    if (!good)
+    if (!good && !f->stream)
         unlink(f->part);
     av_packet_free(&f->pkt);
     av_frame_free(&f->frame);

@@ -5,9 +5,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
-#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_oiio.h"
 #include "cap_sink.h"
 
@@ -35,7 +36,7 @@ bool cap_images_pattern_ok(const char *path, const char **ext)
     if (!dot || dot < q)
         return false;
     *ext = dot;
-    return !strcmp(dot, ".png") || !strcmp(dot, ".exr") || !strcmp(dot, ".tif") || !strcmp(dot, ".tiff");
+    return !strcasecmp(dot, ".png") || !strcasecmp(dot, ".exr") || !strcasecmp(dot, ".tif") || !strcasecmp(dot, ".tiff");
 }
 
 static void frame_path(const cap_sink *s, uint64_t index, char *out, size_t n)
@@ -54,13 +55,18 @@ static bool img_open(cap_sink *s, rs_err *err)
         return rs_fail(err, CAP_ERR_OUTPUT, "%s: expected an image sequence pattern like name%%06d.png", s->path);
     }
     snprintf(q->ext, sizeof q->ext, "%s", ext);
+    for (char *c = q->ext; *c; c++) /* F%04d.PNG is a PNG */
+        if (*c >= 'A' && *c <= 'Z')
+            *c = (char)(*c - 'A' + 'a');
     s->impl = q;
     char first[1100];
     frame_path(s, 0, first, sizeof first);
-    if (rs_mkdirs_for(first, err))
+    /* the folder must exist, as for every output kind (rs_out.h); whether
+     * frames may be overwritten is the command's check, made before this */
+    if (rs_out_check(first, true, err))
         return true;
     if (err)
-        err->code = CAP_ERR_CREATE; /* rs_file's failure, as one of ours */
+        err->code = CAP_ERR_CREATE; /* rs_out's failure, as one of ours */
     return false;
 }
 

@@ -11,6 +11,7 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_stage.h"
+#include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_progress.h"
 
 void cli_error(const char *cmd, const char *fmt, ...)
@@ -137,5 +138,45 @@ bool cli_passes(const char *cmd, const char *arg, int *mode)
         cli_error(cmd, "--passes='%s': expected summary or frames", arg);
         return false;
     }
+    return true;
+}
+
+bool cli_out_ok(const char *cmd, const char *path, bool overwrite)
+{
+    rs_err err = {0};
+    if (rs_out_check(path, overwrite, &err))
+        return true;
+    cli_error(cmd, "%s", err.msg);
+    return false;
+}
+
+FILE *cli_text_open(const char *cmd, const char *path, bool overwrite)
+{
+    if (!strcmp(path, "-"))
+        return stdout;
+    if (!cli_out_ok(cmd, path, overwrite))
+        return NULL;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        cli_error(cmd, "%s: cannot create: %s", path, strerror(errno));
+    return f;
+}
+
+bool cli_text_close(const char *cmd, const char *path, FILE *f)
+{
+    bool ok = f == stdout ? fflush(f) == 0 && !ferror(f) : fclose(f) == 0;
+    if (!ok)
+        cli_error(cmd, "%s: write failed", path);
+    return ok;
+}
+
+bool cli_progress_mode(const char *cmd, const char *arg, int *mode)
+{
+    rs_progress_mode m;
+    if (!rs_progress_parse(arg, &m)) {
+        cli_error(cmd, "--progress '%s': expected tty, plain or off", arg);
+        return false;
+    }
+    *mode = (int)m;
     return true;
 }

@@ -4,6 +4,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 
 /* 3: join only, one or more segments are bad (they are to be rendered again) */
 enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2, RS_EXIT_SEGMENT = 3 };
@@ -60,5 +61,17 @@ bool cli_passes(const char *cmd, const char *arg, int *mode);
 
 /* Stage by name ("dojo") or number; prints a usage error on failure. */
 bool cli_stage(const char *arg, int *stage);
+
+/* Output rules (runtime/util/rs_out.h) for a command's user-named output:
+ * prints "ringside CMD: PATH: exists (use -y to overwrite)" or the folder
+ * that is missing, and returns false. */
+bool cli_out_ok(const char *cmd, const char *path, bool overwrite);
+/* A text output option (--hashes, --csv ...): "-" is standard output;
+ * anything else is checked by cli_out_ok and created.  NULL after printing
+ * the error.  Close with cli_text_close, which reports a failed write. */
+FILE *cli_text_open(const char *cmd, const char *path, bool overwrite);
+bool cli_text_close(const char *cmd, const char *path, FILE *f);
+/* --progress tty|plain|off; prints a usage error naming the command. */
+bool cli_progress_mode(const char *cmd, const char *arg, int *mode);
 
 #endif
