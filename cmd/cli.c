@@ -150,6 +150,18 @@ bool cli_out_ok(const char *cmd, const char *path, bool overwrite)
     return false;
 }
 
+bool cli_pattern_ok(const char *cmd, const char *pattern, uint64_t first, uint64_t end, bool overwrite)
+{
+    /* the pattern was checked by cap_sink_for: one %d or %0Nd and nothing else */
+    for (uint64_t i = first; i < end; i++) {
+        char name[1100];
+        snprintf(name, sizeof name, pattern, (int)i);
+        if (!cli_out_ok(cmd, name, overwrite))
+            return false;
+    }
+    return true;
+}
+
 FILE *cli_text_open(const char *cmd, const char *path, bool overwrite)
 {
     if (!strcmp(path, "-"))

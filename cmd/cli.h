@@ -70,6 +70,9 @@ bool cli_out_ok(const char *cmd, const char *path, bool overwrite);
  * anything else is checked by cli_out_ok and created.  NULL after printing
  * the error.  Close with cli_text_close, which reports a failed write. */
 FILE *cli_text_open(const char *cmd, const char *path, bool overwrite);
+/* An image pattern's outputs: the folder of its names, and every name of
+ * frames first..end-1 (any one that exists is refused without overwrite). */
+bool cli_pattern_ok(const char *cmd, const char *pattern, uint64_t first, uint64_t end, bool overwrite);
 bool cli_text_close(const char *cmd, const char *path, FILE *f);
 /* --progress tty|plain|off; prints a usage error naming the command. */
 bool cli_progress_mode(const char *cmd, const char *arg, int *mode);

@@ -27,15 +27,23 @@ static void help(void)
            "                       [--capture async|sequential] [--downscale gpu|cpu] [--filter F]\n"
            "                       [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
+           "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
            "                       [--ticks A:B] [--segment KEY] [--progress-fd N]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
-           "(60 frames a second, exact).  The output type comes from the extension:\n"
-           "%s.\n"
+           "(60 frames a second, exact).  The output type comes from the extension (any\n"
+           "case) or --format: %s.\n"
            "The output appears only when complete; a failed render leaves nothing.\n\n"
-           "  -o OUT             output file ('/dev/null' and other devices are streamed), or an\n"
-           "                     image sequence pattern such as frames/f%%06d.png\n"
+           "  -o OUT             output file ('/dev/null' and other devices are streamed), an\n"
+           "                     image sequence pattern such as frames/f%%06d.png, or '-': a\n"
+           "                     stream on standard output (Y4M unless --format says nut or mkv)\n"
+           "  --format F         the container when the name does not say it: y4m, nut, mkv,\n"
+           "                     mp4 (not to a pipe: its index goes last) or webm\n"
+           "  -y, --overwrite    replace outputs that exist (video, images, --hashes, manifest)\n"
+           "  -n, --no-overwrite never replace them: an existing output is refused, naming it,\n"
+           "                     and nothing is written.  The default: ringside never asks,\n"
+           "                     on a terminal or off it.  The output's folder must exist\n"
            "  --size WxH         output size, even numbers (default 640x360)\n"
            "  --render-size WxH  size the game is drawn at (default 1280x720)\n"
            "  --capture MODE     async (default): GPU downscale, PBO ring, writer thread;\n"
@@ -46,6 +54,7 @@ static void help(void)
            "  --pbo N            pixel-buffer ring size, 1..%d (default %d)\n"
            "  --queue N          writer queue cap in frames, 0..1000 (default %d; 0: no thread)\n"
            "  --hashes FILE      write \"frame hash\" (64-bit FNV-1a of the frame bytes) per frame\n"
+           "                     ('-' for standard output, unless -o - is there)\n"
            "  --backend B        GL backend (default egl, falling back to osmesa)\n"
            "  --stage-file FILE  the look to use instead of stages/<replay's stage>.stage\n"
            "                     (docs/stages.md)\n"
@@ -68,7 +77,10 @@ static void help(void)
            "  --progress-fd N    also report progress on file descriptor N, for programs\n"
            "                     (ringside serve): 'frames DONE TOTAL' lines, and 'desync TICK'\n"
            "                     if the replay's state hashes stop matching\n"
-           "  --quiet            no progress line\n"
+           "  --progress MODE    tty: one line redrawn in place; plain: a line every 5 s and\n"
+           "                     the last, for logs; off.  Default: tty when stderr is a\n"
+           "                     terminal, else plain\n"
+           "  --quiet            no progress line (--progress off) and no summary\n"
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
@@ -98,8 +110,12 @@ int cmd_render(int argc, char **argv)
         {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
         {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
         {"segment", required_argument, 0, 'S'},    {"help", no_argument, 0, 'h'},
+        {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
+        {"format", required_argument, 0, 'f'},     {"progress", required_argument, 0, 'g'},
         {0}};
-    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL;
+    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL;
+    bool overwrite = false;
+    int progress = RS_PROGRESS_AUTO;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
     r_game_opts go = {0};
@@ -110,7 +126,7 @@ int cmd_render(int argc, char **argv)
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
         case 's': if (!cli_size("--size", optarg, 8192, &cd.w, &cd.h)) return RS_EXIT_USAGE; break;
@@ -192,6 +208,10 @@ int cmd_render(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
+        case 'f': format = optarg; break;
+        case 'g': if (!cli_progress_mode("render", optarg, &progress)) return RS_EXIT_USAGE; break;
         default: return cli_bad_option("render", argv);
         }
     }
@@ -206,6 +226,14 @@ int cmd_render(int argc, char **argv)
     }
     const char *replay = argv[optind];
     rs_err err = {0};
+    if (!strcmp(out, "-") && hashes && !strcmp(hashes, "-")) {
+        cli_error("render", "-o - and --hashes - both write to standard output: give --hashes a file");
+        return RS_EXIT_USAGE;
+    }
+    if (!strcmp(out, "-") && isatty(1)) {
+        cli_error("render", "-o -: standard output is a terminal; pipe it into a program or a file");
+        return RS_EXIT_USAGE;
+    }
     cap_pixfmt fmt = strchr(out, '%') ? CAP_RGBA : CAP_I420;
     if (go.mask && fmt != CAP_RGBA) {
         cli_error("render", "--mask writes RGBA images: give -o an image pattern such as cut/f%%04d.png, not %s", out);
@@ -259,8 +287,16 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     uint64_t t_first = (uint64_t)first, t_end = end < 0 ? rp.ticks : (uint64_t)end;
-    if (!cap_sink_for(out, cd.w, cd.h, &sink, &err))
+    if (!cap_sink_for_format(out, format, cd.w, cd.h, &sink, &err))
         goto done;
+    /* every output this render writes, checked before anything is touched */
+    if (!(sink.fmt == CAP_RGBA ? cli_pattern_ok("render", out, t_first, t_end, overwrite)
+                               : cli_out_ok("render", out, overwrite)) ||
+        (hashes && strcmp(hashes, "-") && !cli_out_ok("render", hashes, overwrite)) ||
+        (segment && !cli_out_ok("render", seg_manifest, overwrite))) {
+        err.msg[0] = 0; /* said */
+        goto done;
+    }
     sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
     sink.segment = segment != NULL;
     /* a manifest says "complete": an older one must not vouch for the files this render replaces */
@@ -268,16 +304,12 @@ int cmd_render(int argc, char **argv)
         rs_fail(&err, 1, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
         goto done;
     }
-    struct stat hst;
-    if (hashes && stat(hashes, &hst) == 0 && !S_ISREG(hst.st_mode)) {
-        rs_fail(&err, 1, "%s: exists and is not a regular file (--hashes)", hashes);
-        goto done;
-    }
-    if (hashes) {
+    if (hashes && !strcmp(hashes, "-")) {
+        cd.hashes = stdout;
+    } else if (hashes) {
         snprintf(hpart, sizeof hpart, "%s.part", hashes);
-        if (!rs_mkdirs_for(hashes, &err) || !(hf = fopen(hpart, "w"))) {
-            if (!err.msg[0])
-                rs_fail(&err, 1, "%s: cannot create", hpart);
+        if (!(hf = fopen(hpart, "w"))) {
+            rs_fail(&err, 1, "%s: cannot create: %s", hpart, strerror(errno));
             goto done;
         }
         cd.hashes = hf;
@@ -297,7 +329,7 @@ int cmd_render(int argc, char **argv)
         goto done;
 
     rs_progress prog;
-    rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet);
+    rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
     double last_report = 0;
     cli_progress_fd((int)progress_fd, 0, t_end - t_first, &last_report);
     job_render j;
@@ -332,6 +364,10 @@ int cmd_render(int argc, char **argv)
     cap_stats st;
     if (!cap_close(cp, ok, &st, &err))
         goto done;
+    if (cd.hashes == stdout && fflush(stdout) != 0) {
+        rs_fail(&err, 1, "--hashes -: write failed");
+        goto done;
+    }
     if (hf) {
         bool hok = fclose(hf) == 0;
         hf = NULL;
@@ -370,7 +406,7 @@ int cmd_render(int argc, char **argv)
 done:
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
-    if (status != RS_EXIT_OK)
+    if (status != RS_EXIT_OK && err.msg[0])
         cli_error("render", "%s", err.msg);
     if (hf)
         fclose(hf);
