@@ -65,7 +65,9 @@ cap_join *cap_join_open(const cap_join_desc *d, rs_err *err)
         fail_av(err, CAP_ERR_CREATE, j->part, "cannot create", r);
         goto fail;
     }
-    if (d->hashes) {
+    if (d->hashes && !strcmp(d->hashes, "-")) {
+        j->hf = stdout; /* --hashes -: written as it goes, nothing to rename */
+    } else if (d->hashes) {
         snprintf(j->hpart, sizeof j->hpart, "%s.part", d->hashes);
         if (!(j->hf = fopen(j->hpart, "w"))) {
             rs_fail(err, CAP_ERR_CREATE, "%s: cannot create: %s", j->hpart, strerror(errno));
@@ -240,7 +242,11 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
     }
     if (good && !sync_file(j->part))
         good = rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", j->d.out, strerror(errno));
-    if (j->hf) {
+    if (j->hf == stdout) {
+        j->hf = NULL;
+        if (fflush(stdout) != 0 && good)
+            good = rs_fail(err, CAP_ERR_WRITE, "--hashes -: write failed: %s", strerror(errno));
+    } else if (j->hf) {
         errno = 0;
         bool hok = fflush(j->hf) == 0 && fsync(fileno(j->hf)) == 0;
         int e = errno;
@@ -255,7 +261,7 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
     }
     if (good && rename(j->part, j->d.out) != 0) {
         good = rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename %s into place: %s", j->d.out, j->part, strerror(errno));
-        if (j->d.hashes)
+        if (j->d.hashes && strcmp(j->d.hashes, "-"))
             unlink(j->d.hashes); /* no list without its video */
     }
     if (!good) {

@@ -14,8 +14,8 @@
 
 static void help(void)
 {
-    printf("usage: ringside join --segment KEY -o OUT [--hashes FILE] [--first T]\n"
-           "                     [--progress-fd N] [--quiet] SEG...\n\n"
+    printf("usage: ringside join --segment KEY -o OUT [-y|-n] [--hashes FILE] [--first T]\n"
+           "                     [--progress-fd N] [--progress tty|plain|off] [--quiet] SEG...\n\n"
            "Joins segments written by 'ringside render --ticks A:B --segment KEY' into one\n"
            "video by stream copy (no re-encoding): .mp4 (index at the front), .mkv or .webm,\n"
            "as OUT's extension says, with the segments' own format.  SEG... in tick order.\n\n"
@@ -26,12 +26,17 @@ static void help(void)
            "OUT and its hash list appear only when complete.\n\n"
            "  --segment KEY     the job's key: segments with another key are never joined\n"
            "  -o OUT            the video (its directory must exist)\n"
+           "  -y, --overwrite   replace OUT and the --hashes file if they exist\n"
+           "  -n, --no-overwrite  refuse them, naming the file (the default; never asks)\n"
            "  --hashes FILE     also write the segments' --hashes lists, concatenated\n"
-           "                    (one line per frame, as 'render --hashes' of the whole video)\n"
+           "                    (one line per frame, as 'render --hashes' of the whole video;\n"
+           "                    '-' for standard output)\n"
            "  --first T         the first segment starts at tick T (default 0)\n"
            "  --progress-fd N   report on file descriptor N, for programs (ringside serve):\n"
            "                    'bad INDEX REASON MESSAGE' for each bad segment (INDEX: its\n"
            "                    position in SEG..., from 0), then 'frames DONE TOTAL' lines\n"
+           "  --progress MODE   tty (a line redrawn in place), plain (a line every 5 s and\n"
+           "                    the last, for logs) or off; default tty on a terminal, else plain\n"
            "  --quiet           no progress line\n\n"
            "exit status: 0 joined; 1 the output failed (directory gone, disk full), nothing\n"
            "left; 2 bad usage; 3 one or more segments are bad (each named on stderr and in a\n"
@@ -83,15 +88,18 @@ int cmd_join(int argc, char **argv)
         {"output", required_argument, 0, 'o'},     {"segment", required_argument, 0, 'S'},
         {"hashes", required_argument, 0, 'H'},     {"first", required_argument, 0, 'f'},
         {"progress-fd", required_argument, 0, 'G'}, {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},             {0}};
+        {"help", no_argument, 0, 'h'},
+        {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
+        {"progress", required_argument, 0, 'g'},   {0}};
     const char *out = NULL, *key = NULL, *hashes = NULL;
     uint64_t first = 0;
     long progress_fd = -1;
-    bool quiet = false;
+    bool quiet = false, overwrite = false;
+    int progress = RS_PROGRESS_AUTO;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
         case 'S': key = optarg; break;
@@ -100,6 +108,9 @@ int cmd_join(int argc, char **argv)
         case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
+        case 'g': if (!cli_progress_mode("join", optarg, &progress)) return RS_EXIT_USAGE; break;
         default: return cli_bad_option("join", argv);
         }
     }
@@ -117,6 +128,8 @@ int cmd_join(int argc, char **argv)
         cli_error("join", "no segments given");
         return cli_usage_error("join");
     }
+    if (!cli_out_ok("join", out, overwrite) || (hashes && strcmp(hashes, "-") && !cli_out_ok("join", hashes, overwrite)))
+        return RS_EXIT_FAIL;
     int n = argc - optind;
     char *const *paths = argv + optind;
     join_report rep = {.fd = (int)progress_fd};
@@ -151,7 +164,7 @@ int cmd_join(int argc, char **argv)
     uint64_t total = 0;
     for (int i = 0; i < n; i++)
         total += segs[i].m.frames;
-    rs_progress_start(&rep.prog, "join", "frames", total, quiet);
+    rs_progress_start(&rep.prog, "join", "frames", total, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
     cli_progress_fd(rep.fd, 0, total, &rep.last);
     int bad = -1;
     bool ok = cap_join_copy(j, segs, n, &bad, &err);

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "../player/mv_csp.h"
 #include "../player/mv_player.h"
@@ -22,10 +23,11 @@
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
+#include "../runtime/util/rs_out.h"
 
 static void help(void)
 {
-    printf("usage: ringside movie FILE [--dump DIR] [--hashes FILE] [--headless] [--ticks N]\n"
+    printf("usage: ringside movie FILE [--dump DIR] [--hashes FILE] [-y|-n] [--headless] [--ticks N]\n"
            "                      [--upload pbo|direct|persistent] [--matrix bt601|bt709]\n"
            "                      [--range limited|full] [--size WxH] [--fullscreen] [--loop] [--quiet]\n\n"
            "Plays a movie on the 60 Hz tick: Y4M (8-bit 4:2:0, 4:2:2, 4:4:4, mono) or anything\n"
@@ -35,7 +37,11 @@ static void help(void)
            "In a window (GLFW; needs X, or xvfb-run -a) Escape quits.\n\n"
            "  --dump DIR      headless: write each displayed frame as DIR/frameNNNNNN.ppm (NNNNNN is\n"
            "                  the movie frame number)\n"
-           "  --hashes FILE   headless: one line per tick: TICK FRAME HASH (FNV-1a of the RGB image)\n"
+           "  --hashes FILE   headless: one line per tick: TICK FRAME HASH (FNV-1a of the RGB image);\n"
+           "                  '-' for standard output\n"
+           "  -y, --overwrite replace an existing --hashes file or dumped frame\n"
+           "  -n, --no-overwrite  refuse them, naming the file (the default; never asks).  The\n"
+           "                  folder of --hashes, and the one above --dump DIR, must exist\n"
            "  --headless      no window: EGL/OSMesa, every tick as fast as possible\n"
            "  --ticks N       stop after N ticks (default: the end of the movie)\n"
            "  --upload MODE   pbo (two unpack buffers in ping-pong; default), direct (glTexSubImage2D\n"
@@ -55,7 +61,7 @@ typedef struct mv_cmd {
     plat *p;
     r_target target;
     int w, h;
-    bool headless, loop, failed, quit;
+    bool headless, loop, failed, quit, overwrite;
     int64_t limit, ticks, last_dumped;
     const char *dump;
     FILE *hashes;
@@ -106,7 +112,7 @@ static bool write_outputs(mv_cmd *s)
     if (s->dump && frame >= 0 && frame != s->last_dumped) {
         char path[1100];
         snprintf(path, sizeof path, "%s/frame%06" PRId64 ".ppm", s->dump, frame);
-        if (!rs_image_write(path, s->w, s->h, 3, s->px, &s->err))
+        if (!rs_out_check(path, s->overwrite, &s->err) || !rs_image_write(path, s->w, s->h, 3, s->px, &s->err))
             return false;
         s->last_dumped = frame;
     }
@@ -174,11 +180,12 @@ int cmd_movie(int argc, char **argv)
 {
     static const struct option opts[] = {
         {"dump", required_argument, 0, 'd'},    {"hashes", required_argument, 0, 'x'},
-        {"headless", no_argument, 0, 'H'},      {"ticks", required_argument, 0, 'n'},
+        {"headless", no_argument, 0, 'H'},      {"ticks", required_argument, 0, 't'},
         {"upload", required_argument, 0, 'u'},  {"matrix", required_argument, 0, 'm'},
         {"range", required_argument, 0, 'r'},   {"size", required_argument, 0, 'z'},
         {"fullscreen", no_argument, 0, 'f'},    {"loop", no_argument, 0, 'L'},
         {"quiet", no_argument, 0, 'q'},         {"help", no_argument, 0, 'h'},
+        {"overwrite", no_argument, 0, 'y'},     {"no-overwrite", no_argument, 0, 'n'},
         {0}};
     mv_cmd *s = calloc(1, sizeof *s);
     if (!s)
@@ -191,12 +198,12 @@ int cmd_movie(int argc, char **argv)
     plat_desc pd = {.title = "ringside movie"};
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'd': s->dump = optarg; s->headless = true; break;
         case 'x': hashes = optarg; s->headless = true; break;
         case 'H': s->headless = true; break;
-        case 'n':
+        case 't':
             if (!cli_int("--ticks", optarg, 1, 1L << 40, &n))
                 goto done;
             s->limit = n;
@@ -231,6 +238,8 @@ int cmd_movie(int argc, char **argv)
         case 'f': pd.fullscreen = true; break;
         case 'L': s->loop = true; break;
         case 'q': quiet = true; break;
+        case 'y': s->overwrite = true; break;
+        case 'n': s->overwrite = false; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
             status = cli_bad_option("movie", argv);
@@ -246,20 +255,15 @@ int cmd_movie(int argc, char **argv)
     s->path = argv[optind];
     s->po.wait = s->headless;
     status = RS_EXIT_FAIL;
-    if (s->dump) {
-        char probe[1100];
-        snprintf(probe, sizeof probe, "%s/.", s->dump);
-        if (!rs_mkdirs_for(probe, &s->err))
-            goto done;
+    struct stat dst;
+    /* --dump DIR is created, as an output is, when the folder it is in exists */
+    if (s->dump && stat(s->dump, &dst) != 0 && (!rs_out_check(s->dump, false, &s->err) || mkdir(s->dump, 0777) != 0)) {
+        if (!s->err.msg[0])
+            rs_fail(&s->err, 1, "%s: cannot create: %s", s->dump, strerror(errno));
+        goto done;
     }
-    if (hashes) {
-        if (!rs_mkdirs_for(hashes, &s->err))
-            goto done;
-        if (!(s->hashes = fopen(hashes, "w"))) {
-            rs_fail(&s->err, 1, "%s: cannot write: %s", hashes, strerror(errno));
-            goto done;
-        }
-    }
+    if (hashes && !(s->hashes = cli_text_open("movie", hashes, s->overwrite)))
+        goto done;
     /* A file we cannot play is reported as such, before any window opens. */
     mv_src *probe = mv_open(s->path, &s->err);
     if (!probe)
@@ -297,18 +301,16 @@ int cmd_movie(int argc, char **argv)
     if (s->failed)
         goto done;
     if (s->hashes) {
-        int e = ferror(s->hashes) | fclose(s->hashes);
+        bool hok = cli_text_close("movie", hashes, s->hashes);
         s->hashes = NULL;
-        if (e) {
-            rs_fail(&s->err, 1, "%s: write failed", hashes);
+        if (!hok)
             goto done;
-        }
     }
     status = RS_EXIT_OK;
 done:
     if (status == RS_EXIT_FAIL && s->err.msg[0])
         cli_error("movie", "%s", s->err.msg);
-    if (s->hashes)
+    if (s->hashes && s->hashes != stdout)
         fclose(s->hashes);
     if (s->p) {
         mv_player_close(s->mp);

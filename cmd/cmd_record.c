@@ -16,18 +16,24 @@
 
 static void help(void)
 {
-    printf("usage: ringside record --ai -o FILE [--seconds N] [--seed S] [--stage NAME] [--level L] [--quiet]\n\n"
+    printf("usage: ringside record --ai -o FILE [-y|-n] [--seconds N] [--seed S] [--stage NAME] [--level L]\n"
+           "                       [--progress tty|plain|off] [--quiet]\n\n"
            "Plays a CPU-vs-CPU match headless (no GL needed) and writes it as a replay\n"
            "(.rsr, see docs/replay-format.md).  The file is read back and compared with\n"
            "what was recorded before it is put in place.\n\n"
            "  --ai          both players are the CPU (required: to record people, use\n"
            "                'ringside play --record')\n"
-           "  -o FILE       output replay\n"
+           "  -o FILE       output replay (its folder must exist)\n"
+           "  -y            replace FILE if it exists (--overwrite)\n"
+           "  -n            refuse an existing FILE, naming it (--no-overwrite; the default,\n"
+           "                ringside never asks)\n"
            "  --seconds N   record exactly N seconds of game time; matches follow one\n"
            "                another (default: until the first match is over, at most %d s)\n"
            "  --seed S      game and CPU random seed (default 1)\n"
            "  --stage NAME  dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry, or 0..%d\n                (default dojo)\n"
            "  --level L     CPU skill 0..3 (default 2)\n"
+           "  --progress M  tty (a line redrawn in place), plain (a line every 5 s and the\n"
+           "                last, for logs) or off; default tty on a terminal, else plain\n"
            "  --quiet       no progress line\n",
            MATCH_LIMIT_S, G_STAGES - 1);
 }
@@ -38,15 +44,18 @@ int cmd_record(int argc, char **argv)
                                          {"seconds", required_argument, 0, 's'}, {"seed", required_argument, 0, 'S'},
                                          {"stage", required_argument, 0, 't'},  {"level", required_argument, 0, 'l'},
                                          {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
+                                         {"progress", required_argument, 0, 'g'},
                                          {0}};
     const char *out = NULL;
-    bool ai = false, quiet = false;
+    bool ai = false, quiet = false, overwrite = false;
+    int progress = RS_PROGRESS_AUTO;
     long seconds = 0, level = 2;
     uint64_t seed = 1;
     int stage = 0, c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'a': ai = true; break;
         case 'o': out = optarg; break;
@@ -68,6 +77,9 @@ int cmd_record(int argc, char **argv)
             break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
+        case 'g': if (!cli_progress_mode("record", optarg, &progress)) return RS_EXIT_USAGE; break;
         default: return cli_bad_option("record", argv);
         }
     }
@@ -83,6 +95,8 @@ int cmd_record(int argc, char **argv)
         cli_error("record", "-o FILE is required");
         return RS_EXIT_USAGE;
     }
+    if (!cli_out_ok("record", out, overwrite))
+        return RS_EXIT_FAIL;
 
     rs_err err = {0};
     g_state st;
@@ -94,7 +108,7 @@ int cmd_record(int argc, char **argv)
     rp_rec_init(&rec, stage, seed, RP_CPU, RP_CPU);
     uint64_t limit = seconds ? (uint64_t)seconds * G_HZ : (uint64_t)MATCH_LIMIT_S * G_HZ;
     rs_progress prog;
-    rs_progress_start(&prog, "record", "ticks", limit, quiet);
+    rs_progress_start(&prog, "record", "ticks", limit, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
     int status = RS_EXIT_FAIL;
     while (st.tick < limit) {
         g_input in[2] = {g_ai_input(&cpu[0], &st), g_ai_input(&cpu[1], &st)};
@@ -107,7 +121,7 @@ int cmd_record(int argc, char **argv)
             rs_progress_update(&prog, st.tick);
     }
     rs_progress_end(&prog);
-    if (!rs_mkdirs_for(out, &err) || !rp_rec_save(&rec, out, &err))
+    if (!rp_rec_save(&rec, out, &err))
         goto done;
     const rp_replay *rp = &rec.rp;
     fprintf(stderr, "ringside record: wrote %s: %" PRIu64 " ticks (%.2f s), stage %s, seed %" PRIu64 ", ", out, rp->ticks,

@@ -13,11 +13,14 @@
 
 static void help(void)
 {
-    printf("usage: ringside smoke [-o FILE] [--size WxH] [--backend egl|osmesa|glfw] [--no-check]\n\n"
+    printf("usage: ringside smoke [-o FILE] [-y|-n] [--size WxH] [--backend egl|osmesa|glfw] [--no-check]\n\n"
            "Renders the smoke test scene headless through shaders/smoke.* and writes it\n"
            "as .png or .ppm.  The picture is compared with its exact CPU\n"
            "reference; if any pixel differs, nothing is written and the exit status is 1.\n\n"
-           "  -o FILE        output image (default: out/smoke.png)\n"
+           "  -o FILE        output image (default: out/smoke.png, replaced each run, out/\n"
+           "                 created); a FILE given here must be in a folder that exists\n"
+           "  -y             replace FILE if it exists (--overwrite)\n"
+           "  -n             refuse an existing FILE, naming it (--no-overwrite; the default)\n"
            "  --size WxH     picture size (default 1280x720; %d..max texture size)\n"
            "  --backend B    GL backend (default egl, falling back to osmesa)\n"
            "  --no-check     skip the comparison with the CPU reference\n",
@@ -29,16 +32,19 @@ int cmd_smoke(int argc, char **argv)
     static const struct option opts[] = {{"output", required_argument, 0, 'o'},
                                          {"size", required_argument, 0, 's'},
                                          {"backend", required_argument, 0, 'b'},
-                                         {"no-check", no_argument, 0, 'n'},
+                                         {"no-check", no_argument, 0, 'N'},
                                          {"help", no_argument, 0, 'h'},
+                                         {"overwrite", no_argument, 0, 'y'},
+                                         {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
-    const char *out = "out/smoke.png";
+    const char *out = NULL; /* NULL: out/smoke.png, ours to replace */
+    bool overwrite = false;
     int w = 1280, h = 720, c;
     bool check = true;
     plat_desc d = {.hidden = true};
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:hyn", opts, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
         case 's':
@@ -46,7 +52,9 @@ int cmd_smoke(int argc, char **argv)
                 return RS_EXIT_USAGE;
             break;
         case 'b': d.backend = optarg; break;
-        case 'n': check = false; break;
+        case 'N': check = false; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("smoke", argv);
         }
@@ -59,11 +67,16 @@ int cmd_smoke(int argc, char **argv)
         cli_error("smoke", "--size %dx%d: each side must be at least %d", w, h, R_SMOKE_MIN_SIZE);
         return RS_EXIT_USAGE;
     }
+    bool named = out != NULL;
+    if (!named)
+        out = "out/smoke.png";
     const char *dot = strrchr(out, '.');
     if (!dot || (strcmp(dot, ".png") && strcmp(dot, ".ppm"))) {
         cli_error("smoke", "%s: unknown image extension (expected .png or .ppm)", out);
         return RS_EXIT_USAGE;
     }
+    if (named && !cli_out_ok("smoke", out, overwrite))
+        return RS_EXIT_FAIL;
 
     int status = RS_EXIT_FAIL;
     rs_err err = {0};
@@ -100,7 +113,7 @@ int cmd_smoke(int argc, char **argv)
             goto fail;
         }
     }
-    if (!rs_mkdirs_for(out, &err) || !rs_image_write(out, w, h, 4, px, &err))
+    if ((!named && !rs_mkdirs_for(out, &err)) || !rs_image_write(out, w, h, 4, px, &err))
         goto fail;
     fprintf(stderr, "ringside smoke: wrote %s (%dx%d, %s%s)\n", out, w, h, plat_backend_name(p),
             check ? ", matches the reference exactly" : "");
