@@ -11,6 +11,7 @@
 #include "../runtime/game/g_game.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_stage.h"
+#include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_progress.h"
 
@@ -174,9 +175,27 @@ FILE *cli_text_open(const char *cmd, const char *path, bool overwrite)
     return f;
 }
 
+int cli_fclose(FILE *f)
+{
+    if (f != stdout)
+        return fclose(f);
+    return fflush(f) != 0 || ferror(f) ? EOF : 0;
+}
+
+FILE *cli_bench_open(const char *cmd, const char *path, bool user, bool overwrite)
+{
+    if (user)
+        return cli_text_open(cmd, path, overwrite);
+    rs_err err = {0};
+    FILE *f = rs_mkdirs_for(path, &err) ? fopen(path, "w") : NULL;
+    if (!f)
+        cli_error(cmd, "%s: cannot create", path);
+    return f;
+}
+
 bool cli_text_close(const char *cmd, const char *path, FILE *f)
 {
-    bool ok = f == stdout ? fflush(f) == 0 && !ferror(f) : fclose(f) == 0;
+    bool ok = cli_fclose(f) == 0;
     if (!ok)
         cli_error(cmd, "%s: write failed", path);
     return ok;

@@ -74,6 +74,11 @@ FILE *cli_text_open(const char *cmd, const char *path, bool overwrite);
  * frames first..end-1 (any one that exists is refused without overwrite). */
 bool cli_pattern_ok(const char *cmd, const char *pattern, uint64_t first, uint64_t end, bool overwrite);
 bool cli_text_close(const char *cmd, const char *path, FILE *f);
+/* fclose, except that standard output is only flushed: 0 when all went out. */
+int cli_fclose(FILE *f);
+/* A benchmark's table: its own default name (user false: under out/,
+ * created, replaced each run) or one the user gave (cli_text_open). */
+FILE *cli_bench_open(const char *cmd, const char *path, bool user, bool overwrite);
 /* --progress tty|plain|off; prints a usage error naming the command. */
 bool cli_progress_mode(const char *cmd, const char *arg, int *mode);
 

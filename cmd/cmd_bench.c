@@ -36,7 +36,11 @@ static void help(void)
            "  --size WxH    frame size (default 1280x720)\n"
            "  --frames N    frames per run (default 60)\n"
            "  --runs N      runs per backend (default 5)\n"
-           "  --csv FILE    also write the table as CSV\n");
+           "  --csv FILE    also write the table as CSV ('-': standard output, after the table);\n"
+           "                its folder must exist\n"
+           "  -y, -n        replace an existing --csv FILE, or refuse it, naming it (the default)\n"
+           "  --progress M  sim: tty, plain (a line every 5 s and the last) or off; default\n"
+           "                tty on a terminal, else plain\n");
 }
 
 static void on_progress(uint64_t done, uint64_t total, void *user)
@@ -122,14 +126,18 @@ static int bench_sim(int argc, char **argv)
                                          {"csv", required_argument, 0, 'c'},
                                          {"quiet", no_argument, 0, 'q'},
                                          {"help", no_argument, 0, 'h'},
+                                         {"overwrite", no_argument, 0, 'y'},
+                                         {"no-overwrite", no_argument, 0, 'n'},
+                                         {"progress", required_argument, 0, 'g'},
                                          {0}};
     long hours = 24;
     const char *csv = NULL;
-    bool quiet = false;
+    bool quiet = false, overwrite = false;
+    int progress = RS_PROGRESS_AUTO;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'H':
             if (!cli_int("--hours", optarg, 1, 168, &hours))
@@ -137,10 +145,16 @@ static int bench_sim(int argc, char **argv)
             break;
         case 'c': csv = optarg; break;
         case 'q': quiet = true; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
+        case 'g': if (!cli_progress_mode("bench", optarg, &progress)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }
     }
+    if (csv && !cli_out_ok("bench", csv, overwrite))
+        return RS_EXIT_FAIL;
+    rs_progress_mode pmode = quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress;
     uint64_t ticks = (uint64_t)hours * 3600 * G_HZ;
     rs_err err = {0};
     g_state st;
@@ -156,7 +170,7 @@ static int bench_sim(int argc, char **argv)
     size_t len = 0, size_3min = 0;
     rp_replay back = {0};
 
-    rs_progress_start(&prog, "record", "ticks", ticks, quiet);
+    rs_progress_start(&prog, "record", "ticks", ticks, pmode);
     while (st.tick < ticks) {
         g_input in[2] = {g_ai_input(&cpu[0], &st), g_ai_input(&cpu[1], &st)};
         g_step(&st, in, NULL);
@@ -180,7 +194,7 @@ static int bench_sim(int argc, char **argv)
     if (!rp_decode(buf, len, "synthetic replay", &back, &err))
         goto done;
     double t_dec = rs_now() - t0;
-    rs_progress_start(&prog, "verify", "ticks", ticks, quiet);
+    rs_progress_start(&prog, "verify", "ticks", ticks, pmode);
     rp_verify_result res;
     bool ran = rp_verify(&back, NULL, on_progress, &prog, &res, &err);
     double t_ver = rs_progress_end(&prog);
@@ -203,12 +217,12 @@ static int bench_sim(int argc, char **argv)
     printf("verify: all %zu checkpoints and the final hash match; goal >= 200000 ticks/s: %s\n", back.ncheck,
            ticks / t_ver >= 200000 ? "met" : "NOT met");
     if (csv) {
-        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
+        FILE *f = cli_text_open("bench", csv, overwrite);
         bool wrote = f && fprintf(f, "hours,ticks,record_tps,encode_tps,decode_tps,verify_tps,bytes,bytes_3min\n"
                                      "%ld,%llu,%.0f,%.0f,%.0f,%.0f,%zu,%zu\n",
                                   hours, (unsigned long long)ticks, ticks / t_rec, ticks / t_enc, ticks / t_dec,
                                   ticks / t_ver, len, size_3min) > 0;
-        if (f && fclose(f) != 0)
+        if (f && cli_fclose(f) != 0)
             wrote = false;
         if (!wrote) {
             rs_fail(&err, 1, "%s: cannot write", csv);
@@ -245,13 +259,16 @@ int cmd_bench(int argc, char **argv)
     }
     static const struct option opts[] = {{"size", required_argument, 0, 's'},  {"frames", required_argument, 0, 'f'},
                                          {"runs", required_argument, 0, 'r'},  {"csv", required_argument, 0, 'c'},
-                                         {"help", no_argument, 0, 'h'},        {0}};
+                                         {"help", no_argument, 0, 'h'},
+                                         {"overwrite", no_argument, 0, 'y'},   {"no-overwrite", no_argument, 0, 'n'},
+                                         {0}};
     int w = 1280, h = 720, c;
     long frames = 60, runs = 5;
     const char *csv = NULL;
+    bool overwrite = false;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc - 1, argv + 1, "h", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc - 1, argv + 1, "hyn", opts, NULL)) != -1) {
         switch (c) {
         case 's':
             if (!cli_size("--size", optarg, 8192, &w, &h))
@@ -266,10 +283,14 @@ int cmd_bench(int argc, char **argv)
                 return RS_EXIT_USAGE;
             break;
         case 'c': csv = optarg; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv + 1);
         }
     }
+    if (csv && !cli_out_ok("bench", csv, overwrite))
+        return RS_EXIT_FAIL;
     if (w < R_SMOKE_MIN_SIZE || h < R_SMOKE_MIN_SIZE) {
         cli_error("bench", "--size %dx%d: each side must be at least %d", w, h, R_SMOKE_MIN_SIZE);
         return RS_EXIT_USAGE;
@@ -296,17 +317,14 @@ int cmd_bench(int argc, char **argv)
         printf("ratio osmesa/egl: draw %.2f, draw+read %.2f (>1: osmesa slower)\n", res[1].draw_ms / res[0].draw_ms,
                res[1].read_ms / res[0].read_ms);
     if (csv && nres) {
-        rs_err err = {0};
-        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
-        if (!f) {
-            cli_error("bench", "%s: cannot create", csv);
+        FILE *f = cli_text_open("bench", csv, overwrite);
+        if (!f)
             return RS_EXIT_FAIL;
-        }
         fprintf(f, "backend,width,height,frames,runs,create_ms,draw_ms,draw_read_ms,fps,renderer\n");
         for (int i = 0; i < nres; i++)
             fprintf(f, "%s,%d,%d,%ld,%ld,%.3f,%.4f,%.4f,%.2f,\"%s\"\n", res[i].backend, w, h, frames, runs,
                     res[i].create_ms, res[i].draw_ms, res[i].read_ms, 1000.0 / res[i].read_ms, res[i].renderer);
-        if (fclose(f) != 0) {
+        if (cli_fclose(f) != 0) {
             cli_error("bench", "%s: write failed", csv);
             return RS_EXIT_FAIL;
         }

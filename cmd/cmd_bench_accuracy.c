@@ -188,7 +188,7 @@ static void help(void)
 {
     printf("usage: ringside bench accuracy [--only capture|ibl|tone|water|fog|lspsm] [--frames N] [--size WxH]\n"
            "                               [--render-size WxH] [--ibl-sizes LIST] [--ibl-reference N]\n"
-           "                               [--stage NAME] [--csv FILE]\n\n"
+           "                               [--stage NAME] [--csv FILE] [-y|-n]\n\n"
            "Run time against error, six tables:\n"
            "  capture  downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
            "           nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
@@ -212,7 +212,9 @@ static void help(void)
            "  --stage NAME        the stage whose environment the IBL table uses (default dojo)\n"
            "  --csv FILE          also write the tables (default out/bench-accuracy.csv; the IBL,\n"
            "                      tone and LSPSM tables go to FILE's name with -ibl, -tone and\n"
-           "                      -lspsm added)\n");
+           "                      -lspsm added).  A FILE given here must be in a folder that\n"
+           "                      exists, and none of its tables may exist unless -y\n"
+           "  -y, -n              replace those tables, or refuse them, naming one (the default)\n");
 }
 
 /* out/x.csv + "-ibl" -> out/x-ibl.csv */
@@ -224,11 +226,17 @@ static void csv_name(const char *csv, const char *suffix, char *out, size_t n)
     snprintf(out, n, "%.*s%s%s", (int)(dot - csv), csv, suffix, dot);
 }
 
+/* --csv given by the user (its rules, cli.h) or the default under out/;
+ * set once from the options, before any table is written */
+static struct {
+    bool user, overwrite;
+} csv_rules;
+
 static FILE *csv_open(const char *path, const char *header, rs_err *err)
 {
-    FILE *f = rs_mkdirs_for(path, err) ? fopen(path, "w") : NULL;
+    FILE *f = cli_bench_open("bench", path, csv_rules.user, csv_rules.overwrite);
     if (!f) {
-        rs_fail(err, 1, "%s: cannot create", path);
+        rs_fail(err, 1, "%s: not written", path);
         return NULL;
     }
     fprintf(f, "%s\n", header);
@@ -250,19 +258,24 @@ int bench_accuracy(int argc, char **argv)
                                          {"render-size", required_argument, 0, 'r'}, {"csv", required_argument, 0, 'c'},
                                          {"only", required_argument, 0, 'o'}, {"ibl-sizes", required_argument, 0, 'I'},
                                          {"ibl-reference", required_argument, 0, 'R'}, {"stage", required_argument, 0, 'S'},
-                                         {"help", no_argument, 0, 'h'},         {0}};
+                                         {"help", no_argument, 0, 'h'},
+                                         {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
+                                         {0}};
     int frames = 8, sw = 1280, sh = 720, w = 640, h = 360, c, ref_size = 128;
     int sizes[16] = {8, 16, 32, 64}, nsizes = 4;
     long v;
     const char *csv = "out/bench-accuracy.csv", *only = NULL, *stage = "dojo";
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    csv_rules.user = csv_rules.overwrite = false;
+    while ((c = getopt_long(argc, argv, "hyn", opts, NULL)) != -1) {
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 1, 60, &v)) return RS_EXIT_USAGE; frames = (int)v; break;
         case 's': if (!cli_size("--size", optarg, 8192, &w, &h)) return RS_EXIT_USAGE; break;
         case 'r': if (!cli_size("--render-size", optarg, 8192, &sw, &sh)) return RS_EXIT_USAGE; break;
-        case 'c': csv = optarg; break;
+        case 'c': csv = optarg; csv_rules.user = true; break;
+        case 'y': csv_rules.overwrite = true; break;
+        case 'n': csv_rules.overwrite = false; break;
         case 'o':
             if (strcmp(optarg, "capture") && strcmp(optarg, "ibl") && strcmp(optarg, "tone") && strcmp(optarg, "water") &&
                 strcmp(optarg, "fog") && strcmp(optarg, "lspsm")) {
@@ -286,6 +299,17 @@ int bench_accuracy(int argc, char **argv)
     if (optind < argc) {
         cli_error("bench", "unexpected argument '%s'", argv[optind]);
         return cli_usage_error("bench");
+    }
+    if (csv_rules.user && !strcmp(csv, "-")) {
+        cli_error("bench", "--csv -: accuracy writes several tables; give a file name");
+        return RS_EXIT_USAGE;
+    }
+    static const char *const suffix[] = {"", "-ibl", "-tone", "-lspsm"}, *const table[] = {"capture", "ibl", "tone", "lspsm"};
+    for (int i = 0; csv_rules.user && *csv && i < 4; i++) {
+        char name[1200];
+        csv_name(csv, suffix[i], name, sizeof name);
+        if ((!only || !strcmp(only, table[i])) && !cli_out_ok("bench", i ? name : csv, csv_rules.overwrite))
+            return RS_EXIT_FAIL;
     }
     rs_err err = {0};
     if ((!only || !strcmp(only, "capture")) && !cap_check_sizes(sw, sh, w, h, &err)) {
@@ -341,10 +365,8 @@ int bench_accuracy(int argc, char **argv)
     }
     if (!only || !strcmp(only, "lspsm")) {
         csv_name(csv, "-lspsm", path, sizeof path);
-        if (*csv && !(cf = rs_mkdirs_for(path, &err) ? fopen(path, "w") : NULL)) {
-            cli_error("bench", "%s: cannot create", path);
+        if (*csv && !(cf = cli_bench_open("bench", path, csv_rules.user, csv_rules.overwrite)))
             return RS_EXIT_FAIL;
-        }
         r_lspsm_density_rows(stdout, cf);
         if (!csv_close(cf, path, &err)) {
             cli_error("bench", "%s", err.msg);
@@ -444,9 +466,8 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     printf("%-12s %10s %12s\n", "filter", "PSNR dB", "ms/frame");
     FILE *cf = NULL;
     if (csv && *csv) {
-        cf = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
-        if (!cf) {
-            rs_fail(&err, 1, "%s: cannot create", csv);
+        if (!(cf = cli_bench_open("bench", csv, csv_rules.user, csv_rules.overwrite))) {
+            rs_fail(&err, 1, "%s: not written", csv);
             goto done;
         }
         fprintf(cf, "filter,psnr_db,ms_per_frame,frames,render_w,render_h,w,h\n");

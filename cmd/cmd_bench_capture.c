@@ -175,7 +175,10 @@ static void help(void)
            "  --sink S           mp4 (H.264, default), y4m (raw, disk-bound) or null\n"
            "  --runs N           repeat every configuration N times, report medians (default 3)\n"
            "  --csv FILE         the table as CSV (default out/bench-capture.csv)\n"
-           "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n",
+           "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n"
+           "  -y, -n             replace a --csv or --chart FILE given here, or refuse it (the\n"
+           "                     default); the defaults under out/ are replaced each run.\n"
+           "                     --csv - writes to standard output\n",
            "the");
 }
 
@@ -185,16 +188,18 @@ int bench_capture(int argc, char **argv)
                                          {"render-size", required_argument, 0, 'r'}, {"sink", required_argument, 0, 'k'},
                                          {"csv", required_argument, 0, 'c'},    {"chart", required_argument, 0, 'C'},
                                          {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
-                                         {"runs", required_argument, 0, 'R'},   {0}};
+                                         {"runs", required_argument, 0, 'R'},
+                                         {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
+                                         {0}};
     long nrep = 3;
     bench b = {.frames = 300, .sw = 1280, .sh = 720, .w = 640, .h = 360, .start = 600};
     const char *sink = "mp4", *csv = "out/bench-capture.csv", *chart = "out/bench-capture.png";
-    bool quiet = false;
+    bool quiet = false, overwrite = false, user_csv = false, user_chart = false;
     long v;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 10, 100000, &v)) return RS_EXIT_USAGE; b.frames = (int)v; break;
         case 's': if (!cli_size("--size", optarg, 8192, &b.w, &b.h)) return RS_EXIT_USAGE; break;
@@ -206,8 +211,10 @@ int bench_capture(int argc, char **argv)
             }
             sink = optarg;
             break;
-        case 'c': csv = optarg; break;
-        case 'C': chart = optarg; break;
+        case 'c': csv = optarg; user_csv = true; break;
+        case 'C': chart = optarg; user_chart = true; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
         case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
         case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
@@ -219,6 +226,9 @@ int bench_capture(int argc, char **argv)
         cli_error("bench", "%s", err.msg);
         return RS_EXIT_USAGE;
     }
+    if ((user_csv && *csv && !cli_out_ok("bench", csv, overwrite)) ||
+        (user_chart && *chart && !cli_out_ok("bench", chart, overwrite)))
+        return RS_EXIT_FAIL;
     char outpath[64];
     snprintf(outpath, sizeof outpath, !strcmp(sink, "null") ? "null:" : "out/bench-capture-scratch.%s", sink);
     b.out = outpath;
@@ -314,7 +324,7 @@ int bench_capture(int argc, char **argv)
         printf("async / min(render-only %.1f, writer-only %.1f fps):   %.2f   (goal >= 0.9)\n", render_only,
                writer_only, def->fps / slowest);
     if (csv && *csv) {
-        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
+        FILE *f = cli_bench_open("bench", csv, user_csv, overwrite);
         bool ok = f != NULL;
         if (ok)
             ok = fprintf(f, "config,fps,render_ms,downscale_ms,readback_ms,fence_ms,map_copy_ms,queue_wait_ms,write_ms,"
@@ -327,7 +337,7 @@ int bench_capture(int argc, char **argv)
                          r->st.ms_map_copy / n, r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water,
                          r->rss_mb, b.frames, b.sw, b.sh, b.w, b.h, sink) > 0;
         }
-        if (f && fclose(f) != 0)
+        if (f && cli_fclose(f) != 0)
             ok = false;
         if (!ok) {
             rs_fail(&err, 1, "%s: cannot write", csv);

@@ -79,7 +79,9 @@ static void help(void)
            "  --size WxH       frame size (default 1280x768)\n"
            "  --modes LIST     comma list of direct, pbo, persistent (default all)\n"
            "  --runs N         runs per mode, report medians (default 3; 1 to %d)\n"
-           "  --csv FILE       also write one row per mode as CSV\n"
+           "  --csv FILE       also write one row per mode as CSV ('-': standard output); its\n"
+           "                   folder must exist\n"
+           "  -y, -n           replace an existing --csv FILE, or refuse it (the default)\n"
            "  --backend B      egl or osmesa (default egl, falling back to osmesa)\n"
            "  --quiet          no progress on stderr\n",
            NFRAMES, NSLOTS, MAX_RUNS);
@@ -320,22 +322,25 @@ int bench_upload(int argc, char **argv)
                                          {"modes", required_argument, 0, 'm'},  {"runs", required_argument, 0, 'R'},
                                          {"csv", required_argument, 0, 'c'},    {"backend", required_argument, 0, 'b'},
                                          {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
     long frames = 300, nrep = 3;
     bench b = {.w = 1280, .h = 768};
     int modes[MV_UP_COUNT] = {MV_UP_DIRECT, MV_UP_PBO, MV_UP_PERSISTENT}, nmode = 3;
     const char *csv = NULL, *backend = NULL;
-    bool quiet = false;
+    bool quiet = false, overwrite = false;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 1, 100000, &frames)) return RS_EXIT_USAGE; break;
         case 's': if (!cli_size("--size", optarg, 8192, &b.w, &b.h)) return RS_EXIT_USAGE; break;
         case 'm': if (!parse_modes(optarg, modes, &nmode)) return RS_EXIT_USAGE; break;
         case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
         case 'c': csv = optarg; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
         case 'b':
             if (strcmp(optarg, "egl") && strcmp(optarg, "osmesa") && strcmp(optarg, "auto")) {
                 cli_error("bench", "--backend '%s': expected egl or osmesa", optarg);
@@ -352,6 +357,8 @@ int bench_upload(int argc, char **argv)
         cli_error("bench", "unexpected argument '%s'", argv[optind]);
         return cli_usage_error("bench");
     }
+    if (csv && *csv && !cli_out_ok("bench", csv, overwrite))
+        return RS_EXIT_FAIL;
     int nsync = (int)frames / 4;
     if (nsync < 30)
         nsync = 30;
@@ -500,7 +507,7 @@ int bench_upload(int argc, char **argv)
     }
 
     if (csv && *csv) {
-        FILE *f = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL;
+        FILE *f = cli_text_open("bench", csv, overwrite);
         bool ok = f && fprintf(f, "mode,available,width,height,frames,runs,synced_frames,total_ms,synced_ms,"
                                   "produce_ms,copy_ms,gl_ms,fence_wait_ms,fence_waits,fps,vs_direct,draw_only_ms,backend,"
                                   "renderer,note\n") > 0;
@@ -522,7 +529,7 @@ int bench_upload(int argc, char **argv)
                          m->med.produce, m->med.copy, m->med.gl, m->med.fence, m->med.waits, 1000.0 / m->med.total,
                          ratio, floor_ms, plat_backend_name(p), glcaps.renderer) > 0;
         }
-        if (f && fclose(f) != 0)
+        if (f && cli_fclose(f) != 0)
             ok = false;
         if (!ok) {
             if (!err.msg[0])

@@ -14,13 +14,16 @@
 static void help(void)
 {
     printf("usage: ringside replay info FILE\n"
-           "       ringside replay verify FILE [--hashes OUT] [--quiet]\n\n"
+           "       ringside replay verify FILE [--hashes OUT] [-y|-n] [--progress tty|plain|off] [--quiet]\n\n"
            "info    prints the header: stage, seed, duration, players, winner, sizes.\n"
            "verify  re-simulates every tick from the recorded inputs (no GL) and checks\n"
            "        every state-hash checkpoint and the final hash.  On a mismatch it\n"
            "        prints the first checkpoint tick that differs and exits 1; a replay\n"
            "        recorded by another version of the game is refused before that.\n\n"
            "  --hashes OUT  also write \"tick hash\" for every tick to OUT ('-' for stdout)\n"
+           "  -y, -n        replace an existing OUT, or refuse it, naming it (the default)\n"
+           "  --progress M  tty (a line redrawn in place), plain (a line every 5 s and the\n"
+           "                last, for logs) or off; default tty on a terminal, else plain\n"
            "  --quiet       no progress line\n");
 }
 
@@ -82,7 +85,7 @@ static void on_progress(uint64_t done, uint64_t total, void *user)
     rs_progress_update(user, done);
 }
 
-static int verify(const char *path, const char *hashes_path, bool quiet)
+static int verify(const char *path, const char *hashes_path, bool overwrite, rs_progress_mode pmode)
 {
     rp_replay rp;
     rs_err err = {0};
@@ -92,19 +95,18 @@ static int verify(const char *path, const char *hashes_path, bool quiet)
     }
     FILE *hf = NULL;
     if (hashes_path) {
-        hf = strcmp(hashes_path, "-") ? fopen(hashes_path, "w") : stdout;
+        hf = cli_text_open("replay", hashes_path, overwrite);
         if (!hf) {
-            cli_error("replay", "%s: cannot create", hashes_path);
             rp_free(&rp);
             return RS_EXIT_FAIL;
         }
     }
     rs_progress prog;
-    rs_progress_start(&prog, "verify", "ticks", rp.ticks, quiet);
+    rs_progress_start(&prog, "verify", "ticks", rp.ticks, pmode);
     rp_verify_result res;
     bool ran = rp_verify(&rp, hf, on_progress, &prog, &res, &err);
     double secs = rs_progress_end(&prog);
-    if (hf && hf != stdout && fclose(hf) != 0 && ran)
+    if (hf && cli_fclose(hf) != 0 && ran)
         ran = rs_fail(&err, RP_ERR_WRITE, "%s: write failed", hashes_path);
     int status = RS_EXIT_FAIL;
     if (!ran) {
@@ -144,16 +146,22 @@ int cmd_replay(int argc, char **argv)
         return RS_EXIT_USAGE;
     }
     static const struct option opts[] = {
-        {"hashes", required_argument, 0, 'H'}, {"quiet", no_argument, 0, 'q'}, {"help", no_argument, 0, 'h'}, {0}};
+        {"hashes", required_argument, 0, 'H'}, {"quiet", no_argument, 0, 'q'}, {"help", no_argument, 0, 'h'},
+        {"overwrite", no_argument, 0, 'y'},   {"no-overwrite", no_argument, 0, 'n'},
+        {"progress", required_argument, 0, 'g'}, {0}};
     const char *hashes = NULL;
-    bool quiet = false;
+    bool quiet = false, overwrite = false;
+    int progress = RS_PROGRESS_AUTO;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc - 1, argv + 1, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc - 1, argv + 1, "qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'H': hashes = optarg; break;
         case 'q': quiet = true; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
+        case 'g': if (!cli_progress_mode("replay", optarg, &progress)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("replay", argv + 1);
         }
@@ -170,5 +178,5 @@ int cmd_replay(int argc, char **argv)
         }
         return info(file);
     }
-    return verify(file, hashes, quiet);
+    return verify(file, hashes, overwrite, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
 }
