@@ -183,15 +183,15 @@ debug:
 demo: $(BUILD)/ringside
 	@mkdir -p out
 	$(BUILD)/ringside replay verify demos/dojo.rsr
-	$(BUILD)/ringside render demos/dojo.rsr -o out/demo.mp4
+	$(BUILD)/ringside render demos/dojo.rsr -y -o out/demo.mp4
 	@echo "demo: out/demo.mp4, demos/dojo.rsr rendered headless (1280x720 drawn, 640x360 H.264, 60 fps)"
 
 bench: $(BUILD)/ringside
 	@mkdir -p out
-	$(BUILD)/ringside bench platform --csv out/bench-platform.csv
-	$(BUILD)/ringside bench sim --csv out/bench-sim.csv
-	$(BUILD)/ringside bench capture --csv out/bench-capture.csv --chart out/bench-capture.png
-	$(BUILD)/ringside bench upload --csv out/bench-upload.csv
+	$(BUILD)/ringside bench platform -y --csv out/bench-platform.csv
+	$(BUILD)/ringside bench sim -y --csv out/bench-sim.csv
+	$(BUILD)/ringside bench capture -y --csv out/bench-capture.csv --chart out/bench-capture.png
+	$(BUILD)/ringside bench upload -y --csv out/bench-upload.csv
 
 # The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
 # same commands must reproduce them byte for byte (tests/test_replay.sh).
@@ -199,7 +199,7 @@ DEMO_REPLAYS := dojo:1 harbor:7 temple:23 shallows:31 snowfield:37 mistvale:41 p
 demo-replays: $(BUILD)/ringside
 	@for d in $(DEMO_REPLAYS); do \
 	    stage=$${d%%:*} seed=$${d##*:}; \
-	    $(BUILD)/ringside record --ai --quiet --stage $$stage --seed $$seed -o demos/$$stage.rsr || exit 1; \
+	    $(BUILD)/ringside record --ai --quiet --stage $$stage --seed $$seed -y -o demos/$$stage.rsr || exit 1; \
 	done
 
 # --- install ---

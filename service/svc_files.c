@@ -109,7 +109,8 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
     add(&a, "ringside");
     if (j->unit.kind == SVC_UNIT_JOIN) {
         /* the segments in order, each as the attempt the queue recorded */
-        const char *const head[] = {"join", "--segment", j->key, "-o", f->out, "--hashes", f->hashes,
+        /* -y: the names are the daemon's own; one a crashed attempt left is its to replace */
+        const char *const head[] = {"join", "--segment", j->key, "-y", "-o", f->out, "--hashes", f->hashes,
                                     "--progress-fd", "3", "--quiet"};
         for (size_t i = 0; i < sizeof head / sizeof *head; i++)
             add(&a, head[i]);
@@ -143,7 +144,7 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
             add(&a, "--segment");
             add(&a, j->key);
         }
-        const char *const tail[] = {"-o", f->out, "--size", size, "--render-size", rsize, "--hashes", f->hashes,
+        const char *const tail[] = {"-y", "-o", f->out, "--size", size, "--render-size", rsize, "--hashes", f->hashes,
                                     "--progress-fd", "3", "--quiet", "--backend", cfg->backend};
         for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
             add(&a, tail[i]);

@@ -443,7 +443,7 @@ if step_begin golden 10 8; then
         dims=$(head -c 40 "$g" | tr -c '0-9P' ' ' | awk '{ print $2 "x" $3 }')
         fr=$tmp/g_${st}_$tick.y4m
         run_timed 5 "$(left)" "$tmp/o" "$tmp/e" "$RS" render "$demo" --ticks $((tick - 1)):"$tick" --render-size "$dims" \
-            --size "$dims" --capture sequential --downscale cpu --quiet -o "$fr"
+            --size "$dims" --capture sequential --downscale cpu --quiet -y -o "$fr"
         if [ "$RC" -ne 0 ]; then
             [ "$RC" -eq 125 ] && nskip=$((nskip + 1)) || nbad=$((nbad + 1))
             echo "$st,$tick,$((tick - 1)):$tick,$(rc_word "$RC"),$WALL,,,,,,,,,,," >>"$G"
@@ -504,7 +504,7 @@ if step_begin capture 15 26; then
         run_timed 10 "$(share "$todo")" "$tmp/o" "$tmp/e" \
             env ${data:+RINGSIDE_DATA="$data"} "$RS" bench capture \
             --frames "$frames" --runs "$CAP_RUNS" --render-size "$src" --size "$dst" --sink "$SINK" \
-            --csv "$tmp/cap.csv" --chart "" --quiet
+            --csv "$tmp/cap.csv" --chart "" --quiet -y
         if [ "$RC" -ne 0 ] || [ ! -s "$tmp/cap.csv" ]; then
             say "$src -> $dst: $(rc_word "$RC") after ${WALL} s: $(first_error "$tmp/e")"
             ratios="$ratios $src->$dst:$(rc_word "$RC")"
