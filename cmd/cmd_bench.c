@@ -185,6 +185,7 @@ static int bench_sim(int argc, char **argv)
             free(b3);
         }
     }
+    rs_progress_update(&prog, st.tick); /* the last line says all */
     double t_rec = rs_progress_end(&prog);
     double t0 = rs_now();
     if (!rp_encode(&rec.rp, &buf, &len, &err))
@@ -197,6 +198,8 @@ static int bench_sim(int argc, char **argv)
     rs_progress_start(&prog, "verify", "ticks", ticks, pmode);
     rp_verify_result res;
     bool ran = rp_verify(&back, NULL, on_progress, &prog, &res, &err);
+    if (ran)
+        rs_progress_update(&prog, ticks);
     double t_ver = rs_progress_end(&prog);
     if (!ran)
         goto done;

@@ -120,6 +120,7 @@ int cmd_record(int argc, char **argv)
         if ((st.tick & 0xfff) == 0)
             rs_progress_update(&prog, st.tick);
     }
+    rs_progress_update(&prog, st.tick); /* updates are every 4096 ticks; the last line says where it ended */
     rs_progress_end(&prog);
     if (!rp_rec_save(&rec, out, &err))
         goto done;

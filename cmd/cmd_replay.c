@@ -105,6 +105,8 @@ static int verify(const char *path, const char *hashes_path, bool overwrite, rs_
     rs_progress_start(&prog, "verify", "ticks", rp.ticks, pmode);
     rp_verify_result res;
     bool ran = rp_verify(&rp, hf, on_progress, &prog, &res, &err);
+    if (ran)
+        rs_progress_update(&prog, rp.ticks); /* rp_verify reports now and then; the last line says all */
     double secs = rs_progress_end(&prog);
     if (hf && cli_fclose(hf) != 0 && ran)
         ran = rs_fail(&err, RP_ERR_WRITE, "%s: write failed", hashes_path);

@@ -66,7 +66,7 @@ t_info_falls_back() {
 }
 
 t_smoke_both_backends() {
-    "$RS_BIN" smoke --backend egl -o egl/a.png 2>e.txt || { cat e.txt; return 1; }
+    mkdir egl && "$RS_BIN" smoke --backend egl -o egl/a.png 2>e.txt || { cat e.txt; return 1; }
     "$RS_BIN" smoke --backend osmesa -o b.png 2>>e.txt || { cat e.txt; return 1; }
     grep -q "matches the reference exactly" e.txt || return 1
     cmp egl/a.png b.png || { echo "egl and osmesa pictures differ"; return 1; }

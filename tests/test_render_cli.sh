@@ -45,7 +45,7 @@ t_ticks_match_a_full_render() {
     [ "$(sed -n '201,205p' all.txt)" = "$(cat part.txt)" ] ||
         { echo "--ticks frames differ from the full render:"; sed -n '201,205p' all.txt; cat part.txt; return 1; }
     # image sequences are numbered by tick too
-    "$RS_BIN" render short.rsr $SIZES -q --ticks 298:300 -o seq/f%04d.png || return 1
+    mkdir seq && "$RS_BIN" render short.rsr $SIZES -q --ticks 298:300 -o seq/f%04d.png || return 1
     [ "$(ls seq | tr '\n' ' ')" = "f0298.png f0299.png " ] || { ls seq; return 1; }
 }
 
@@ -79,7 +79,7 @@ t_bad_stage_files() {
 
 t_mask_cutouts() {
     short_replay || return 1
-    "$RS_BIN" render short.rsr --ticks 200:202 --mask $SIZES -q -o cut/f%04d.png || return 1
+    mkdir cut && "$RS_BIN" render short.rsr --ticks 200:202 --mask $SIZES -q -o cut/f%04d.png || return 1
     [ -s cut/f0200.png ] && [ -s cut/f0201.png ] || { ls cut; return 1; }
     fmt=$(ffprobe -v error -show_entries stream=pix_fmt -of default=nw=1:nk=1 cut/f0200.png)
     [ "$fmt" = rgba ] || { echo "pix_fmt $fmt, want rgba"; return 1; }

@@ -51,7 +51,7 @@ t_hashes_same_at_O0_O2_and_in_ringside() {
     for d in dojo harbor temple shallows snowfield mistvale plaza quarry; do
         "$BIN_DIR/tests/simhash-O0" "$SRC/demos/$d.rsr" >o0.txt || { echo "O0 build fails $d"; return 1; }
         "$BIN_DIR/tests/simhash-O2" "$SRC/demos/$d.rsr" >o2.txt || { echo "O2 build fails $d"; return 1; }
-        "$RS_BIN" replay verify --quiet --hashes r.txt "$SRC/demos/$d.rsr" 2>/dev/null || return 1
+        "$RS_BIN" replay verify --quiet -y --hashes r.txt "$SRC/demos/$d.rsr" 2>/dev/null || return 1
         cmp o0.txt o2.txt || { echo "$d: -O0 and -O2 hashes differ"; return 1; }
         cmp o0.txt r.txt || { echo "$d: ringside and simhash hashes differ"; return 1; }
         ticks=$("$RS_BIN" replay info "$SRC/demos/$d.rsr" | sed -n 's/^duration *\([0-9]*\) ticks.*/\1/p')
