@@ -69,8 +69,7 @@ static void lower_ext(const char *path, char *out, size_t n)
 
 static bool is_image_ext(const char *ext)
 {
-    return !strcmp(ext, ".png") || !strcmp(ext, ".exr") || !strcmp(ext, ".tif") || !strcmp(ext, ".tiff") ||
-           !strcmp(ext, ".jpg") || !strcmp(ext, ".jpeg");
+    return !strcmp(ext, ".png") || !strcmp(ext, ".exr") || !strcmp(ext, ".tif") || !strcmp(ext, ".tiff");
 }
 
 bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err)

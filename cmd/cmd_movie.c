@@ -20,7 +20,6 @@
 #include "../runtime/loop.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_target.h"
-#include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 #include "../runtime/util/rs_out.h"

@@ -9,7 +9,6 @@
 #include "../runtime/game/g_ai.h"
 #include "../runtime/game/g_game.h"
 #include "../runtime/replay/rp.h"
-#include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
 
 #define MATCH_LIMIT_S 600

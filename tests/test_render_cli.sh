@@ -89,7 +89,7 @@ t_mask_cutouts() {
              END { printf "alpha: %d px, %d zero, %d full\n", n, z, f; exit !(n == 160 * 90 && z > n / 2 && f > n / 100 && f < n / 3) }' ||
         return 1
     expect_fail 2 "--mask writes RGBA images" "$RS_BIN" render short.rsr --mask -o m.y4m || return 1
-    expect_fail 1 "--mask needs an alpha channel" "$RS_BIN" render short.rsr --mask --hdr-format r11g11b10f -o m/f%02d.png || return 1
+    expect_fail 1 "--mask needs an alpha channel" "$RS_BIN" render short.rsr --mask --hdr-format r11g11b10f -o cut/m%02d.png || return 1
     expect_fail 2 "hdr" "$RS_BIN" render short.rsr --hdr-format rgb9e5 -o m.y4m
 }
 
