@@ -159,6 +159,10 @@ t_progress_plain_off_a_terminal() {
     pat='^ringside render: [0-9]+/12 frames \([0-9]+%\), [0-9.]+ fps, [0-9.]+x, elapsed [0-9]+:[0-9][0-9], ETA [0-9]+:[0-9][0-9]$'
     [ "$(grep -Ec "$pat" e.txt)" -ge 2 ] || { echo "want plain lines:"; cat e.txt; return 1; }
     grep -E "$pat" e.txt | tail -1 | grep -q "12/12 frames (100%)" || { cat e.txt; return 1; }
+    # speed is x real time: frames per second / 60
+    grep -E "$pat" e.txt | tail -1 | tr -d ',x' |
+        awk '{ fps = $6; x = $8; if (fps <= 0 || x - fps / 60 > 0.006 || fps / 60 - x > 0.006) exit 1 }' ||
+        { echo "speed is not fps / 60:"; grep -E "$pat" e.txt | tail -1; return 1; }
     grep -q "$(printf '\r')" e.txt && { echo "a tty redraw in a log"; return 1; }
     # the default interval (5 s) gives only the last line on a short run
     "$RS_BIN" render r.rsr $S -y -o a.y4m 2>e.txt || return 1
