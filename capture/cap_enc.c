@@ -130,22 +130,23 @@ typedef struct enc_row {
     const char *const *preset_names;  /* for a string option: the names it takes */
     const char *preset_default;
     int crf_default, crf_max;
+    int min_side;                     /* smallest width and height it encodes; 0: any */
 } enc_row;
 
 /* Defaults: docs/capture.md, "Encoders", has the measurements they come from. */
 static const enc_row rows[] = {
-    {CAP_CODEC_H264, "h264_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 23, 51},
-    {CAP_CODEC_H264, "h264_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 23, 51},
-    {CAP_CODEC_H264, "libx264", CAP_HW_OFF, "preset", x26x_presets, "veryfast", 20, 51},
-    {CAP_CODEC_HEVC, "hevc_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 25, 51},
-    {CAP_CODEC_HEVC, "hevc_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 25, 51},
-    {CAP_CODEC_HEVC, "libx265", CAP_HW_OFF, "preset", x26x_presets, "superfast", 22, 51},
-    {CAP_CODEC_VP9, "vp9_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 100, 255},
-    {CAP_CODEC_VP9, "libvpx-vp9", CAP_HW_OFF, "cpu-used", NULL, "8", 32, 63},
-    {CAP_CODEC_AV1, "av1_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 30, 51},
-    {CAP_CODEC_AV1, "av1_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 100, 255},
-    {CAP_CODEC_AV1, "libsvtav1", CAP_HW_OFF, "preset", NULL, "10", 35, 63},
-    {CAP_CODEC_AV1, "libaom-av1", CAP_HW_OFF, "cpu-used", NULL, "8", 32, 63},
+    {CAP_CODEC_H264, "h264_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 23, 51, 0},
+    {CAP_CODEC_H264, "h264_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 23, 51, 0},
+    {CAP_CODEC_H264, "libx264", CAP_HW_OFF, "preset", x26x_presets, "veryfast", 20, 51, 0},
+    {CAP_CODEC_HEVC, "hevc_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 25, 51, 0},
+    {CAP_CODEC_HEVC, "hevc_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 25, 51, 0},
+    {CAP_CODEC_HEVC, "libx265", CAP_HW_OFF, "preset", x26x_presets, "superfast", 22, 51, 0},
+    {CAP_CODEC_VP9, "vp9_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 100, 255, 0},
+    {CAP_CODEC_VP9, "libvpx-vp9", CAP_HW_OFF, "cpu-used", NULL, "8", 32, 63, 0},
+    {CAP_CODEC_AV1, "av1_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 30, 51, 0},
+    {CAP_CODEC_AV1, "av1_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 100, 255, 0},
+    {CAP_CODEC_AV1, "libsvtav1", CAP_HW_OFF, "preset", NULL, "10", 35, 63, 64},
+    {CAP_CODEC_AV1, "libaom-av1", CAP_HW_OFF, "cpu-used", NULL, "8", 32, 63, 0},
 };
 #define NROWS ((int)(sizeof rows / sizeof rows[0]))
 
@@ -175,6 +176,19 @@ static bool takes_pix(const AVCodec *c, enum AVPixelFormat want)
         if (*p == want)
             return true;
     return false;
+}
+
+/* The software encoder for e at w x h: the first of its codec's rows that this FFmpeg has and that takes the
+ * chroma and the size (SVT-AV1 needs 64x64; libaom-av1 takes smaller). */
+static const enc_row *soft_row(const cap_enc *e, int w, int h)
+{
+    for (int i = 0; i < NROWS; i++) {
+        const AVCodec *c = avcodec_find_encoder_by_name(rows[i].name);
+        if (rows[i].codec == e->codec && rows[i].hw == CAP_HW_OFF && c && takes_pix(c, sw_pix(e)) &&
+            w >= rows[i].min_side && h >= rows[i].min_side)
+            return &rows[i];
+    }
+    return NULL;
 }
 
 /* The container's name for libavformat and whether it holds the codec. */
@@ -351,15 +365,10 @@ bool cap_sink_encoder(cap_sink *s, const cap_enc *enc, rs_err *err)
         snprintf(s->enc_name, sizeof s->enc_name, "%s", row->name);
         return true;
     }
-    const enc_row *soft = NULL;
-    for (int i = 0; i < NROWS && !soft; i++) {
-        const AVCodec *c = avcodec_find_encoder_by_name(rows[i].name);
-        if (rows[i].codec == e.codec && rows[i].hw == CAP_HW_OFF && c && takes_pix(c, sw_pix(&e)))
-            soft = &rows[i];
-    }
+    const enc_row *soft = soft_row(&e, s->w, s->h);
     if (!soft)
-        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this FFmpeg has no software %s encoder for %s", s->path,
-                       cap_codec_name(e.codec), av_get_pix_fmt_name(sw_pix(&e)));
+        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this FFmpeg has no software %s encoder for %s at %dx%d", s->path,
+                       cap_codec_name(e.codec), av_get_pix_fmt_name(sw_pix(&e)), s->w, s->h);
     if (!row_takes(soft, &e, why, sizeof why))
         return rs_fail(err, CAP_ERR_ENC_SETTING, "%s: %s", s->path, why);
     char tried[sizeof s->enc_note] = "";
@@ -384,12 +393,10 @@ bool cap_sink_encoder(cap_sink *s, const cap_enc *enc, rs_err *err)
     return true;
 }
 
-const char *cap_enc_software(cap_codec c)
+const char *cap_enc_software(cap_codec c, int w, int h)
 {
-    for (int i = 0; i < NROWS; i++)
-        if (rows[i].codec == c && rows[i].hw == CAP_HW_OFF && avcodec_find_encoder_by_name(rows[i].name))
-            return rows[i].name;
-    return NULL;
+    const enc_row *row = soft_row(&(cap_enc){.codec = c}, w, h);
+    return row ? row->name : NULL;
 }
 
 /* --- the encoder itself --- */
@@ -601,7 +608,7 @@ bool cap_enc_trial_run(const cap_enc *enc, int w, int h, const uint8_t *i420, in
     snprintf(s.path, sizeof s.path, "bench encode");
     s.enc.hw = CAP_HW_OFF;
     s.enc.chroma = CAP_CHROMA_420;
-    const char *name = cap_enc_software(enc->codec);
+    const char *name = cap_enc_software(enc->codec, w, h);
     const enc_row *row = name ? row_named(name) : NULL;
     char why[600];
     memset(t, 0, sizeof *t);
@@ -682,9 +689,9 @@ bool cap_sink_encoder(cap_sink *s, const cap_enc *enc, rs_err *err)
     return true;
 }
 
-const char *cap_enc_software(cap_codec c)
+const char *cap_enc_software(cap_codec c, int w, int h)
 {
-    (void)c;
+    (void)c, (void)w, (void)h;
     return NULL;
 }
 

@@ -73,7 +73,7 @@ typedef struct cap_enc_trial {
  * frames) and fills t.  Software encoders only (enc->hw is ignored). */
 bool cap_enc_trial_run(const cap_enc *enc, int w, int h, const uint8_t *i420, int n, uint8_t *decoded,
                        cap_enc_trial *t, rs_err *err);
-/* The software encoder this FFmpeg would use for codec c, or NULL. */
-const char *cap_enc_software(cap_codec c);
+/* The software encoder this FFmpeg would use for codec c at w x h (4:2:0), or NULL. */
+const char *cap_enc_software(cap_codec c, int w, int h);
 
 #endif
