@@ -140,7 +140,7 @@ static const enc_row rows[] = {
     {CAP_CODEC_H264, "libx264", CAP_HW_OFF, "preset", x26x_presets, "veryfast", 20, 51, 0},
     {CAP_CODEC_HEVC, "hevc_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 25, 51, 0},
     {CAP_CODEC_HEVC, "hevc_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 25, 51, 0},
-    {CAP_CODEC_HEVC, "libx265", CAP_HW_OFF, "preset", x26x_presets, "superfast", 22, 51, 0},
+    {CAP_CODEC_HEVC, "libx265", CAP_HW_OFF, "preset", x26x_presets, "superfast", 20, 51, 0},
     {CAP_CODEC_VP9, "vp9_vaapi", CAP_HW_VAAPI, NULL, NULL, NULL, 100, 255, 0},
     {CAP_CODEC_VP9, "libvpx-vp9", CAP_HW_OFF, "cpu-used", NULL, "8", 32, 63, 0},
     {CAP_CODEC_AV1, "av1_nvenc", CAP_HW_NVENC, "preset", NULL, "p4", 30, 51, 0},

@@ -74,7 +74,7 @@ static void help(void)
            "  --codec C          h264, hevc, vp9 or av1 (.mp4: h264, hevc, av1; .webm: vp9, av1;\n"
            "                     .mkv: all); default h264, vp9 for .webm\n"
            "  --crf N            constant quality, lower is better (x264/x265 1..51, default\n"
-           "                     20/22; vp9/av1 1..63, default 32/35)\n"
+           "                     20 both; vp9/av1 1..63, default 32/35)\n"
            "  --bitrate RATE     an average rate instead, such as 4M or 800k\n"
            "  --preset P         the encoder's own speed names: x264/x265 ultrafast..placebo\n"
            "                     (default veryfast/superfast), vp9 cpu-used -8..8 (default 8),\n"
@@ -108,8 +108,10 @@ static void render_meta(cap_sink *s, const char *replay, const rp_replay *rp)
     cap_sink_meta(s, "players", text);
     if (rp->winner > 0)
         snprintf(text, sizeof text, "P%d, rounds %d-%d", rp->winner, rp->rounds[0], rp->rounds[1]);
-    else
-        snprintf(text, sizeof text, "%s, rounds %d-%d", rp->winner ? "none (unfinished)" : "draw", rp->rounds[0], rp->rounds[1]);
+    else if (rp->winner == 0)
+        snprintf(text, sizeof text, "draw, rounds %d-%d", rp->rounds[0], rp->rounds[1]);
+    else /* the words of `replay info` */
+        snprintf(text, sizeof text, "none (match unfinished, rounds %d-%d)", rp->rounds[0], rp->rounds[1]);
     cap_sink_meta(s, "winner", text);
     cap_sink_meta(s, "ringside_version", RS_VERSION);
 }
