@@ -100,24 +100,24 @@ t_yuv444_tagged_and_decodes() {
 }
 
 t_bad_settings_refused() {
-    expect_fail 2 "x.webm: WebM does not hold h264" render $TINY --codec h264 -o x.webm || return 1
-    expect_fail 2 "x.mp4: MP4 does not hold vp9" render $TINY --codec vp9 -o x.mp4 || return 1
-    expect_fail 2 "--preset 'quick' is not one of libx264's presets \(ultrafast, .*placebo\)" render $TINY --preset quick -o x.mp4 || return 1
-    expect_fail 2 "--preset '20' is not one of libvpx-vp9's presets \(-8\.\.8\)" render $TINY --preset 20 -o x.webm || return 1
-    expect_fail 2 "--crf and --bitrate exclude each other" render $TINY --crf 20 --bitrate 1M -o x.mp4 || return 1
-    expect_fail 2 "--crf 60: libx264 takes 1\.\.51" render $TINY --crf 60 -o x.mp4 || return 1
-    expect_fail 2 "--codec 'h265': expected h264, hevc, vp9 or av1" render $TINY --codec h265 -o x.mp4 || return 1
-    expect_fail 2 "--bitrate '4X'" render $TINY --bitrate 4X -o x.mp4 || return 1
-    expect_fail 2 "--pix-fmt 'rgb24'" render $TINY --pix-fmt rgb24 -o x.mp4 || return 1
-    expect_fail 2 "x.y4m: --codec, --crf.* apply to .mp4, .mkv and .webm" render $TINY --crf 20 -o x.y4m || return 1
+    expect_fail 2 "x.webm: WebM does not hold h264" render --ticks 0:2 $TINY --codec h264 -o x.webm || return 1
+    expect_fail 2 "x.mp4: MP4 does not hold vp9" render --ticks 0:2 $TINY --codec vp9 -o x.mp4 || return 1
+    expect_fail 2 "--preset 'quick' is not one of libx264's presets \(ultrafast, .*placebo\)" render --ticks 0:2 $TINY --preset quick -o x.mp4 || return 1
+    expect_fail 2 "--preset '20' is not one of libvpx-vp9's presets \(-8\.\.8\)" render --ticks 0:2 $TINY --preset 20 -o x.webm || return 1
+    expect_fail 2 "--crf and --bitrate exclude each other" render --ticks 0:2 $TINY --crf 20 --bitrate 1M -o x.mp4 || return 1
+    expect_fail 2 "--crf 60: libx264 takes 1\.\.51" render --ticks 0:2 $TINY --crf 60 -o x.mp4 || return 1
+    expect_fail 2 "--codec 'h265': expected h264, hevc, vp9 or av1" render --ticks 0:2 $TINY --codec h265 -o x.mp4 || return 1
+    expect_fail 2 "--bitrate '4X'" render --ticks 0:2 $TINY --bitrate 4X -o x.mp4 || return 1
+    expect_fail 2 "--pix-fmt 'rgb24'" render --ticks 0:2 $TINY --pix-fmt rgb24 -o x.mp4 || return 1
+    expect_fail 2 "x.y4m: --codec, --crf.* apply to .mp4, .mkv and .webm" render --ticks 0:2 $TINY --crf 20 -o x.y4m || return 1
     [ ! -e x.mp4 ] && [ ! -e x.webm ] && [ ! -e x.mp4.part ] || { echo "a refused render left a file"; ls; return 1; }
 }
 
 t_hw_without_devices() {
     no_hw_nodes || t_skip_case "this machine has a GPU device node: the fallback is not what runs"
-    expect_fail 1 "x.mp4: --hw nvenc: no device /dev/nvidia0" render $TINY --hw nvenc -o x.mp4 || return 1
-    expect_fail 1 "x.mp4: --hw vaapi: no device /dev/dri/renderD" render $TINY --hw vaapi --codec hevc -o x.mp4 || return 1
-    expect_fail 1 "--hw nvenc: NVENC has no vp9 encoder" render $TINY --hw nvenc -o x.webm || return 1
+    expect_fail 1 "x.mp4: --hw nvenc: no device /dev/nvidia0" render --ticks 0:2 $TINY --hw nvenc -o x.mp4 || return 1
+    expect_fail 1 "x.mp4: --hw vaapi: no device /dev/dri/renderD" render --ticks 0:2 $TINY --hw vaapi --codec hevc -o x.mp4 || return 1
+    expect_fail 1 "--hw nvenc: NVENC has no vp9 encoder" render --ticks 0:2 $TINY --hw nvenc -o x.webm || return 1
     # auto: nothing to try, nothing to say; the software encoder is named in the wrote line
     render --ticks 0:10 $TINY -o a.mp4 2>err.txt || { cat err.txt; return 1; }
     ! grep -qi "hardware\|nvenc\|vaapi" err.txt || { echo "--hw auto spoke without a device:"; cat err.txt; return 1; }
