@@ -21,7 +21,10 @@
  *   is drawn.  The probe's libav messages are caught, not printed: the
  *   reason goes into the one note line (s->enc_note).  Probing runs on the
  *   thread that calls cap_sink_encoder, before the writer thread exists,
- *   because the libav log callback is process-wide. */
+ *   because the libav log callback is process-wide.
+ * - A segment (--segment) does not try hardware unless asked by name: the
+ *   segments of one job may run on different machines, and join needs one
+ *   encoder's parameter sets in all of them. */
 #include "cap_enc.h"
 
 #include <ctype.h>
@@ -341,6 +344,9 @@ bool cap_sink_encoder(cap_sink *s, const cap_enc *enc, rs_err *err)
         return rs_fail(err, CAP_ERR_ENC_SETTING, "%s: %s does not hold %s (%s)", s->path, !strcmp(fmt, "webm") ? "WebM" : "MP4",
                        cap_codec_name(e.codec),
                        !strcmp(fmt, "webm") ? "WebM takes vp9 or av1; use .mp4 or .mkv" : "MP4 takes h264, hevc or av1; use .webm or .mkv");
+    if (s->segment && e.hw == CAP_HW_AUTO)
+        e.hw = CAP_HW_OFF; /* segments of one video may be rendered on machines with and without a GPU: they must
+                            * all get the same encoder, or join cannot stream-copy them (--hw nvenc still asks) */
     if (e.crf && e.bitrate)
         return rs_fail(err, CAP_ERR_ENC_SETTING, "%s: --crf and --bitrate exclude each other (constant quality or an average rate)",
                        s->path);
