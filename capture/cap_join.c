@@ -80,20 +80,28 @@ fail:
     return NULL;
 }
 
-/* The output stream, from the first segment's (all are equal: verified). */
-static bool write_header(cap_join *j, const AVStream *in, rs_err *err)
+/* The output stream, from the first segment's (all are equal: verified),
+ * and the first segment's metadata (the keys the render writes). */
+static bool write_header(cap_join *j, const AVFormatContext *ic, const AVStream *in, rs_err *err)
 {
     if (!(j->st = avformat_new_stream(j->fmt, NULL)))
         return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", j->d.out);
     int r = avcodec_parameters_copy(j->st->codecpar, in->codecpar);
     if (r < 0)
         return fail_av(err, CAP_ERR_NOMEM, j->d.out, "codec parameters", r);
-    j->st->codecpar->codec_tag = 0; /* the output container's own tag */
+    bool mp4 = !strcmp(cap_seg_format_of(j->d.out), "mp4");
+    /* the output container's own tag; HEVC in MP4 as hvc1, as the render writes it (cap_sink_ffmpeg.c) */
+    j->st->codecpar->codec_tag = mp4 && in->codecpar->codec_id == AV_CODEC_ID_HEVC ? MKTAG('h', 'v', 'c', '1') : 0;
+    for (int i = 0; cap_meta_keys[i]; i++) {
+        const AVDictionaryEntry *e = av_dict_get(ic->metadata, cap_meta_keys[i], NULL, 0); /* any case: MKV's are upper */
+        if (e)
+            av_dict_set(&j->fmt->metadata, cap_meta_keys[i], e->value, 0);
+    }
     j->st->time_base = (AVRational){1, 60};
     j->st->avg_frame_rate = j->st->r_frame_rate = (AVRational){60, 1};
     AVDictionary *opts = NULL;
-    if (!strcmp(cap_seg_format_of(j->d.out), "mp4"))
-        av_dict_set(&opts, "movflags", "+faststart", 0); /* the index before the frames: plays while it downloads */
+    if (mp4) /* the index before the frames: plays while it downloads; every metadata key kept */
+        av_dict_set(&opts, "movflags", "+faststart+use_metadata_tags", 0);
     r = avformat_write_header(j->fmt, &opts);
     av_dict_free(&opts);
     if (r < 0)
@@ -138,7 +146,7 @@ static bool copy_one(cap_join *j, const cap_seg *s, int64_t origin, int reorder,
             rs_fail(err, CAP_ERR_SEG_MEDIA, "%s: changed since it was verified", s->path);
         goto done;
     }
-    if (!j->header && !write_header(j, ic->streams[0], err)) {
+    if (!j->header && !write_header(j, ic, ic->streams[0], err)) {
         *seg_fault = false;
         goto done;
     }

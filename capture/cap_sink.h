@@ -12,6 +12,7 @@
 #include <stdint.h>
 
 #include "../runtime/util/rs_err.h"
+#include "cap_enc.h"
 
 /* Error ids (rs_err.h) of the whole capture pipeline: sizes, sinks,
  * outputs, the writer and the GL readback. */
@@ -35,7 +36,10 @@
     X(SEG_SIZE, "a segment file's byte size differs from its manifest (truncated or grown)")           \
     X(SEG_MEDIA, "a segment file does not open, or its packets differ from its manifest")             \
     X(SEG_CODEC, "a segment's codec parameters differ from the others (no stream copy possible)")      \
-    X(SEG_HASHES, "a segment's frame hash list is missing, malformed or differs from its manifest")
+    X(SEG_HASHES, "a segment's frame hash list is missing, malformed or differs from its manifest")  \
+    /* encoder settings (cap_enc.h) */                                                               \
+    X(ENC_SETTING, "an encoder setting that the container or the encoder does not take")              \
+    X(ENC_HW, "the hardware encoder asked for (--hw nvenc|vaapi) has no device or does not open")
 
 typedef enum cap_error {
     CAP_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_CAP),
@@ -57,6 +61,15 @@ typedef enum cap_pixfmt {
 } cap_pixfmt;
 
 size_t cap_frame_bytes(cap_pixfmt fmt, int w, int h);
+
+/* Container metadata (title, stage, ...): FFmpeg sinks write it, join
+ * copies it.  Keys are the ones in cap_meta_keys, in that order. */
+#define CAP_META_MAX 8
+typedef struct cap_meta {
+    char key[24];
+    char value[160];
+} cap_meta;
+extern const char *const cap_meta_keys[]; /* NULL-terminated */
 
 typedef struct cap_sink cap_sink;
 
@@ -86,7 +99,18 @@ struct cap_sink {
     /* the container, lower case with its dot (".mp4", ".nut"), from the
      * name's extension or --format: sinks go by it, not by the name */
     char ext[8];
+    /* FFmpeg sinks: the encoder settings and the encoder chosen
+     * (cap_sink_encoder; zero: the defaults, chosen at open), and the
+     * metadata to write (cap_sink_meta) */
+    cap_enc enc;
+    char enc_name[32];
+    char enc_note[256];
+    cap_meta meta[CAP_META_MAX];
+    int n_meta;
 };
+
+/* Adds one metadata entry (key from cap_meta_keys; empty values are skipped). */
+void cap_sink_meta(cap_sink *s, const char *key, const char *value);
 
 /* Picks the sink from the output's extension (.y4m, .mp4, .mkv, .webm,
  * name%06d.png|.exr|.tif, any case) and checks it can work (the encoder

@@ -25,7 +25,8 @@ static void help(void)
            "       ringside bench sim [--hours H] [--csv FILE] [--quiet]\n"
            "       ringside bench capture [--frames N] [--sink mp4|y4m|null] ... (see bench capture --help)\n"
            "       ringside bench accuracy [--frames N] ... (see bench accuracy --help)\n"
-           "       ringside bench upload [--frames N] [--modes LIST] ... (see bench upload --help)\n\n"
+           "       ringside bench upload [--frames N] [--modes LIST] ... (see bench upload --help)\n"
+           "       ringside bench encode [--frames N] [--codecs LIST] ... (see bench encode --help)\n\n"
            "bench sim records a synthetic CPU-vs-CPU replay of H hours of continuous\n"
            "matches (default 24: 5,184,000 ticks), encodes it, decodes it and verifies\n"
            "every checkpoint, printing ticks per second for each step and the sizes.\n\n"
@@ -256,8 +257,10 @@ int cmd_bench(int argc, char **argv)
         return bench_accuracy(argc - 1, argv + 1);
     if (!strcmp(argv[1], "upload"))
         return bench_upload(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "encode"))
+        return bench_encode(argc - 1, argv + 1);
     if (strcmp(argv[1], "platform") != 0) {
-        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim, capture, accuracy, upload)", argv[1]);
+        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim, capture, accuracy, upload, encode)", argv[1]);
         return RS_EXIT_USAGE;
     }
     static const struct option opts[] = {{"size", required_argument, 0, 's'},  {"frames", required_argument, 0, 'f'},

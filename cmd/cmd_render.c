@@ -20,6 +20,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "../runtime/util/rs_version.h"
 
 static void help(void)
 {
@@ -30,7 +31,9 @@ static void help(void)
            "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
-           "                       [--ticks A:B] [--segment KEY] [--progress-fd N]\n\n"
+           "                       [--ticks A:B] [--segment KEY] [--progress-fd N]\n"
+           "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
+           "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension (any\n"
            "case) or --format: %s.\n"
@@ -77,6 +80,18 @@ static void help(void)
            "  --progress-fd N    also report progress on file descriptor N, for programs\n"
            "                     (ringside serve): 'frames DONE TOTAL' lines, and 'desync TICK'\n"
            "                     if the replay's state hashes stop matching\n"
+           "  --codec C          h264, hevc, vp9 or av1 (.mp4: h264, hevc, av1; .webm: vp9, av1;\n"
+           "                     .mkv: all); default h264, vp9 for .webm\n"
+           "  --crf N            constant quality, lower is better (x264/x265 1..51, default\n"
+           "                     20 both; vp9/av1 1..63, default 32/35)\n"
+           "  --bitrate RATE     an average rate instead, such as 4M or 800k\n"
+           "  --preset P         the encoder's own speed names: x264/x265 ultrafast..placebo\n"
+           "                     (default veryfast/superfast), vp9 cpu-used -8..8 (default 8),\n"
+           "                     SVT-AV1 -1..13 (default 10), NVENC p1..p7 (default p4)\n"
+           "  --pix-fmt F        yuv420p (default) or yuv444p (full-resolution colour)\n"
+           "  --hw H             auto (default): NVENC or VAAPI when a device exists and the\n"
+           "                     encoder opens, else software, with a note; off: software;\n"
+           "                     nvenc, vaapi: that one or fail (docs/capture.md, Encoders)\n"
            "  --progress MODE    tty: one line redrawn in place; plain: a line every 5 s and\n"
            "                     the last, for logs; off.  Default: tty when stderr is a\n"
            "                     terminal, else plain\n"
@@ -85,6 +100,32 @@ static void help(void)
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
            cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
+}
+
+/* long-only options (no letter): the encoder's */
+enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW };
+
+/* The metadata every video carries (cap_meta_keys): from the replay's header. */
+static void render_meta(cap_sink *s, const char *replay, const rp_replay *rp)
+{
+    static const char *const kind[] = {"human", "cpu"};
+    const char *base = strrchr(replay, '/');
+    char text[160];
+    const char *p1 = kind[rp->kind[0] != 0], *p2 = kind[rp->kind[1] != 0];
+    const char *stage = rp->stage >= 0 && rp->stage < G_STAGES ? g_stages[rp->stage].name : "?";
+    snprintf(text, sizeof text, "%s: P1 (%s) vs P2 (%s), %s", base ? base + 1 : replay, p1, p2, stage);
+    cap_sink_meta(s, "title", text);
+    cap_sink_meta(s, "stage", stage);
+    snprintf(text, sizeof text, "P1 %s, P2 %s", p1, p2);
+    cap_sink_meta(s, "players", text);
+    if (rp->winner > 0)
+        snprintf(text, sizeof text, "P%d, rounds %d-%d", rp->winner, rp->rounds[0], rp->rounds[1]);
+    else if (rp->winner == 0)
+        snprintf(text, sizeof text, "draw, rounds %d-%d", rp->rounds[0], rp->rounds[1]);
+    else /* the words of `replay info` */
+        snprintf(text, sizeof text, "none (match unfinished, rounds %d-%d)", rp->rounds[0], rp->rounds[1]);
+    cap_sink_meta(s, "winner", text);
+    cap_sink_meta(s, "ringside_version", RS_VERSION);
 }
 
 /* Ctrl-C / SIGTERM: the handler only sets a flag; the loop stops, and
@@ -112,7 +153,10 @@ int cmd_render(int argc, char **argv)
         {"segment", required_argument, 0, 'S'},    {"help", no_argument, 0, 'h'},
         {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
         {"format", required_argument, 0, 'f'},     {"progress", required_argument, 0, 'g'},
+        {"codec", required_argument, 0, OPT_CODEC}, {"crf", required_argument, 0, OPT_CRF},
+        {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
         {0}};
+    cap_enc enc = {0};
     const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL;
     bool overwrite = false;
     int progress = RS_PROGRESS_AUTO;
@@ -212,6 +256,32 @@ int cmd_render(int argc, char **argv)
         case 'n': overwrite = false; break;
         case 'f': format = optarg; break;
         case 'g': if (!cli_progress_mode("render", optarg, &progress)) return RS_EXIT_USAGE; break;
+        case OPT_CODEC:
+            if (!cap_codec_parse(optarg, &enc.codec)) {
+                cli_error("render", "--codec '%s': expected h264, hevc, vp9 or av1", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case OPT_CRF: if (!cli_int("--crf", optarg, 1, 255, &v)) return RS_EXIT_USAGE; enc.crf = (int)v; break;
+        case OPT_BITRATE:
+            if (!cap_bitrate_parse(optarg, &enc.bitrate)) {
+                cli_error("render", "--bitrate '%s': expected bits a second such as 4M, 800k or 2500000 (10k..1000M)", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case OPT_PRESET: snprintf(enc.preset, sizeof enc.preset, "%s", optarg); break;
+        case OPT_PIXFMT:
+            if (!cap_chroma_parse(optarg, &enc.chroma)) {
+                cli_error("render", "--pix-fmt '%s': expected yuv420p or yuv444p", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
+        case OPT_HW:
+            if (!cap_hw_parse(optarg, &enc.hw)) {
+                cli_error("render", "--hw '%s': expected auto, off, nvenc or vaapi", optarg);
+                return RS_EXIT_USAGE;
+            }
+            break;
         default: return cli_bad_option("render", argv);
         }
     }
@@ -299,6 +369,13 @@ int cmd_render(int argc, char **argv)
     }
     sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
     sink.segment = segment != NULL;
+    render_meta(&sink, replay, &rp);
+    if (!cap_sink_encoder(&sink, &enc, &err)) {
+        status = err.code == CAP_ERR_ENC_SETTING ? RS_EXIT_USAGE : RS_EXIT_FAIL;
+        goto done;
+    }
+    if (sink.enc_note[0])
+        fprintf(stderr, "ringside render: %s\n", sink.enc_note); /* once: the choice is made here, for the whole run */
     /* a manifest says "complete": an older one must not vouch for the files this render replaces */
     if (segment && unlink(seg_manifest) != 0 && errno != ENOENT) {
         rs_fail(&err, 1, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
@@ -391,12 +468,12 @@ int cmd_render(int argc, char **argv)
     if (!quiet)
         fprintf(stderr,
                 "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d) in %.1f s, %.1f fps; %s capture, "
-                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits\n",
+                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s\n",
                 out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, secs, secs > 0 ? st.frames / secs : 0.0,
                 cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
-                st.high_water, st.fence_waits);
+                st.high_water, st.fence_waits, sink.enc_name[0] ? "; encoder " : "", sink.enc_name);
     if (!quiet && t_first > 0)
         fprintf(stderr,
                 "ringside render: warm-up for tick %" PRIu64 ": the effects' history from tick %" PRIu64 " (%" PRIu64
