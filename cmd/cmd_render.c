@@ -154,6 +154,7 @@ int cmd_render(int argc, char **argv)
         {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
         {"format", required_argument, 0, 'f'},     {"progress", required_argument, 0, 'g'},
         {"codec", required_argument, 0, OPT_CODEC}, {"crf", required_argument, 0, OPT_CRF},
+        {"bitrate", required_argument, 0, OPT_BITRATE}, {"preset", required_argument, 0, OPT_PRESET},
         {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
         {0}};
     cap_enc enc = {0};

@@ -138,7 +138,7 @@ t_segments_with_a_codec_join() {
     ffmpeg -v error -i j.mp4 -f framemd5 - | grep -v '^#' | cut -d, -f6 >joined.md5
     [ "$(wc -l <joined.md5)" = 120 ] && cmp -s segs.md5 joined.md5 || { echo "joined frames differ from the segments'"; return 1; }
     # a segment with other codec parameters cannot be stream-copied with the rest
-    render --ticks 40:90 $TINY -q --segment jh -o s40.mp4 || return 1
+    render --ticks 40:90 $TINY -q -y --segment jh -o s40.mp4 || return 1
     "$RS_BIN" join --segment jh -o k.mp4 --progress-fd 3 s0.mp4 s40.mp4 s90.mp4 3>bad.txt 2>err.txt
     [ $? = 3 ] && grep -q "^bad 1 codec " bad.txt || { echo "mixed h264/hevc segments not refused:"; cat bad.txt err.txt; return 1; }
 }
