@@ -175,7 +175,8 @@ static void help(void)
            "  --sink S           mp4 (H.264, default), y4m (raw, disk-bound) or null\n"
            "  --runs N           repeat every configuration N times, report medians (default 3)\n"
            "  --csv FILE         the table as CSV (default out/bench-capture.csv)\n"
-           "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n",
+           "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n"
+           "  --quiet            no progress line\n",
            "the");
 }
 

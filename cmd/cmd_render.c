@@ -24,8 +24,8 @@
 static void help(void)
 {
     printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
-           "                       [--capture async|sequential] [--downscale gpu|cpu] [--filter F]\n"
-           "                       [--pbo N] [--queue N]\n"
+           "                       [--capture async|sequential] [--downscale gpu|cpu]\n"
+           "                       [--filter box|bilinear|nearest|lanczos3] [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
