@@ -109,7 +109,15 @@ done
     printf 'which override the file; ringside serve --print-config prints every value.\n'
     printf 'An example with every setting, its default and its meaning, commented out, is\n'
     printf 'installed as share/doc/ringside/ringside.conf.example.\n\n'
-    printf 'Settings (name, default, meaning):\n'
-    "$bin" serve --help | awk '/^Settings/ { on = 1; next } on && /^$/ { exit } on'
+    printf 'Settings:\n'
+    # "  name  default  help" -> "  name  help (default: D)"; "(see text)"
+    # defaults are spelled out in the help
+    "$bin" serve --help | awk '/^Settings/ { on = 1; next } on && /^$/ { exit }
+        on {
+            name = $1; rest = $0; sub(/^ +[^ ]+ +/, "", rest)
+            if (rest ~ /^\(see text\)/) { sub(/^\(see text\) +/, "", rest); print "  " name "  " rest; next }
+            def = rest; sub(/ .*/, "", def); sub(/^[^ ]+ +/, "", rest)
+            print "  " name "  " rest " (default: " def ")"
+        }'
 } | { printf 'usage: ringside serve --config FILE\n\n'; cat; } |
     help2roff ringside.conf 5 "settings file of ringside serve" >"$out/ringside.conf.5"
