@@ -205,7 +205,7 @@ demo-replays: $(BUILD)/ringside
 	    $(BUILD)/ringside record --ai --quiet --stage $$stage --seed $$seed -o demos/$$stage.rsr || exit 1; \
 	done
 
-# --- what a system package ships (docs/packaging in README) ---
+# --- what a system package ships (README, Installing) ---
 # The manual pages, the completion and the example config are made from the
 # binary's own --help (tools/man.sh says why), so they are rebuilt with it.
 MAN_STAMP := $(BUILD)/man/.made
