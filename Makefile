@@ -8,7 +8,8 @@
 #   make debug      -O0 build with GL error checks in build-debug/
 #   make demo       the main job on the bundled default (see README)
 #   make bench      benchmarks
-#   make install PREFIX=/usr/local
+#   make man        manual pages, bash completion, example config in build/man, build/dist
+#   make install PREFIX=/usr/local [DESTDIR=...]   (make uninstall removes it all)
 #   make clean
 #
 # Variables: BUILD (output dir), OPT, SAN=1, DEBUG=1, WERROR=1 (on when CI=true),
@@ -91,7 +92,7 @@ MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 check-layers:
 	@tools/check-layers.sh
 
-.PHONY: check-layers all test test-service asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run
+.PHONY: check-layers all test test-service asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -105,6 +106,8 @@ $(STAMPS)/test: tools/deps.sh
 	@tools/deps.sh test
 $(STAMPS)/service: tools/deps.sh
 	@tools/deps.sh service
+$(STAMPS)/man: tools/deps.sh
+	@tools/deps.sh man
 deps: $(STAMPS)/build $(STAMPS)/test
 
 $(BUILD)/config.mk: tools/configure.sh $(STAMPS)/build
@@ -165,7 +168,7 @@ $(BUILD)/tests/simhash-clang: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/rep
 	clang -std=c11 -D_POSIX_C_SOURCE=200809L -O2 -ffp-contract=off -o $@ $(SIM_SRC) -lm
 
 # --- tests ---
-test: $(STAMPS)/test $(BUILD)/ringside $(TEST_BIN) $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2 $(SIMHASH_CLANG)
+test: $(STAMPS)/test $(STAMPS)/man $(BUILD)/ringside $(TEST_BIN) $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2 $(SIMHASH_CLANG)
 	@tests/run.sh $(BUILD) $(T)
 
 # the service end to end: real HTTP, SQLite, a PostgreSQL server started by
@@ -202,19 +205,67 @@ demo-replays: $(BUILD)/ringside
 	    $(BUILD)/ringside record --ai --quiet --stage $$stage --seed $$seed -y -o demos/$$stage.rsr || exit 1; \
 	done
 
+# --- what a system package ships (README, Installing) ---
+# The manual pages, the completion and the example config are made from the
+# binary's own --help (tools/man.sh says why), so they are rebuilt with it.
+MAN_STAMP := $(BUILD)/man/.made
+man: $(MAN_STAMP) $(BUILD)/dist/ringside.bash $(BUILD)/dist/ringside.conf.example
+$(MAN_STAMP): $(BUILD)/ringside tools/man.sh $(STAMPS)/man
+	@rm -rf $(BUILD)/man
+	tools/man.sh $(BUILD)/ringside $(BUILD)/man
+	@for f in $(BUILD)/man/*.[15]; do w=$$(groff -man -Tutf8 -ww -z $$f 2>&1); \
+	    [ -z "$$w" ] || { echo "$$f: $$w" >&2; exit 1; }; done
+	@touch $@
+$(BUILD)/dist/ringside.bash: $(BUILD)/ringside tools/completion.sh
+	@mkdir -p $(dir $@)
+	tools/completion.sh $(BUILD)/ringside > $@.tmp && mv $@.tmp $@
+$(BUILD)/dist/ringside.conf.example: $(BUILD)/ringside tools/example-conf.sh
+	@mkdir -p $(dir $@)
+	tools/example-conf.sh $(BUILD)/ringside > $@.tmp && mv $@.tmp $@
+
 # --- install ---
-install: $(BUILD)/ringside
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/ringside/shaders $(DESTDIR)$(PREFIX)/share/ringside/demos \
-	    $(DESTDIR)$(PREFIX)/share/ringside/stages $(DESTDIR)$(PREFIX)/share/ringside/service
+# Where the files go under PREFIX (and DESTDIR, for packagers):
+#   bin/ringside; share/ringside/{shaders,demos,stages,service}: what it reads at run time
+#   share/man/man1, man5; share/bash-completion/completions/ringside
+#   lib/systemd/system/ringside.service (SYSTEMD_UNIT_DIR: /lib/systemd/system for PREFIX=/usr)
+#   share/doc/ringside: README.md, docs/, ringside.conf.example
+#   SYSCONFDIR/ringside/ringside.conf (/etc for PREFIX=/usr, else PREFIX/etc): the
+#   example, as the unit's config file, only where there is none (never over
+#   an operator's); uninstall removes it only while it is still the example
+DATA_DIR   = $(DESTDIR)$(PREFIX)/share/ringside
+DOC_DIR    = $(DESTDIR)$(PREFIX)/share/doc/ringside
+MAN_DIR    = $(DESTDIR)$(PREFIX)/share/man
+COMPL_DIR  = $(DESTDIR)$(PREFIX)/share/bash-completion/completions
+SYSTEMD_UNIT_DIR ?= $(PREFIX)/lib/systemd/system
+SYSCONFDIR ?= $(if $(filter /usr,$(PREFIX)),/etc,$(PREFIX)/etc)
+CONF       = $(DESTDIR)$(SYSCONFDIR)/ringside/ringside.conf
+install: $(BUILD)/ringside man
+	install -d $(DESTDIR)$(PREFIX)/bin $(DATA_DIR)/shaders $(DATA_DIR)/demos $(DATA_DIR)/stages $(DATA_DIR)/service \
+	    $(MAN_DIR)/man1 $(MAN_DIR)/man5 $(COMPL_DIR) $(DESTDIR)$(SYSTEMD_UNIT_DIR) $(DOC_DIR)/docs \
+	    $(DESTDIR)$(SYSCONFDIR)/ringside
 	install -m 755 $(BUILD)/ringside $(DESTDIR)$(PREFIX)/bin/ringside
-	install -m 644 shaders/* $(DESTDIR)$(PREFIX)/share/ringside/shaders/
-	install -m 644 demos/*.rsr $(DESTDIR)$(PREFIX)/share/ringside/demos/
-	install -m 644 stages/*.stage $(DESTDIR)$(PREFIX)/share/ringside/stages/
-	install -m 644 service/dashboard.html $(DESTDIR)$(PREFIX)/share/ringside/service/
+	install -m 644 shaders/* $(DATA_DIR)/shaders/
+	install -m 644 demos/*.rsr $(DATA_DIR)/demos/
+	install -m 644 stages/*.stage $(DATA_DIR)/stages/
+	install -m 644 service/dashboard.html $(DATA_DIR)/service/
+	install -m 644 $(BUILD)/man/*.1 $(MAN_DIR)/man1/
+	install -m 644 $(BUILD)/man/*.5 $(MAN_DIR)/man5/
+	install -m 644 $(BUILD)/dist/ringside.bash $(COMPL_DIR)/ringside
+	sed -e 's|@BINDIR@|$(PREFIX)/bin|g' -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' dist/ringside.service > $(DESTDIR)$(SYSTEMD_UNIT_DIR)/ringside.service
+	chmod 644 $(DESTDIR)$(SYSTEMD_UNIT_DIR)/ringside.service
+	install -m 644 README.md $(BUILD)/dist/ringside.conf.example $(DOC_DIR)/
+	install -m 644 docs/*.md docs/*.png $(DOC_DIR)/docs/
+	@if [ -e $(CONF) ]; then echo "install: $(CONF) exists: left as it is"; \
+	    else echo "install -m 644 $(BUILD)/dist/ringside.conf.example $(CONF)"; \
+	    install -m 644 $(BUILD)/dist/ringside.conf.example $(CONF); fi
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/ringside
-	rm -rf $(DESTDIR)$(PREFIX)/share/ringside
+	rm -rf $(DESTDIR)$(PREFIX)/share/ringside $(DESTDIR)$(PREFIX)/share/doc/ringside
+	rm -f $(MAN_DIR)/man1/ringside.1 $(MAN_DIR)/man1/ringside-*.1 $(MAN_DIR)/man5/ringside.conf.5
+	rm -f $(COMPL_DIR)/ringside $(DESTDIR)$(SYSTEMD_UNIT_DIR)/ringside.service
+	@if [ -e $(CONF) ] && ! grep -qv '^#\|^$$' $(CONF); then rm -f $(CONF); rmdir $(DESTDIR)$(SYSCONFDIR)/ringside 2>/dev/null; \
+	    elif [ -e $(CONF) ]; then echo "uninstall: $(CONF) has settings: left as it is"; fi; true
 
 clean:
 	rm -rf build build-asan build-debug out

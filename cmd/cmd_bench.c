@@ -21,27 +21,29 @@
 
 static void help(void)
 {
-    printf("usage: ringside bench platform [--size WxH] [--frames N] [--runs N] [--csv FILE]\n"
-           "       ringside bench sim [--hours H] [--csv FILE] [--quiet]\n"
+    printf("usage: ringside bench platform [--size WxH] [--frames N] [--runs N] [--csv FILE] [-y|-n]\n"
+           "       ringside bench sim [--hours H] [--csv FILE] [-y|-n] [--progress tty|plain|off] [--quiet]\n"
            "       ringside bench capture [--frames N] [--sink mp4|y4m|null] ... (see bench capture --help)\n"
            "       ringside bench accuracy [--frames N] ... (see bench accuracy --help)\n"
            "       ringside bench upload [--frames N] [--modes LIST] ... (see bench upload --help)\n"
            "       ringside bench encode [--frames N] [--codecs LIST] ... (see bench encode --help)\n\n"
+           "bench platform times every headless backend built in (egl, osmesa) in one run\n"
+           "on the smoke scene: context start-up, draw (glFinish), and draw + full-frame\n"
+           "glReadPixels.  Each figure is the median over the runs; the ratio line compares\n"
+           "backends measured side by side, which is what to trust on a noisy machine.\n\n"
            "bench sim records a synthetic CPU-vs-CPU replay of H hours of continuous\n"
            "matches (default 24: 5,184,000 ticks), encodes it, decodes it and verifies\n"
            "every checkpoint, printing ticks per second for each step and the sizes.\n\n"
-           "Times every headless backend built in (egl, osmesa) in one run on the smoke\n"
-           "scene: context start-up, draw (glFinish), and draw + full-frame glReadPixels.\n"
-           "Each figure is the median over the runs; the ratio line compares backends\n"
-           "measured side by side, which is what to trust on a noisy machine.\n\n"
-           "  --size WxH    frame size (default 1280x720)\n"
-           "  --frames N    frames per run (default 60)\n"
-           "  --runs N      runs per backend (default 5)\n"
+           "  --size WxH    platform: frame size (default 1280x720)\n"
+           "  --frames N    platform: frames per run (default 60)\n"
+           "  --runs N      platform: runs per backend (default 5)\n"
+           "  --hours H     sim: hours of matches, 1..168 (default 24)\n"
            "  --csv FILE    also write the table as CSV ('-': standard output, after the table);\n"
            "                its folder must exist\n"
            "  -y, -n        replace an existing --csv FILE, or refuse it, naming it (the default)\n"
            "  --progress M  sim: tty, plain (a line every 5 s and the last) or off; default\n"
-           "                tty on a terminal, else plain\n");
+           "                tty on a terminal, else plain\n"
+           "  --quiet       sim: no progress line (--progress off)\n");
 }
 
 static void on_progress(uint64_t done, uint64_t total, void *user)

@@ -207,6 +207,8 @@ static void help(void)
            "           shadow maps against uniform shadow mapping, 1024x1024 map, by light angle.\n\n"
            "  --only T            one table (default: all six)\n"
            "  --frames N          capture: frames from tick 600 on, 60 ticks apart (default 8)\n"
+           "  --size WxH          capture: the downscaled size (default 640x360)\n"
+           "  --render-size WxH   capture: the size the frames are drawn at (default 1280x720)\n"
            "  --ibl-sizes LIST    source cube edges, comma-separated (default 8,16,32,64)\n"
            "  --ibl-reference N   the reference cube's edge (default 128)\n"
            "  --stage NAME        the stage whose environment the IBL table uses (default dojo)\n"

@@ -162,7 +162,7 @@ static bool do_run(bench *b, run *r, rs_err *err)
 static void help(void)
 {
     printf("usage: ringside bench capture [--frames N] [--runs N] [--size WxH] [--render-size WxH]\n"
-           "                              [--sink mp4|y4m|null] [--csv FILE] [--chart FILE.png] [--quiet]\n\n"
+           "                              [--sink mp4|y4m|null] [--csv FILE] [--chart FILE.png] [-y|-n] [--quiet]\n\n"
            "Renders %s same frames of demos/dojo.rsr (from tick 600) through every capture\n"
            "configuration and prints fps and milliseconds per frame for each stage:\n"
            "render-only, writer-only (frames from memory to the sink), sequential (CPU\n"
@@ -178,7 +178,8 @@ static void help(void)
            "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n"
            "  -y, -n             replace a --csv or --chart FILE given here, or refuse it (the\n"
            "                     default); the defaults under out/ are replaced each run.\n"
-           "                     --csv - writes to standard output\n",
+           "                     --csv - writes to standard output\n"
+           "  --quiet            no progress line\n",
            "the");
 }
 

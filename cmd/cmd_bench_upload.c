@@ -62,7 +62,7 @@ typedef struct bench {
 static void help(void)
 {
     printf("usage: ringside bench upload [--frames N] [--size WxH] [--modes LIST] [--runs N]\n"
-           "                             [--csv FILE] [--backend egl|osmesa] [--quiet]\n\n"
+           "                             [--csv FILE] [--backend egl|osmesa] [-y|-n] [--quiet]\n\n"
            "Plays synthetic 4:2:0 movie frames (BT.709, 60 fps, %d distinct frames) through\n"
            "each texture upload path the movie player has, the way the player drives it on\n"
            "one 60 Hz tick, as fast as possible, and prints milliseconds per frame:\n"

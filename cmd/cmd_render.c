@@ -25,8 +25,8 @@
 static void help(void)
 {
     printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
-           "                       [--capture async|sequential] [--downscale gpu|cpu] [--filter F]\n"
-           "                       [--pbo N] [--queue N]\n"
+           "                       [--capture async|sequential] [--downscale gpu|cpu]\n"
+           "                       [--filter box|bilinear|nearest|lanczos3] [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
            "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"

@@ -46,7 +46,7 @@ static void token_help(void)
     printf("usage: ringside serve token add NAME [--operator] [--max-queued N] [--seconds-per-hour N]\n"
            "       ringside serve token list\n"
            "       ringside serve token revoke NAME|ID\n"
-           "       (each also takes serve's --config, --data, --queue: the queue they act on)\n\n"
+           "       (each also takes serve's --config FILE, --data DIR and --queue Q: the queue they act on)\n\n"
            "API tokens for 'ringside serve'.  Clients send one as 'Authorization: Bearer TOKEN'.\n"
            "A token sees and acts on its own jobs only; an operator token on every job.\n"
            "The queue keeps only a token's SHA-256: 'add' prints the token once, and it\n"

@@ -20,23 +20,33 @@ static const cli_cmd commands[] = {
     {"movie", cmd_movie, "play a movie (Y4M or anything FFmpeg decodes) on the 60 Hz tick"},
     {"replay", cmd_replay, "replay info FILE, replay verify FILE"},
     {"serve", cmd_serve, "the replay-to-video daemon: HTTP API, dashboard, queue, workers"},
-    {"bench", cmd_bench, "run a benchmark (bench platform, bench sim)"},
+    {"bench", cmd_bench, "run a benchmark: bench platform, sim, capture, accuracy or upload"},
 };
 
+/* DESIGN: this text is also the source of ringside(1) (tools/man.sh) and of
+ * the bash completion (tools/completion.sh): the usage block first, then
+ * paragraphs, and lists as "  TERM  text" lines. */
 static void usage(FILE *f)
 {
-    fprintf(f, "ringside %s: arcade fighting-game runtime with replay capture\n\n"
-               "usage: ringside COMMAND [OPTIONS]\n\ncommands:\n",
+    fprintf(f, "usage: ringside COMMAND [OPTIONS]\n"
+               "       ringside help COMMAND\n\n"
+               "ringside %s: arcade fighting-game runtime with replay capture.\n\n"
+               "commands:\n",
             RS_VERSION);
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
     fprintf(f, "  %-9s %s\n", "help", "this text; 'ringside COMMAND --help' for one command");
     fprintf(f, "  %-9s %s\n", "version", "print the version");
     fprintf(f, "\nGL backends built in: %s (headless default: egl, then osmesa)\n"
-               "environment: RINGSIDE_DATA (directory holding shaders/), RINGSIDE_GL_DEBUG=1,\n"
-               "             RINGSIDE_EGL_DEVICE=N\n"
-               "exit status: 0 success, 1 failure, 2 bad usage (join: 3, a bad segment)\n"
-               "docs: README.md and docs/ in the source tree\n",
+               "\nenvironment:\n"
+               "  RINGSIDE_DATA          the directory holding shaders/ and stages/ (default: found\n"
+               "                         beside the binary in the source tree or the install prefix)\n"
+               "  RINGSIDE_CACHE         where prefiltered lighting is cached (default:\n"
+               "                         $XDG_CACHE_HOME/ringside or ~/.cache/ringside; off: no cache)\n"
+               "  RINGSIDE_GL_DEBUG=1    GL debug messages on stderr\n"
+               "  RINGSIDE_EGL_DEVICE=N  the EGL device to use (default: the first that works)\n"
+               "\nexit status: 0 success, 1 failure, 2 bad usage (join: 3, a bad segment)\n"
+               "docs: 'man ringside-COMMAND'; README.md and docs/ (installed in share/doc/ringside)\n",
             plat_built_backends());
 }
 

@@ -27,8 +27,9 @@ static const c_row rows[] = {
     {"listen", C_LISTEN, OFF(listen), 0, 0, sizeof((svc_config *)0)->listen, "127.0.0.1:8080", NULL,
      "address:port for the HTTP API and dashboard (loopback unless told otherwise)"},
     {"workers", C_INT, OFF(workers), 0, 1, 64, "1", NULL, "render processes running at once"},
-    {"data", C_STR, OFF(data), 0, 1, sizeof((svc_config *)0)->data - 64, "ringside-data", NULL,
-     "directory for the queue database, work files and (by default) videos"},
+    {"data", C_STR, OFF(data), 0, 0, sizeof((svc_config *)0)->data - 64, "", NULL,
+     "directory for the queue database, work files and (by default) videos (default: $STATE_DIRECTORY under "
+     "systemd, else $XDG_STATE_HOME/ringside, else ~/.local/state/ringside)"},
     {"queue", C_STR, OFF(queue), 0, 0, sizeof((svc_config *)0)->queue - 1, "", NULL,
      "sqlite:PATH or postgres://user@host:port/db (default: sqlite:DATA/queue.db)"},
     {"output", C_STR, OFF(output), 0, 0, sizeof((svc_config *)0)->output - 32, "", NULL,
@@ -269,8 +270,35 @@ out:
     return ok;
 }
 
+/* DESIGN: the data directory is state, so its default is where state goes:
+ * systemd's StateDirectory= (STATE_DIRECTORY; a colon-separated list when
+ * the unit names several: ours is the first), else the XDG base directory
+ * spec's XDG_STATE_HOME (ignored unless absolute, as the spec says), else
+ * its default ~/.local/state.  Never the current directory: a daemon's
+ * queue must not depend on where it was started from. */
+static bool default_data(svc_config *c, rs_err *err)
+{
+    const char *v = getenv("STATE_DIRECTORY");
+    size_t max = sizeof c->data - 64;
+    int n;
+    if (v && *v)
+        n = snprintf(c->data, max + 1, "%.*s", (int)strcspn(v, ":"), v);
+    else if ((v = getenv("XDG_STATE_HOME")) && v[0] == '/')
+        n = snprintf(c->data, max + 1, "%s/ringside", v);
+    else if ((v = getenv("HOME")) && v[0] == '/')
+        n = snprintf(c->data, max + 1, "%s/.local/state/ringside", v);
+    else
+        return rs_fail(err, 1, "data: no default (neither STATE_DIRECTORY, XDG_STATE_HOME nor HOME is set); "
+                               "give --data DIR");
+    if (n < 0 || (size_t)n > max)
+        return rs_fail(err, 1, "data: the default from the environment is longer than %zu characters", max);
+    return true;
+}
+
 bool svc_config_finish(svc_config *c, rs_err *err)
 {
+    if (!c->data[0] && !default_data(c, err))
+        return false;
     if (!c->queue[0])
         snprintf(c->queue, sizeof c->queue, "sqlite:%s/queue.db", c->data);
     if (!c->output[0])

@@ -115,16 +115,6 @@ t_missing_data_dir() {
     expect_fail 1 "RINGSIDE_DATA=/nonexistent: no shaders/" env RINGSIDE_DATA=/nonexistent "$RS_BIN" smoke -o x.png
 }
 
-t_installed_layout() {
-    make -s -C "$SRC" install BUILD="$(dirname "$RS_BIN")" PREFIX="$PWD/prefix" >/dev/null || return 1
-    env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" shaders --quiet >o.txt 2>&1 || { cat o.txt; return 1; }
-    grep -q "0 failed" o.txt || return 1
-    env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" smoke --size 32x32 -o i.png 2>/dev/null || return 1
-    # the renderer finds its stage files in the prefix too
-    env -u RINGSIDE_DATA "$PWD/prefix/bin/ringside" render "$PWD/prefix/share/ringside/demos/temple.rsr" --ticks 60:62 \
-        --size 64x36 --render-size 128x72 -q -o r.y4m >o.txt 2>&1 || { cat o.txt; return 1; }
-}
-
 t_bench_platform() {
     "$RS_BIN" bench platform --size 64x64 --frames 3 --runs 2 --csv b.csv >b.txt 2>&1 || { cat b.txt; return 1; }
     grep -q "^egl " b.txt && grep -q "^osmesa " b.txt && grep -q "^ratio osmesa/egl" b.txt || { cat b.txt; return 1; }
@@ -134,5 +124,5 @@ t_bench_platform() {
 
 t_run help usage_errors shader_variants_all_compile info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
     smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
-    installed_layout bench_platform
+    bench_platform
 t_done

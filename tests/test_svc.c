@@ -29,12 +29,57 @@ static uint32_t rnd(void)
 
 /* --- svc_config --- */
 
+/* data's default: systemd's state directory, else XDG's, else ~/.local/state;
+ * never the current directory */
+static void t_config_data_default(void)
+{
+    static const char *const vars[] = {"STATE_DIRECTORY", "XDG_STATE_HOME", "HOME"};
+    char *saved[3];
+    for (int i = 0; i < 3; i++) {
+        const char *v = getenv(vars[i]);
+        saved[i] = v ? strdup(v) : NULL;
+    }
+    svc_config c;
+    rs_err err = {0};
+    setenv("STATE_DIRECTORY", "/var/lib/ringside:/var/lib/other", 1);
+    setenv("XDG_STATE_HOME", "/x/state", 1);
+    setenv("HOME", "/home/u", 1);
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_finish(&c, &err));
+    T_ASSERTF(!strcmp(c.data, "/var/lib/ringside"), "%s", c.data);
+    T_ASSERTF(!strcmp(c.queue, "sqlite:/var/lib/ringside/queue.db"), "%s", c.queue);
+    T_ASSERTF(!strcmp(c.output, "/var/lib/ringside/videos"), "%s", c.output);
+    unsetenv("STATE_DIRECTORY");
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_finish(&c, &err));
+    T_ASSERTF(!strcmp(c.data, "/x/state/ringside"), "%s", c.data);
+    setenv("XDG_STATE_HOME", "relative", 1); /* the spec: a relative path is ignored */
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_finish(&c, &err));
+    T_ASSERTF(!strcmp(c.data, "/home/u/.local/state/ringside"), "%s", c.data);
+    unsetenv("XDG_STATE_HOME");
+    unsetenv("HOME");
+    svc_config_defaults(&c);
+    T_ASSERT(!svc_config_finish(&c, &err) && strstr(err.msg, "give --data DIR"));
+    /* --data wins over all of them */
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_set(&c, "data", "mine", &err) && svc_config_finish(&c, &err));
+    T_ASSERTF(!strcmp(c.data, "mine"), "%s", c.data);
+    for (int i = 0; i < 3; i++) {
+        if (saved[i])
+            setenv(vars[i], saved[i], 1);
+        else
+            unsetenv(vars[i]);
+        free(saved[i]);
+    }
+}
+
 static void t_config_defaults(void)
 {
     svc_config c;
     svc_config_defaults(&c);
     T_ASSERT(!strcmp(c.listen, "127.0.0.1:8080")); /* loopback unless told otherwise */
-    T_ASSERT(!strcmp(c.data, "ringside-data") && !c.queue[0] && !c.output[0]); /* svc_config_finish derives */
+    T_ASSERT(!c.data[0] && !c.queue[0] && !c.output[0]); /* svc_config_finish derives */
     T_ASSERT(!strcmp(c.format, "mp4") && !strcmp(c.backend, "egl"));
     T_ASSERT(c.workers == 1 && c.max_upload == 1 << 20 && c.max_attempts == 3);
     T_ASSERT(c.lease == 30 && c.watchdog == 120 && c.grace == 30);
@@ -75,7 +120,7 @@ static const set_case set_cases[] = {
     {"max_upload", "K", 0, "max_upload: 'K' is not a size (expected bytes, or a number with K or M)"},
     {"max_upload", "99999999999999999999M", 0, "is not a size"}, {"queue", "", 1, "queue = "},
     {"queue", "postgres://u@db:5432/ring", 1, "queue = postgres://u@db:5432/ring"},
-    {"data", "", 0, "data: must not be empty"}, {"size", "800x600", 1, "size = 800x600"},
+    {"data", "", 1, "data = "} /* the default: svc_config_finish picks it */, {"size", "800x600", 1, "size = 800x600"},
     {"max_size", "8192X16", 1, "max_size = 8192x16"},
     {"size", "641x360", 0, "size: 641x360: each side must be even and 16..8192"},
     {"size", "640x361", 0, "must be even"},
@@ -991,7 +1036,7 @@ static void t_tokens_and_bearer(void)
 }
 
 T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t_tokens_and_bearer},
-       {"config_defaults", t_config_defaults}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
+       {"config_defaults", t_config_defaults}, {"config_data_default", t_config_data_default}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
        {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
        {"config_load_errors", t_config_load_errors}, {"config_finish", t_config_finish},
        {"config_dump_roundtrip", t_config_dump_roundtrip}, {"config_dump_hash", t_config_dump_hash},

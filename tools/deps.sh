@@ -25,7 +25,10 @@ group_pkgs() {
     # make test-service: a real PostgreSQL server for the two-daemon test,
     # Debian's Chromium for the dashboard test (driven by playwright-core from npm)
     service) echo "postgresql chromium" ;;
-    *) echo "deps.sh: unknown group '$1' (known: build test service)" >&2; return 1 ;;
+    # make man checks every page it writes with groff -ww; the docs test
+    # renders them with man -l
+    man) echo "groff-base man-db" ;;
+    *) echo "deps.sh: unknown group '$1' (known: build test service man)" >&2; return 1 ;;
     esac
 }
 
