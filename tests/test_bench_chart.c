@@ -12,6 +12,7 @@
 static const bench_bar bars[] = {{"sequential", 76.9, 1}, {"async pbo2 q8", 96.3, 0}, {"render-only", 178.2, 0}};
 static const bench_chart chart = {"capture fps, 1280x720 to 640x360, mp4", "frames per second (fps)", "fps", bars, 3};
 
+#ifdef RS_HAVE_CAIRO
 /* pixels in [x0,x1) x [y0,y1) that are not the background; *grey counts
  * those between background and ink in every channel (antialiased edges) */
 static int inked(const float *rgb, int w, int x0, int y0, int x1, int y1, int *grey)
@@ -29,7 +30,6 @@ static int inked(const float *rgb, int w, int x0, int y0, int x1, int y1, int *g
     return n;
 }
 
-#ifdef RS_HAVE_CAIRO
 static void t_png_and_svg(void)
 {
     char png[512], svg[512];
