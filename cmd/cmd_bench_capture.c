@@ -175,7 +175,8 @@ static void help(void)
            "  --sink S           mp4 (H.264, default), y4m (raw, disk-bound) or null\n"
            "  --runs N           repeat every configuration N times, report medians (default 3)\n"
            "  --csv FILE         the table as CSV (default out/bench-capture.csv)\n"
-           "  --chart FILE       bar chart of fps as PNG (default out/bench-capture.png)\n"
+           "  --chart FILE       bar chart of fps as PNG, and SVG beside it (default\n"
+           "                     out/bench-capture.png; '' for none)\n"
            "  -y, -n             replace a --csv or --chart FILE given here, or refuse it (the\n"
            "                     default); the defaults under out/ are replaced each run.\n"
            "                     --csv - writes to standard output\n"
@@ -225,6 +226,10 @@ int bench_capture(int argc, char **argv)
     rs_err err = {0};
     if (!cap_check_sizes(b.sw, b.sh, b.w, b.h, &err)) {
         cli_error("bench", "%s", err.msg);
+        return RS_EXIT_USAGE;
+    }
+    if (chart && *chart && !bench_chart_check(chart, &err)) { /* before minutes of runs, not after */
+        cli_error("bench", "--chart %s", err.msg);
         return RS_EXIT_USAGE;
     }
     if ((user_csv && *csv && !cli_out_ok("bench", csv, overwrite)) ||
@@ -353,7 +358,8 @@ int bench_capture(int argc, char **argv)
                 bars[nb++] = (bench_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
         char title[128];
         snprintf(title, sizeof title, "capture fps, %dx%d to %dx%d, %s", b.sw, b.sh, b.w, b.h, sink);
-        if (!bench_chart_png(chart, title, "fps", bars, nb, &err))
+        bench_chart bc = {title, "frames per second (fps), higher is better", "fps", bars, nb};
+        if (!bench_chart_write(chart, &bc, &err))
             goto done;
     }
     status = RS_EXIT_OK;

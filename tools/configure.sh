@@ -24,10 +24,22 @@ probe osmesa osmesa RS_HAVE_OSMESA
 probe glfw glfw3 RS_HAVE_GLFW
 probe ffmpeg "libavformat libavcodec libavutil" RS_HAVE_FFMPEG
 probe oiio OpenImageIO RS_HAVE_OIIO
+# charts (cmd/bench_chart.c): drawn with cairo, text in a fontconfig font
+probe cairo cairo RS_HAVE_CAIRO
 # the replay-to-video service (ringside serve): queue stores and HTTP
 probe sqlite sqlite3 RS_HAVE_SQLITE
 probe postgres libpq RS_HAVE_PQ
 probe microhttpd libmicrohttpd RS_HAVE_MHD
+# libpng writes every PNG (runtime/util/rs_img.c): every build needs it,
+# whatever RS_ONLY says
+if pkg-config --exists libpng 2>/dev/null; then
+    cflags="$cflags $(pkg-config --cflags libpng)"
+    libs="$libs $(pkg-config --libs libpng)"
+    have="$have png"
+else
+    echo "configure: libpng not found by pkg-config; run tools/deps.sh build" >&2
+    exit 1
+fi
 case "$have" in
 *egl*|*osmesa*) ;;
 *) echo "configure: neither EGL nor OSMesa found by pkg-config; run tools/deps.sh build" >&2; exit 1 ;;

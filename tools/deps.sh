@@ -14,9 +14,10 @@ group_pkgs() {
     case "$1" in
     # compiler, GL headers, Mesa's EGL + llvmpipe, OSMesa fallback, GLFW window,
     # FFmpeg's libraries for video output (x264 and libvpx come with libavcodec),
-    # OpenImageIO for image sequences and the reference resize; SQLite, libpq and
+    # OpenImageIO for image sequences and the reference resize; libpng for every
+    # PNG; cairo and a DejaVu font for the benchmarks' charts; SQLite, libpq and
     # libmicrohttpd for the service (ringside serve)
-    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev libsqlite3-dev libpq-dev libmicrohttpd-dev" ;;
+    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev libpng-dev libcairo2-dev fonts-dejavu-core libsqlite3-dev libpq-dev libmicrohttpd-dev" ;;
     # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
     # presses keys in that window to prove a person can play; ffprobe (in
     # ffmpeg) is the independent player that checks our videos; xz packs the

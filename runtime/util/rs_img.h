@@ -1,9 +1,10 @@
-/* Dependency-free image files for tests, goldens and the smoke render.
+/* Image files for the smoke render, screenshots, attract stills, charts,
+ * tests and goldens.
  *
- * PNG is written with stored (uncompressed) deflate blocks: valid for every
- * reader, no zlib needed.  Binary PPM/PGM (P6/P5) is read and written for
- * golden images.  General image formats (EXR, TIFF, compressed PNG) belong
- * to capture's OpenImageIO sink, not here.
+ * PNG goes through libpng (a dependency of every build, tools/configure.sh),
+ * zlib level RS_PNG_LEVEL, no row filter: the choice is measured in
+ * rs_img.c.  Binary PPM/PGM (P5/P6) is read and written by hand for golden
+ * images.  EXR and TIFF sequences belong to capture's OpenImageIO sink.
  *
  * Pixels are 8-bit, rows top-down, `channels` of 1 (grey), 3 (RGB) or
  * 4 (RGBA), tightly packed. */
@@ -14,6 +15,9 @@
 #include <stdint.h>
 
 #include "rs_err.h"
+
+/* zlib level of every PNG ringside writes, OpenImageIO's sequences included */
+#define RS_PNG_LEVEL 6
 
 enum { RS_IMG_ERR_IO = 1, RS_IMG_ERR_FORMAT, RS_IMG_ERR_ARG };
 

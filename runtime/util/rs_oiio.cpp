@@ -1,8 +1,9 @@
 // OpenImageIO behind a C interface (see rs_oiio.h).  Kept to what ringside
 // needs: a reference resize, image files for sequences, and float images
 // for image-based lighting (runtime/render/r_ibl.c).
-extern "C" { /* rs_err.h is a C header without its own extern "C" */
+extern "C" { /* rs_err.h and rs_img.h are C headers without their own extern "C" */
 #include "rs_err.h"
+#include "rs_img.h"
 }
 #include "rs_oiio.h"
 
@@ -14,6 +15,7 @@ extern "C" { /* rs_err.h is a C header without its own extern "C" */
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <png.h>
 
 using namespace OIIO;
 
@@ -48,6 +50,10 @@ extern "C" bool rs_oiio_write(const char *path, const char *ext, int w, int h, c
     if (!std::strcmp(ext, ".exr"))
         spec.set_format(TypeDesc::HALF);
     spec.alpha_channel = 3;
+    if (!std::strcmp(ext, ".png")) { /* the level and filter of rs_png_write (rs_img.c says why) */
+        spec.attribute("png:compressionLevel", RS_PNG_LEVEL);
+        spec.attribute("png:filter", PNG_FILTER_NONE);
+    }
     if (!o->open(path, spec))
         return fail(err, RS_OIIO_ERR_WRITE, path, o->geterror());
     bool ok = o->write_image(TypeDesc::UINT8, rgba);
