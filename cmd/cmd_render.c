@@ -12,6 +12,7 @@
 #include "../capture/cap.h"
 #include "../capture/cap_seg.h"
 #include "cli.h"
+#include "job_poster.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
@@ -29,7 +30,7 @@ static void help(void)
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
-           "                       [--ticks A:B] [--segment KEY] [--progress-fd N]\n\n"
+           "                       [--ticks A:B] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension:\n"
            "%s.\n"
@@ -46,6 +47,10 @@ static void help(void)
            "  --pbo N            pixel-buffer ring size, 1..%d (default %d)\n"
            "  --queue N          writer queue cap in frames, 0..1000 (default %d; 0: no thread)\n"
            "  --hashes FILE      write \"frame hash\" (64-bit FNV-1a of the frame bytes) per frame\n"
+           "  --poster FILE.png  also write one frame worth showing, at the output size: the\n"
+           "                     last knock-out or ring-out (%d ticks on), else the match end,\n"
+           "                     else the middle; chosen by simulating the replay first.  With\n"
+           "                     --ticks, written only by the render whose range holds it\n"
            "  --backend B        GL backend (default egl, falling back to osmesa)\n"
            "  --stage-file FILE  the look to use instead of stages/<replay's stage>.stage\n"
            "                     (docs/stages.md)\n"
@@ -72,7 +77,7 @@ static void help(void)
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
-           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
+           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO);
 }
 
 /* Ctrl-C / SIGTERM: the handler only sets a flag; the loop stops, and
@@ -98,8 +103,9 @@ int cmd_render(int argc, char **argv)
         {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
         {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
         {"segment", required_argument, 0, 'S'},    {"help", no_argument, 0, 'h'},
+        {"poster", required_argument, 0, 'O'},
         {0}};
-    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL;
+    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *poster_path = NULL;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
     bool quiet = false;
     r_game_opts go = {0};
@@ -192,6 +198,7 @@ int cmd_render(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
+        case 'O': poster_path = optarg; break;
         default: return cli_bad_option("render", argv);
         }
     }
@@ -239,6 +246,7 @@ int cmd_render(int argc, char **argv)
     r_target t = {0};
     FILE *hf = NULL;
     char hpart[1100] = "";
+    job_poster poster = {0};
     /* Ctrl-C and SIGTERM from here on end the render cleanly (nothing
      * partial left), also during start-up: the GL context, shaders and the
      * IBL prefilter can take seconds, and outputs are created before the
@@ -259,6 +267,8 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     uint64_t t_first = (uint64_t)first, t_end = end < 0 ? rp.ticks : (uint64_t)end;
+    if (!job_poster_plan(&poster, poster_path, &rp, t_first, t_end, &err))
+        goto done;
     if (!cap_sink_for(out, cd.w, cd.h, &sink, &err))
         goto done;
     sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
@@ -312,7 +322,7 @@ int cmd_render(int argc, char **argv)
                     out, tick, t_end);
             break;
         }
-        ok = job_render_next(&j, &err) > 0;
+        ok = job_render_next(&j, &err) > 0 && job_poster_frame(&poster, tick, &t, cd.w, cd.h, &err);
         if (j.desync)
             break;
         rs_progress_update(&prog, tick + 1 - t_first);
@@ -345,6 +355,8 @@ int cmd_render(int argc, char **argv)
         }
         hpart[0] = 0;
     }
+    if (!job_poster_commit(&poster, &err))
+        goto done;
     if (segment && !cap_seg_seal(out, segment, t_first, t_end, hashes, &err)) {
         /* no manifest, no segment: the files go too */
         unlink(out);
@@ -361,6 +373,9 @@ int cmd_render(int argc, char **argv)
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
                 st.high_water, st.fence_waits);
+    if (!quiet && poster.due)
+        fprintf(stderr, "ringside render: poster %s: frame %" PRIu64 " (%s)\n", poster.path, poster.tick,
+                job_poster_why_name(poster.why));
     if (!quiet && t_first > 0)
         fprintf(stderr,
                 "ringside render: warm-up for tick %" PRIu64 ": the effects' history from tick %" PRIu64 " (%" PRIu64
@@ -376,6 +391,7 @@ done:
         fclose(hf);
     if (hpart[0])
         unlink(hpart);
+    job_poster_abandon(&poster);
     if (p) {
         r_target_destroy(&t);
         r_game_destroy(r);
