@@ -531,7 +531,7 @@ static svc_job job(int state)
 static void job_is(const svc_job *j, const char *want, bool exact)
 {
     svc_buf b = {0};
-    svc_json_job(&b, j, 3, NULL, 0);
+    svc_json_job(&b, j, 3, NULL, 0, NULL);
     T_ASSERT(b.p && !b.oom);
     if (exact)
         T_ASSERTF(!strcmp(b.p, want), "\ngot  %s\nwant %s", b.p, want);
@@ -602,7 +602,7 @@ static void t_json_split_job(void)
     snprintf(u[0].error, sizeof u[0].error, "lease expired");
     snprintf(u[1].owner, sizeof u[1].owner, "box:1-ab/1");
     svc_buf b = {0};
-    svc_json_job(&b, &j, 3, u, 3);
+    svc_json_job(&b, &j, 3, u, 3, NULL);
     T_ASSERT(b.p && !b.oom);
     T_CONTAINS(b.p, "\"segment_seconds\":1,\"segment_count\":2,\"segments\":["
                     "{\"index\":0,\"ticks\":[0,60],\"state\":\"done\",\"attempts\":2,\"renders\":1,"
@@ -615,7 +615,7 @@ static void t_json_split_job(void)
     svc_buf_free(&b);
     /* unsplit: not a word more than before */
     j = job(SVC_RUNNING);
-    svc_json_job(&b, &j, 3, u, 3);
+    svc_json_job(&b, &j, 3, u, 3, NULL);
     T_ASSERT(!strstr(b.p, "segment"));
     svc_buf_free(&b);
 }
