@@ -599,10 +599,12 @@ static void t_json_job(void)
     j.desync_tick = 0; /* tick 0 is a tick, not "none" */
     snprintf(j.error, sizeof j.error, "desync at tick 0:\n\"want\" \x01 \xff");
     job_is(&j, JOB_HEAD "\"failed\"," JOB_NAME "\"frames_done\":120,\"frames_total\":200,\"progress\":0.6000,"
-                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":3,\"max_attempts\":3,"
+                        "\"fps\":0.00,\"eta_s\":null,\"queue_position\":null,\"stage\":null,\"players\":null,"
+                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,"
+                        "\"render_s\":null,\"attempts\":3,\"max_attempts\":3,"
                         "\"error\":\"desync at tick 0:\\n\\\"want\\\" \\u0001 \\ufffd\",\"desync_tick\":0,"
                         "\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
-                        "\"finished\":\"2023-11-14T22:15:00Z\",\"url\":\"/jobs/42\"}", true);
+                        "\"finished\":\"2023-11-14T22:15:00Z\",\"url\":\"/jobs/42\",\"log\":\"/jobs/42/log\"}", true);
     j.desync_tick = 3600;
     job_is(&j, ",\"desync_tick\":3600,", false);
     j = job(SVC_CANCELLED);
