@@ -362,6 +362,8 @@ int cmd_render(int argc, char **argv)
         unlink(out);
         if (hashes)
             unlink(hashes);
+        if (poster.due)
+            unlink(poster.path);
         goto done;
     }
     if (!quiet)
