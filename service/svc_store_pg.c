@@ -230,7 +230,7 @@ static int64_t d_exec(void *cp, const char *what, const char *sql, const sq_val 
     if (!sq_spell(text, sizeof text, sql, "floor(extract(epoch from now()))::bigint", " FOR UPDATE",
                   " FOR UPDATE OF j SKIP LOCKED", true))
         return rs_fail(err, SVC_STORE_ERR_QUERY, "%s: %s: statement too long", s->label, what), -1;
-    enum { MAXP = 16 };
+    enum { MAXP = 24 }; /* the job insert has 17 */
     if (nargs > MAXP)
         return rs_fail(err, SVC_STORE_ERR_QUERY, "%s: %s: too many parameters", s->label, what), -1;
     Oid types[MAXP];
