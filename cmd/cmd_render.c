@@ -12,6 +12,7 @@
 #include "../capture/cap.h"
 #include "../capture/cap_seg.h"
 #include "cli.h"
+#include "job_poster.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
@@ -31,7 +32,7 @@ static void help(void)
            "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
-           "                       [--ticks A:B] [--segment KEY] [--progress-fd N]\n"
+           "                       [--ticks A:B] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
            "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
            "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
@@ -58,6 +59,10 @@ static void help(void)
            "  --queue N          writer queue cap in frames, 0..1000 (default %d; 0: no thread)\n"
            "  --hashes FILE      write \"frame hash\" (64-bit FNV-1a of the frame bytes) per frame\n"
            "                     ('-' for standard output, unless -o - is there)\n"
+           "  --poster FILE.png  also write one frame worth showing, at the output size: the\n"
+           "                     last knock-out or ring-out (%d ticks on), else the match end,\n"
+           "                     else the middle; chosen by simulating the replay first.  With\n"
+           "                     --ticks, written only by the render whose range holds it\n"
            "  --backend B        GL backend (default egl, falling back to osmesa)\n"
            "  --stage-file FILE  the look to use instead of stages/<replay's stage>.stage\n"
            "                     (docs/stages.md)\n"
@@ -99,7 +104,7 @@ static void help(void)
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
-           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE);
+           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO);
 }
 
 /* long-only options (no letter): the encoder's */
@@ -156,9 +161,10 @@ int cmd_render(int argc, char **argv)
         {"codec", required_argument, 0, OPT_CODEC}, {"crf", required_argument, 0, OPT_CRF},
         {"bitrate", required_argument, 0, OPT_BITRATE}, {"preset", required_argument, 0, OPT_PRESET},
         {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
+        {"poster", required_argument, 0, 'O'},
         {0}};
     cap_enc enc = {0};
-    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL;
+    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL, *poster_path = NULL;
     bool overwrite = false;
     int progress = RS_PROGRESS_AUTO;
     cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
@@ -283,6 +289,7 @@ int cmd_render(int argc, char **argv)
                 return RS_EXIT_USAGE;
             }
             break;
+        case 'O': poster_path = optarg; break;
         default: return cli_bad_option("render", argv);
         }
     }
@@ -338,6 +345,7 @@ int cmd_render(int argc, char **argv)
     r_target t = {0};
     FILE *hf = NULL;
     char hpart[1100] = "";
+    job_poster poster = {0};
     /* Ctrl-C and SIGTERM from here on end the render cleanly (nothing
      * partial left), also during start-up: the GL context, shaders and the
      * IBL prefilter can take seconds, and outputs are created before the
@@ -358,13 +366,16 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     uint64_t t_first = (uint64_t)first, t_end = end < 0 ? rp.ticks : (uint64_t)end;
+    if (!job_poster_plan(&poster, poster_path, &rp, t_first, t_end, &err))
+        goto done;
     if (!cap_sink_for_format(out, format, cd.w, cd.h, &sink, &err))
         goto done;
     /* every output this render writes, checked before anything is touched */
     if (!(sink.fmt == CAP_RGBA ? cli_pattern_ok("render", out, t_first, t_end, overwrite)
                                : cli_out_ok("render", out, overwrite)) ||
         (hashes && strcmp(hashes, "-") && !cli_out_ok("render", hashes, overwrite)) ||
-        (segment && !cli_out_ok("render", seg_manifest, overwrite))) {
+        (segment && !cli_out_ok("render", seg_manifest, overwrite)) ||
+        (poster.due && !cli_out_ok("render", poster.path, overwrite))) {
         err.msg[0] = 0; /* said */
         goto done;
     }
@@ -422,7 +433,7 @@ int cmd_render(int argc, char **argv)
                     out, tick, t_end);
             break;
         }
-        ok = job_render_next(&j, &err) > 0;
+        ok = job_render_next(&j, &err) > 0 && job_poster_frame(&poster, tick, &t, cd.w, cd.h, &err);
         if (j.desync)
             break;
         rs_progress_update(&prog, tick + 1 - t_first);
@@ -459,11 +470,15 @@ int cmd_render(int argc, char **argv)
         }
         hpart[0] = 0;
     }
+    if (!job_poster_commit(&poster, &err))
+        goto done;
     if (segment && !cap_seg_seal(out, segment, t_first, t_end, hashes, &err)) {
         /* no manifest, no segment: the files go too */
         unlink(out);
         if (hashes)
             unlink(hashes);
+        if (poster.due)
+            unlink(poster.path);
         goto done;
     }
     if (!quiet)
@@ -475,6 +490,9 @@ int cmd_render(int argc, char **argv)
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
                 st.high_water, st.fence_waits, sink.enc_name[0] ? "; encoder " : "", sink.enc_name);
+    if (!quiet && poster.due)
+        fprintf(stderr, "ringside render: poster %s: frame %" PRIu64 " (%s)\n", poster.path, poster.tick,
+                job_poster_why_name(poster.why));
     if (!quiet && t_first > 0)
         fprintf(stderr,
                 "ringside render: warm-up for tick %" PRIu64 ": the effects' history from tick %" PRIu64 " (%" PRIu64
@@ -490,6 +508,7 @@ done:
         fclose(hf);
     if (hpart[0])
         unlink(hpart);
+    job_poster_abandon(&poster);
     if (p) {
         r_target_destroy(&t);
         r_game_destroy(r);

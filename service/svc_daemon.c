@@ -8,11 +8,15 @@
  *
  *   claim a unit (store) -> write the replay to DATA/work -> fork+exec
  *     fd 3: "frames DONE TOTAL" / "desync TICK" / "bad INDEX REASON" lines
- *     fd 2: its messages; the last line is the unit's error if it fails
+ *     fd 2: its messages; the last line is the unit's error if it fails, and
+ *       the last SVC_LOG_LINES go to the job's render log (OUTPUT/N.log,
+ *       appended when the unit ends; GET /jobs/N/log shows it and, while
+ *       the unit runs, the lines so far from svc_live.log)
  *   every lease/6 s: heartbeat (progress + lease); "not ours" -> SIGTERM it
  *   no new frame for `watchdog` s -> SIGKILL, retried like a crash
- *   exit 0 -> a whole job or a join: rename the output into place,
- *     finish(done); a segment: its files stay where they are (the queue
+ *   exit 0 -> a whole job or a join: rename the output and the poster
+ *     (render --poster; a join takes the segment's that held its frame)
+ *     into place, finish(done); a segment: its files stay where they are (the queue
  *     records which attempt made them), finish(done)
  *   desync -> finish(failed) with the tick: a replay that desyncs once
  *     desyncs every time, so it is not retried
@@ -75,6 +79,8 @@ typedef struct worker {
     char prog_buf[1024], err_buf[1024];
     size_t prog_len, err_len;
     char last_err[SVC_ERROR_MAX]; /* the child's last message line */
+    char log[SVC_LOG_LINES][SVC_LOG_LINE]; /* its last stderr lines, a ring from log_head */
+    int log_n, log_head;
     int64_t done, total, desync;
     double spawned, last_frame, last_beat, fps_t0;
     int64_t fps_d0, beat_done;
@@ -112,6 +118,32 @@ static void publish(svc_daemon *d, const worker *w)
     pthread_mutex_unlock(&d->mu);
 }
 
+/* The unit's log so far, oldest line first, into out (n >= 1). */
+static size_t log_text(const worker *w, char *out, size_t n)
+{
+    size_t k = 0;
+    out[0] = 0;
+    for (int i = 0; i < w->log_n && k + 1 < n; i++) {
+        int r = snprintf(out + k, n - k, "%s\n", w->log[(w->log_head + i) % SVC_LOG_LINES]);
+        k = r < 0 ? k : k + (size_t)r >= n ? n - 1 : k + (size_t)r;
+    }
+    return k;
+}
+
+/* A stderr line into the ring, and the ring to the HTTP threads. */
+static void log_line(svc_daemon *d, worker *w, const char *line)
+{
+    int at = (w->log_head + w->log_n) % SVC_LOG_LINES;
+    if (w->log_n == SVC_LOG_LINES)
+        w->log_head = (w->log_head + 1) % SVC_LOG_LINES;
+    else
+        w->log_n++;
+    snprintf(w->log[at], SVC_LOG_LINE, "%s", line);
+    pthread_mutex_lock(&d->mu);
+    log_text(w, d->live[w->slot].log, sizeof d->live[w->slot].log);
+    pthread_mutex_unlock(&d->mu);
+}
+
 /* What a unit's log lines start with after "job N: ": "" for a whole job,
  * "segment 2 (ticks 120-180): " or "join: " */
 static const char *ctx(const worker *w)
@@ -136,8 +168,8 @@ static void worker_clear(svc_daemon *d, worker *w)
         unlink(w->f.replay);
     /* a child killed with SIGKILL could not remove its own ".part" files */
     char part[1200];
-    const char *tmps[] = {w->f.out, w->f.hashes};
-    for (int i = 0; i < 2 && w->job.unit.kind != SVC_UNIT_SEGMENT; i++)
+    const char *tmps[] = {w->f.out, w->f.hashes, w->f.poster};
+    for (int i = 0; i < 3 && w->job.unit.kind != SVC_UNIT_SEGMENT; i++)
         if (tmps[i][0]) {
             unlink(tmps[i]);
             snprintf(part, sizeof part, "%s.part", tmps[i]);
@@ -149,9 +181,11 @@ static void worker_clear(svc_daemon *d, worker *w)
      * whatever crashed attempts (of any daemon) left */
     svc_job cur;
     rs_err err = {0};
-    if (w->busy && d->store->ops->get(d->store, w->job.id, &cur, &err) == 1 && cur.state != SVC_QUEUED &&
-        cur.state != SVC_RUNNING)
+    int have = w->busy ? d->store->ops->get(d->store, w->job.id, &cur, &err) : -1;
+    if (have == 1 && cur.state != SVC_QUEUED && cur.state != SVC_RUNNING)
         svc_remove_job_files(&d->cfg, w->job.id);
+    if (have == 0) /* deleted while it ran: the log this unit just wrote has no job */
+        svc_remove_job_outputs(&d->cfg, w->job.id, w->job.format);
     svc_job_free(&w->job);
     free(w->units);
     free(w->bad);
@@ -162,6 +196,9 @@ static void worker_clear(svc_daemon *d, worker *w)
     w->slot = slot;
     memcpy(w->owner, owner, sizeof owner);
     w->prog_fd = w->err_fd = -1;
+    pthread_mutex_lock(&d->mu);
+    d->live[w->slot].log[0] = 0;
+    pthread_mutex_unlock(&d->mu);
     publish(d, w);
 }
 
@@ -286,6 +323,8 @@ static void on_prog_line(worker *w, char *line)
 
 static void on_err_line(svc_daemon *d, worker *w, char *line)
 {
+    if (*line)
+        log_line(d, w, line);
     /* a usage error's second line says where help is: the first says why */
     if (!*line || (strstr(line, "see 'ringside ") && strstr(line, "--help'")))
         return;
@@ -300,7 +339,6 @@ static void on_err_line(svc_daemon *d, worker *w, char *line)
     else
         snprintf(w->last_err, sizeof w->last_err, "%s", m);
     svc_log(SVC_LOG_DEBUG, w->job.id, "%s%s says: %s", ctx(w), w->job.unit.kind == SVC_UNIT_JOIN ? "join" : "render", m);
-    (void)d;
 }
 
 /* Reads what is there; splits lines.  Returns false at EOF or error. */
@@ -379,6 +417,29 @@ static void give_back_local(svc_daemon *d, worker *w, const char *why)
     svc_log(SVC_LOG_ERROR, w->job.id, "%s%s; re-queued, no new jobs for %.0f s", ctx(w), why, local_backoff);
 }
 
+/* The poster beside the video: the whole render's own, or for a join the
+ * one segment whose ticks held its frame (render --poster).  A job
+ * without one (its render could not write it) is still done: the poster
+ * route answers 404. */
+static void place_poster(svc_daemon *d, worker *w)
+{
+    char poster[1100], seg[1200];
+    svc_job_file(&d->cfg, w->job.id, "png", poster, sizeof poster);
+    if (w->job.unit.kind != SVC_UNIT_JOIN) {
+        if (rename(w->f.poster, poster) != 0)
+            svc_log(SVC_LOG_WARN, w->job.id, "no poster: %s: %s", w->f.poster, strerror(errno));
+        return;
+    }
+    for (int i = 0; i < w->nunits; i++) {
+        if (w->units[i].kind != SVC_UNIT_SEGMENT)
+            continue;
+        svc_segment_path(seg, sizeof seg, w->f.segdir, w->units[i].index, w->units[i].done_attempt, "png");
+        if (rename(seg, poster) == 0)
+            return;
+    }
+    svc_log(SVC_LOG_WARN, w->job.id, "no poster: no segment wrote one");
+}
+
 /* A whole job or a join that exited 0: its output moves into place. */
 static void finished_video(svc_daemon *d, worker *w, double secs)
 {
@@ -393,6 +454,7 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
         give_back_local(d, w, why);
         return;
     }
+    place_poster(d, w);
     int64_t frames = j->unit.kind == SVC_UNIT_JOIN ? j->frames_total : w->total;
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, frames, &err);
     if (r == 1) {
@@ -408,8 +470,7 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
          * (a lease lost and re-claimed): the same bytes, keep them */
         svc_job cur;
         if (d->store->ops->get(d->store, j->id, &cur, &err) == 1 && cur.state == SVC_CANCELLED) {
-            unlink(video);
-            unlink(hashes);
+            svc_remove_job_outputs(&d->cfg, j->id, j->format);
             svc_log(SVC_LOG_INFO, j->id, "finished just after it was cancelled: video removed");
         } else
             svc_log(SVC_LOG_WARN, j->id, "finished, but the job is no longer ours (re-claimed elsewhere)");
@@ -475,6 +536,14 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
     describe_status(status, how, sizeof how);
     double secs = now_s() - w->spawned;
     int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    {
+        /* the job's render log: this attempt's header and last lines, in one write */
+        char block[SVC_LOG_LINES * SVC_LOG_LINE + 512];
+        int k = snprintf(block, sizeof block, "== %s%s, attempt %d, process %d: %s after %.1f s ==\n", ctx(w),
+                         kind == SVC_UNIT_JOIN ? "join" : "render", j->unit.claim, (int)w->pid, how, secs);
+        size_t len = (size_t)k + log_text(w, block + k, sizeof block - (size_t)k);
+        svc_job_log_append(&d->cfg, j->id, block, len);
+    }
 
     if (w->killed == K_CANCEL && code != 0) {
         svc_log(SVC_LOG_INFO, j->id, "%scancelled; %s process stopped after %.1f s", ctx(w),

@@ -4,15 +4,20 @@
  * DESIGN: called from the supervisor thread only (svc_daemon.c); nothing
  * here keeps state.  The layout under the output directory:
  *
- *   N.fmt, N.hashes                 a finished job (the only names clients see)
- *   .jobN-PID-aK.fmt / .hashes      an unsplit job's render, claim K, by daemon PID
+ *   N.fmt, N.hashes, N.png          a finished job (the only names clients see):
+ *                                   video, hash list, poster (render --poster)
+ *   N.log                           the job's render log: each unit attempt's
+ *                                   last stderr lines, appended as it ends
+ *   .jobN-PID-aK.fmt/.hashes/.png   an unsplit job's render, claim K, by daemon PID
  *   .jobN-PID-jK.fmt / .hashes      a split job's join, claim K
  *   .jobN-NONCE/                    a split job's segments: the directory is
  *                                   named by the job's key (svc_store.h), so a
  *                                   reused job id (a new queue, the same output
  *                                   directory) never meets the old files
  *       sI-aK.fmt, sI-aK.hashes,    segment I as claim K rendered it (its
- *       sI-aK.fmt.seg               manifest last: a manifest means complete)
+ *       sI-aK.fmt.seg               manifest last: a manifest means complete);
+ *       sI-aK.png                   the poster, from the segment holding its tick
+ *                                   (the join moves it to N.png)
  *
  * K is the unit's claim number (svc_unit.claim: attempts + lost leases), so
  * each claim writes names of its own, even when a lost lease gave its
@@ -23,6 +28,7 @@
  * leaves every other name alone (the directory may be shared). */
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <signal.h>
 #include <stdio.h>
@@ -45,6 +51,7 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
     case SVC_UNIT_SEGMENT:
         svc_segment_path(f->out, sizeof f->out, f->segdir, j->unit.index, j->unit.claim, j->format);
         svc_segment_path(f->hashes, sizeof f->hashes, f->segdir, j->unit.index, j->unit.claim, "hashes");
+        svc_segment_path(f->poster, sizeof f->poster, f->segdir, j->unit.index, j->unit.claim, "png");
         break;
     case SVC_UNIT_JOIN:
         snprintf(f->out, sizeof f->out, "%s/.job%" PRId64 "-%d-j%d.%s", cfg->output, j->id, pid, j->unit.claim,
@@ -57,7 +64,28 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
                  j->format);
         snprintf(f->hashes, sizeof f->hashes, "%s/.job%" PRId64 "-%d-a%d.hashes", cfg->output, j->id, pid,
                  j->unit.claim);
+        snprintf(f->poster, sizeof f->poster, "%s/.job%" PRId64 "-%d-a%d.png", cfg->output, j->id, pid, j->unit.claim);
     }
+}
+
+void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out, size_t n)
+{
+    snprintf(out, n, "%s/%" PRId64 ".%s", cfg->output, id, ext);
+}
+
+void svc_job_log_append(const svc_config *cfg, int64_t id, const char *block, size_t len)
+{
+    char path[1100];
+    svc_job_file(cfg, id, "log", path, sizeof path);
+    int fd = open(path, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        svc_log(SVC_LOG_WARN, id, "%s: cannot write the render log: %s", path, strerror(errno));
+        return;
+    }
+    ssize_t w = write(fd, block, len);
+    if (w != (ssize_t)len)
+        svc_log(SVC_LOG_WARN, id, "%s: the render log was not written whole", path);
+    close(fd);
 }
 
 void svc_segment_path(char *out, size_t n, const char *segdir, int index, int attempt, const char *ext)
@@ -145,7 +173,7 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
             add(&a, j->key);
         }
         const char *const tail[] = {"-y", "-o", f->out, "--size", size, "--render-size", rsize, "--hashes", f->hashes,
-                                    "--progress-fd", "3", "--quiet", "--backend", cfg->backend};
+                                    "--poster", f->poster, "--progress-fd", "3", "--progress", "off", "--backend", cfg->backend};
         for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
             add(&a, tail[i]);
     }
@@ -225,6 +253,10 @@ int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format
     snprintf(path, sizeof path, "%s/%" PRId64 ".%s", cfg->output, id, format);
     n += unlink(path) == 0;
     snprintf(path, sizeof path, "%s/%" PRId64 ".hashes", cfg->output, id);
+    n += unlink(path) == 0;
+    svc_job_file(cfg, id, "png", path, sizeof path);
+    n += unlink(path) == 0;
+    svc_job_file(cfg, id, "log", path, sizeof path);
     n += unlink(path) == 0;
     svc_remove_job_files(cfg, id);
     return n;

@@ -114,6 +114,10 @@ bool svc_check_upload(const svc_config *cfg, const uint8_t *data, size_t len, co
     if (!rp_decode(data, len, name, &rp, &perr))
         return rs_fail(err, SVC_ERR_REPLAY, "%s", perr.msg);
     j->frames_total = (int64_t)rp.ticks;
+    j->stage = rp.stage;
+    j->kind[0] = rp.kind[0], j->kind[1] = rp.kind[1];
+    j->winner = rp.winner;
+    j->rounds[0] = rp.rounds[0], j->rounds[1] = rp.rounds[1];
     bool ok = true;
     if (j->frames_total == 0)
         ok = rs_fail(err, SVC_ERR_REPLAY, "%s: the replay has no ticks: nothing to render", name);
@@ -723,6 +727,71 @@ static void overlay_live(svc_daemon *d, svc_job *j, svc_unit *units, int n)
         j->fps = 0;
 }
 
+/* DESIGN (queue position and ETA of a queued job): the claim hands out
+ * units of the oldest job first (svc_store.h), so a queued job's position
+ * is 1 + the queued jobs older than it.  Its ETA is the frames still to
+ * render up to and including it (the running jobs' remainders, the older
+ * queued jobs' totals, its own) over the queue's throughput: the recent
+ * render speed (frames over wall seconds of the last QUEUE_SPEED_JOBS done
+ * jobs, as the queue recorded them, so a split job's parallel segments
+ * count) times this daemon's workers.  Another daemon on a PostgreSQL
+ * queue is not counted, so the estimate errs long there; before any job
+ * is done there is no speed and the ETA is null.  A running job keeps its
+ * own: its remaining frames over its live fps.  At most QUEUE_SCAN jobs of
+ * the queue are looked at; one further back shows no position. */
+#define QUEUE_SPEED_JOBS 20
+#define QUEUE_SCAN 10000
+
+typedef struct queue_view {
+    svc_pending *p;
+    int n;
+    double speed; /* frames per second of one worker, recently; 0: unknown */
+} queue_view;
+
+/* Loads the queue order when one of jobs[0..n-1] is queued (else nothing
+ * to look up).  False: the queue failed (err). */
+static bool queue_load(svc_daemon *d, const svc_job *jobs, int n, queue_view *qv, rs_err *err)
+{
+    memset(qv, 0, sizeof *qv);
+    bool any = false;
+    for (int i = 0; i < n; i++)
+        any |= jobs[i].state == SVC_QUEUED;
+    if (!any)
+        return true;
+    if (!(qv->p = calloc(QUEUE_SCAN, sizeof *qv->p)))
+        return rs_fail(err, SVC_ERR_NOMEM, "out of memory");
+    qv->n = d->http_store->ops->pending(d->http_store, qv->p, QUEUE_SCAN, err);
+    return qv->n >= 0 && d->http_store->ops->speed(d->http_store, QUEUE_SPEED_JOBS, &qv->speed, err);
+}
+
+/* What the API shows of job j beyond its row. */
+static void job_view(svc_daemon *d, const queue_view *qv, const svc_job *j, svc_job_view *v)
+{
+    *v = (svc_job_view){.eta_s = -1, .bytes = -1};
+    char path[1100];
+    struct stat st;
+    if (j->state == SVC_DONE && !j->expired) {
+        snprintf(path, sizeof path, "%s/%" PRId64 ".%s", d->cfg.output, j->id, j->format);
+        if (stat(path, &st) == 0 && S_ISREG(st.st_mode))
+            v->bytes = (int64_t)st.st_size;
+        snprintf(path, sizeof path, "%s/%" PRId64 ".png", d->cfg.output, j->id);
+        v->poster = stat(path, &st) == 0 && S_ISREG(st.st_mode);
+    }
+    if (j->state != SVC_QUEUED)
+        return;
+    int64_t frames = 0, ahead = 0;
+    for (int i = 0; i < qv->n; i++) {
+        frames += qv->p[i].frames_left;
+        if (qv->p[i].id == j->id) {
+            v->queue_position = ahead + 1;
+            if (qv->speed > 0)
+                v->eta_s = (double)frames / (qv->speed * d->cfg.workers);
+            break;
+        }
+        ahead += qv->p[i].state == SVC_QUEUED;
+    }
+}
+
 /* A token sees its own jobs only (an operator's, or no token on an open
  * loopback daemon: every job); another's answers 404, as a missing one. */
 static bool may_see(const req *q, const svc_job *j)
@@ -753,8 +822,17 @@ static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, const
         }
     }
     overlay_live(d, &j, units, n);
+    queue_view qv;
+    svc_job_view v;
+    if (!queue_load(d, &j, 1, &qv, &err)) {
+        free(units);
+        free(qv.p);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    }
+    job_view(d, &qv, &j, &v);
+    free(qv.p);
     svc_buf b = {0};
-    svc_json_job(&b, &j, d->cfg.max_attempts, units, n);
+    svc_json_job(&b, &j, d->cfg.max_attempts, units, n, &v);
     svc_buf_add(&b, "\n", 1);
     free(units);
     return reply_json(c, 200, &b);
@@ -781,14 +859,23 @@ static enum MHD_Result do_list(svc_daemon *d, struct MHD_Connection *c, const re
         free(jobs);
         return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
     }
+    queue_view qv;
+    if (!queue_load(d, jobs, n, &qv, &err)) {
+        free(jobs);
+        free(qv.p);
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    }
     svc_buf b = {0};
     svc_buf_add(&b, "{\"jobs\":[", 9);
     for (int i = 0; i < n; i++) {
         overlay_live(d, &jobs[i], NULL, 0);
         if (i)
             svc_buf_add(&b, ",", 1);
-        svc_json_job(&b, &jobs[i], d->cfg.max_attempts, NULL, 0);
+        svc_job_view jv;
+        job_view(d, &qv, &jobs[i], &jv);
+        svc_json_job(&b, &jobs[i], d->cfg.max_attempts, NULL, 0, &jv);
     }
+    free(qv.p);
     if (n == limit && n > 0)
         svc_buf_printf(&b, "],\"next\":\"/jobs?before=%" PRId64 "&limit=%ld\"}\n", jobs[n - 1].id, limit);
     else
@@ -910,6 +997,103 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, const re
     return ret;
 }
 
+/* The job's poster (render --poster), once its render put it in place. */
+static enum MHD_Result do_poster(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
+{
+    svc_job j;
+    rs_err err = {0};
+    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
+    if (r < 0)
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    if (r == 0 || !may_see(q, &j))
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    if (j.expired)
+        return reply_error(c, SVC_ERR_GONE, "job %" PRId64 "'s poster was removed by retention", id);
+    char path[1100];
+    svc_job_file(&d->cfg, id, "png", path, sizeof path);
+    int fd = j.state == SVC_DONE ? open(path, O_RDONLY | O_CLOEXEC) : -1;
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (fd >= 0)
+            close(fd);
+        return reply_error(c, SVC_ERR_NOT_FOUND, "job %" PRId64 " is %s and has no poster%s", id, svc_state_name(j.state),
+                           j.state == SVC_DONE ? "" : " yet: it comes with the video");
+    }
+    struct MHD_Response *resp = MHD_create_response_from_fd64((uint64_t)st.st_size, fd);
+    if (!resp) {
+        close(fd);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, "Content-Type", "image/png");
+    MHD_add_response_header(resp, "Cache-Control", "private, max-age=3600");
+    enum MHD_Result ret = queue(c, 200, resp);
+    MHD_destroy_response(resp);
+    return ret;
+}
+
+/* The job's render log: each ended unit attempt's last lines (OUTPUT/N.log),
+ * then what the units running here have said so far. */
+static enum MHD_Result do_log(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
+{
+    svc_job j;
+    rs_err err = {0};
+    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
+    if (r < 0)
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    if (r == 0 || !may_see(q, &j))
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    char path[1100];
+    svc_job_file(&d->cfg, id, "log", path, sizeof path);
+    size_t len = 0;
+    rs_err ferr = {0};
+    char *text = rs_read_file(path, 4 << 20, &len, &ferr);
+    svc_buf b = {0};
+    if (text)
+        svc_buf_add(&b, text, len);
+    free(text);
+    pthread_mutex_lock(&d->mu);
+    for (int i = 0; i < d->cfg.workers; i++) {
+        const svc_live *l = &d->live[i];
+        if (l->job != id)
+            continue;
+        svc_unit u = {.kind = l->kind, .index = l->index};
+        char cx[96];
+        svc_unit_context(cx, sizeof cx, &u);
+        svc_buf_printf(&b, "== %s%s, running in process %d (%" PRId64 " of %" PRId64 " frames) ==\n%s", cx,
+                       l->kind == SVC_UNIT_JOIN ? "join" : "render", (int)l->pid, l->done, l->total, l->log);
+    }
+    pthread_mutex_unlock(&d->mu);
+    if (b.oom) {
+        svc_buf_free(&b);
+        return MHD_NO;
+    }
+    enum MHD_Result ret = reply(c, 200, "text/plain; charset=utf-8", b.p ? b.p : "", b.len);
+    svc_buf_free(&b);
+    return ret;
+}
+
+/* A failed job back into the queue, its attempts reset (svc_store.h, retry). */
+static enum MHD_Result do_retry(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
+{
+    svc_job j;
+    rs_err err = {0};
+    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
+    if (r == 1 && !may_see(q, &j))
+        r = 0;
+    if (r == 1)
+        r = d->http_store->ops->retry(d->http_store, id, &err);
+    if (r < 0)
+        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    if (r == 0)
+        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    if (r == 2)
+        return reply_error(c, SVC_ERR_CONFLICT, "job %" PRId64 " is %s: only a failed job can be retried", id,
+                           svc_state_name(j.state));
+    svc_log(SVC_LOG_INFO, id, "re-queued by a client%s%s%s (it had failed: %s)", q->tok.id ? " (token '" : "",
+            q->tok.id ? q->tok.name : "", q->tok.id ? "')" : "", j.error);
+    return do_get_job(d, c, q, id);
+}
+
 static enum MHD_Result do_health(svc_daemon *d, struct MHD_Connection *c)
 {
     int64_t counts[SVC_NSTATES];
@@ -925,6 +1109,9 @@ static enum MHD_Result do_health(svc_daemon *d, struct MHD_Connection *c)
     svc_buf_printf(&b, "{\"ok\":%s,\"queue\":\"%s\",\"workers\":%d,\"busy\":%d,\"draining\":%s,\"version\":\"%s\"",
                    ok ? "true" : "false", d->http_store->ops->name, d->cfg.workers, busy, draining ? "true" : "false",
                    RS_VERSION);
+    /* what the dashboard's upload form offers: the default and the bounds */
+    svc_buf_printf(&b, ",\"default_size\":\"%dx%d\",\"max_size\":\"%dx%d\",\"default_format\":\"%s\"", d->cfg.width,
+                   d->cfg.height, d->cfg.max_width, d->cfg.max_height, d->cfg.format);
     if (ok)
         svc_buf_printf(&b, ",\"queued\":%" PRId64 ",\"running\":%" PRId64 "}\n", counts[SVC_QUEUED], counts[SVC_RUNNING]);
     else {
@@ -1031,6 +1218,13 @@ static enum MHD_Result route(svc_daemon *d, struct MHD_Connection *c, const req 
         }
         if (!strcmp(slash, "/video") || !strcmp(slash, "/hashes"))
             return get ? do_file(d, c, q, id, slash[1] == 'v') : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
+        if (!strcmp(slash, "/poster"))
+            return get ? do_poster(d, c, q, id) : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
+        if (!strcmp(slash, "/log"))
+            return get ? do_log(d, c, q, id) : reply_error(c, SVC_ERR_METHOD, "%s %s: only GET", method, url);
+        if (!strcmp(slash, "/retry"))
+            return !strcmp(method, "POST") ? do_retry(d, c, q, id)
+                                           : reply_error(c, SVC_ERR_METHOD, "%s %s: only POST", method, url);
     }
     return reply_error(c, SVC_ERR_NOT_FOUND, "%s: no such resource (see /jobs, /healthz, /metrics)", url);
 }

@@ -7,6 +7,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "../runtime/game/g_game.h"
+#include "../runtime/replay/rp.h"
+
 void svc_buf_free(svc_buf *b)
 {
     free(b->p);
@@ -135,7 +138,30 @@ static void json_unit(svc_buf *b, const svc_unit *u)
     svc_buf_add(b, "}", 1);
 }
 
-void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit *units, int n)
+/* The encoder capture's FFmpeg sink uses for the format (cap_sink_ffmpeg.c). */
+static const char *codec_of(const char *format)
+{
+    return !strcmp(format, "webm") ? "vp9" : "h264";
+}
+
+/* What the replay says (svc_job's header fields), null when not known. */
+static void json_replay(svc_buf *b, const svc_job *j)
+{
+    static const char *const kinds[] = {"human", "cpu"};
+    if (j->stage < 0 || j->stage >= G_STAGES) {
+        svc_buf_printf(b, ",\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null");
+        return;
+    }
+    svc_buf_add(b, ",\"stage\":", 9);
+    svc_json_str(b, g_stages[j->stage].name);
+    svc_buf_printf(b, ",\"players\":[\"%s\",\"%s\"]", kinds[j->kind[0] == RP_CPU], kinds[j->kind[1] == RP_CPU]);
+    if (j->winner >= 0)
+        svc_buf_printf(b, ",\"winner\":%d,\"rounds\":[%d,%d]", j->winner, j->rounds[0], j->rounds[1]);
+    else
+        svc_buf_printf(b, ",\"winner\":null,\"rounds\":null");
+}
+
+void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit *units, int n, const svc_job_view *v)
 {
     svc_buf_printf(b, "{\"id\":%lld,\"state\":\"%s\",\"name\":", (long long)j->id, svc_state_name(j->state));
     svc_json_str(b, j->name);
@@ -145,10 +171,26 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
     double progress = j->frames_total > 0 ? (double)done / (double)j->frames_total : 0.0;
     svc_buf_printf(b, ",\"frames_done\":%lld,\"frames_total\":%lld,\"progress\":%.4f,\"fps\":%.2f", (long long)done,
                    (long long)j->frames_total, progress, j->state == SVC_RUNNING ? j->fps : 0.0);
-    if (j->state == SVC_RUNNING && j->fps > 0 && j->frames_total >= done)
+    if (v && v->eta_s >= 0)
+        svc_buf_printf(b, ",\"eta_s\":%.1f", v->eta_s);
+    else if (j->state == SVC_RUNNING && j->fps > 0 && j->frames_total >= done)
         svc_buf_printf(b, ",\"eta_s\":%.1f", (double)(j->frames_total - done) / j->fps);
     else
         svc_buf_add(b, ",\"eta_s\":null", 13);
+    if (v && v->queue_position > 0)
+        svc_buf_printf(b, ",\"queue_position\":%lld", (long long)v->queue_position);
+    else
+        svc_buf_add(b, ",\"queue_position\":null", 22);
+    json_replay(b, j);
+    svc_buf_printf(b, ",\"length_s\":%.2f,\"codec\":\"%s\"", j->frames_total / 60.0, codec_of(j->format));
+    if (v && v->bytes >= 0)
+        svc_buf_printf(b, ",\"bytes\":%lld", (long long)v->bytes);
+    else
+        svc_buf_add(b, ",\"bytes\":null", 13);
+    if (j->state == SVC_DONE && j->started > 0 && j->finished >= j->started)
+        svc_buf_printf(b, ",\"render_s\":%lld", (long long)(j->finished - j->started));
+    else
+        svc_buf_add(b, ",\"render_s\":null", 16);
     svc_buf_printf(b, ",\"attempts\":%d,\"max_attempts\":%d,", j->attempts, max_attempts);
     if (j->lost > 0) /* leases lost to daemon crashes: not attempts, shown when there were any */
         svc_buf_printf(b, "\"lost_leases\":%d,", j->lost);
@@ -193,6 +235,9 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
     else if (j->state == SVC_DONE)
         svc_buf_printf(b, ",\"video\":\"/jobs/%lld/video\",\"hashes\":\"/jobs/%lld/hashes\"", (long long)j->id,
                        (long long)j->id);
+    if (v && v->poster && !j->expired)
+        svc_buf_printf(b, ",\"poster\":\"/jobs/%lld/poster\"", (long long)j->id);
+    svc_buf_printf(b, ",\"log\":\"/jobs/%lld/log\"", (long long)j->id);
     svc_buf_add(b, "}", 1);
 }
 

@@ -23,6 +23,11 @@
 #include "svc_config.h"
 #include "svc_store.h"
 
+/* A unit's render log: its last SVC_LOG_LINES lines of stderr, each cut
+ * at SVC_LOG_LINE - 1 bytes (GET /jobs/N/log). */
+#define SVC_LOG_LINES 40
+#define SVC_LOG_LINE 200
+
 typedef struct svc_live {
     int64_t job;     /* 0: idle */
     pid_t pid;
@@ -33,6 +38,7 @@ typedef struct svc_live {
      * as of their heartbeats, so a reader adds done - beat_done */
     int64_t beat_done;
     double beat_fps;
+    char log[SVC_LOG_LINES * SVC_LOG_LINE]; /* the running unit's log so far, one line per '\n' */
 } svc_live;
 
 typedef struct svc_net svc_net; /* svc_http.c: connections, deadlines, upload budget */
@@ -121,6 +127,7 @@ typedef struct svc_unit_files {
     char out[1100];     /* what the child writes (-o) */
     char hashes[1100];  /* its --hashes */
     char segdir[1100];  /* a split job's segment directory ("" unsplit) */
+    char poster[1100];  /* its --poster ("" for the join, which takes a segment's) */
 } svc_unit_files;
 void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_files *f);
 /* The child's argv: `ringside render` for a WHOLE unit or a SEGMENT,
@@ -130,6 +137,12 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
 char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_files *f, const svc_unit *units, int n,
                      rs_err *err);
 void svc_argv_free(char **argv);
+/* "OUTPUT/N.png", "OUTPUT/N.log": a job's poster and render log (the log
+ * gathers every unit's attempts, appended as each ends). */
+void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out, size_t n);
+/* Appends one unit attempt's log block to OUTPUT/N.log in one write (units
+ * of a split job may end at once, on several daemons). */
+void svc_job_log_append(const svc_config *cfg, int64_t id, const char *block, size_t len);
 /* "SEGDIR/sI-aK.ext" */
 void svc_segment_path(char *out, size_t n, const char *segdir, int index, int attempt, const char *ext);
 /* Segment I's files as attempt K wrote them (video, hashes, manifest, temporaries). */
@@ -139,8 +152,8 @@ void svc_remove_dir(const char *path);
 /* Everything hidden of job id in the output directory (".jobN-..."): its
  * segments, temporaries of crashed renders and joins.  For a job that is over. */
 void svc_remove_job_files(const svc_config *cfg, int64_t id);
-/* N.fmt, N.hashes and everything hidden of job id: the number of visible
- * files removed.  For a job that is over. */
+/* N.fmt, N.hashes, N.png, N.log and everything hidden of job id: the
+ * number of visible files removed.  For a job that is over. */
 int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format);
 /* Leftovers of jobs that are over or unknown, and of dead daemons' work
  * files; finished jobs past retention.  startup: no render of ours runs

@@ -153,6 +153,12 @@ typedef struct svc_job {
     int segments;                /* how many it was split into (0: unsplit, one WHOLE unit) */
     char key[SVC_KEY_MAX];       /* "job<id>-<nonce>" */
     int64_t token_id;            /* the API token that submitted it (0: none; svc_token) */
+    /* the replay's header, read at upload (rp.h): stage -1 for a job queued
+     * before these were kept (nothing known) */
+    int stage;                   /* g_stages index */
+    int kind[2];                 /* RP_HUMAN / RP_CPU */
+    int winner;                  /* first match: -1 unfinished, 0 draw, 1, 2 */
+    int rounds[2];
     svc_unit unit;               /* claim: the unit handed out (the rest leave it zero) */
     /* the replay: submit reads it, claim fills it (malloc'd; svc_job_free) */
     uint8_t *replay;
@@ -193,6 +199,13 @@ typedef struct svc_usage {
     int64_t oldest;      /* when the oldest of those was created (0: none) */
     int64_t now;         /* the database's clock */
 } svc_usage;
+
+/* A job waiting or running, as the queue order sees it (pending). */
+typedef struct svc_pending {
+    int64_t id;
+    int state;           /* SVC_QUEUED or SVC_RUNNING */
+    int64_t frames_left; /* frames_total - frames_done as of the last heartbeat */
+} svc_pending;
 
 typedef struct svc_store svc_store;
 
@@ -263,6 +276,19 @@ typedef struct svc_store_ops {
     int (*remove)(svc_store *s, int64_t id, rs_err *err);
     /* Jobs per state. */
     bool (*counts)(svc_store *s, int64_t by_state[SVC_NSTATES], rs_err *err);
+    /* A failed job back to queued, from the start: every unit queued with
+     * attempts, lost leases and errors cleared (a split job's segments too:
+     * their files went when it failed); the job's error, desync tick and
+     * times cleared.  1: re-queued; 0: no such
+     * job; 2: not failed; -1: error. */
+    int (*retry)(svc_store *s, int64_t id, rs_err *err);
+    /* The queue in claim order: the queued and running jobs, oldest first,
+     * up to max into out.  Returns the count, or -1. */
+    int (*pending)(svc_store *s, svc_pending *out, int max, rs_err *err);
+    /* The recent render speed: frames per second of wall time of the last
+     * `last` jobs done (their frames over finished - started, summed);
+     * 0 when none is done yet. */
+    bool (*speed)(svc_store *s, int last, double *fps, rs_err *err);
     /* API tokens.  token_add: t's name, is_operator and quotas, with hash
      * (svc_token_hash); fills t->id and t->created.  1: added; 0: a token
      * of that name exists (revoked ones too: names are never reused); -1. */

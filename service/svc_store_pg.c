@@ -230,7 +230,7 @@ static int64_t d_exec(void *cp, const char *what, const char *sql, const sq_val 
     if (!sq_spell(text, sizeof text, sql, "floor(extract(epoch from now()))::bigint", " FOR UPDATE",
                   " FOR UPDATE OF j SKIP LOCKED", true))
         return rs_fail(err, SVC_STORE_ERR_QUERY, "%s: %s: statement too long", s->label, what), -1;
-    enum { MAXP = 16 };
+    enum { MAXP = 24 }; /* the job insert has 17 */
     if (nargs > MAXP)
         return rs_fail(err, SVC_STORE_ERR_QUERY, "%s: %s: too many parameters", s->label, what), -1;
     Oid types[MAXP];
@@ -429,7 +429,8 @@ static void scrub(char *msg, const char *conninfo)
 /* What the schema lacks: 1 the jobs table, 2 its segment columns (a queue
  * from before units), 4 the units table, 8 the lost-lease column (a queue
  * from before it: sq_schema_lost), 16 jobs.token_id (a queue from before
- * tokens), 32 the tokens table; -1 on error. */
+ * tokens), 32 the tokens table, 64 the replay header's columns (a queue
+ * from before them: sq_schema_meta); -1 on error. */
 static int schema_needs(pg_conn *s, rs_err *err)
 {
     sq_res r;
@@ -440,11 +441,12 @@ static int schema_needs(pg_conn *s, rs_err *err)
                " WHERE table_schema = current_schema() AND table_name = 'units' AND column_name = 'lost'),"
                " NOT EXISTS (SELECT 1 FROM information_schema.columns"
                " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'token_id'),"
-               " to_regclass('tokens') IS NULL",
+               " to_regclass('tokens') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
+               " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'stage')",
                NULL, 0, &r, err) < 0)
         return -1;
     int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2 | r.v[3].i << 3 | r.v[4].i << 4 |
-                                   r.v[5].i << 5)
+                                   r.v[5].i << 5 | r.v[6].i << 6)
                            : -1;
     d_res_free(&r);
     return need;
@@ -484,6 +486,7 @@ static bool create_schema(pg_conn *s, rs_err *err)
              (!(need & 15) || sq_schema_units(&pg_driver, s, migrate, err)) &&
              (!(need & 15) || sq_schema_lost(&pg_driver, s, PG_HAS_COLUMN, err)) &&
              (!(need & 48) || sq_schema_tokens(&pg_driver, s, "BIGSERIAL PRIMARY KEY", (need & 16) && !(need & 1), err)) &&
+             (!(need & 65) || sq_schema_meta(&pg_driver, s, PG_HAS_COLUMN, err)) &&
              d_commit(s, err);
         if (!ok) {
             d_rollback(s);

@@ -109,8 +109,21 @@ static void job_from(const sq_res *r, int row, svc_job *j)
     j->expired = v_int(r, row, 21) != 0;
 }
 
-/* get and list read token_id after SQ_JOB_COLS (the claim does not need it) */
+/* get and list read token_id and the replay's header after SQ_JOB_COLS
+ * (the claim needs neither) */
 #define TOKEN_COL 22 /* SQ_JOB_COLS has 22 columns */
+#define EXTRA_COLS "token_id, stage, kind1, kind2, winner, rounds1, rounds2"
+
+static void extra_from(const sq_res *r, int row, svc_job *j)
+{
+    j->token_id = v_int(r, row, TOKEN_COL);
+    j->stage = (int)v_int(r, row, TOKEN_COL + 1);
+    j->kind[0] = (int)v_int(r, row, TOKEN_COL + 2);
+    j->kind[1] = (int)v_int(r, row, TOKEN_COL + 3);
+    j->winner = (int)v_int(r, row, TOKEN_COL + 4);
+    j->rounds[0] = (int)v_int(r, row, TOKEN_COL + 5);
+    j->rounds[1] = (int)v_int(r, row, TOKEN_COL + 6);
+}
 
 static void unit_from(const sq_res *r, int row, svc_unit *u)
 {
@@ -325,9 +338,11 @@ static bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
     sq_res r;
     ok = run(s, "insert job",
              "INSERT INTO jobs (state, name, width, height, format, frames_total, created, replay, segment_ticks,"
-             " segments, seg_key, token_id) VALUES (0, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11) RETURNING id",
+             " segments, seg_key, token_id, stage, kind1, kind2, winner, rounds1, rounds2)"
+             " VALUES (0, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17) RETURNING id",
              ARGS(T(j->name), I(j->width), I(j->height), T(j->format), I(j->frames_total), I(now),
-                  B(j->replay, j->replay_len), I(seg), I(n), T(nonce), I(j->token_id)),
+                  B(j->replay, j->replay_len), I(seg), I(n), T(nonce), I(j->token_id), I(j->stage), I(j->kind[0]),
+                  I(j->kind[1]), I(j->winner), I(j->rounds[0]), I(j->rounds[1])),
              &r, err) >= 0 &&
          r.rows == 1;
     int64_t id = ok ? v_int(&r, 0, 0) : 0;
@@ -668,10 +683,10 @@ static int sq_get(svc_store *bs, int64_t id, svc_job *out, rs_err *err)
     sq_store *s = S(bs);
     sq_res r;
     pthread_mutex_lock(&s->mu);
-    int rc = run(s, "get", "SELECT " SQ_JOB_COLS ", token_id FROM jobs WHERE id = ?1", ARGS(I(id)), &r, err) < 0 ? -1 : 0;
+    int rc = run(s, "get", "SELECT " SQ_JOB_COLS ", " EXTRA_COLS " FROM jobs WHERE id = ?1", ARGS(I(id)), &r, err) < 0 ? -1 : 0;
     if (rc == 0 && r.rows > 0) {
         job_from(&r, 0, out);
-        out->token_id = v_int(&r, 0, TOKEN_COL);
+        extra_from(&r, 0, out);
         rc = 1;
     }
     if (rc >= 0)
@@ -689,14 +704,14 @@ static int sq_list(svc_store *bs, int64_t token_id, int64_t before, int limit, s
     pthread_mutex_lock(&s->mu);
     /* 0 means "from the newest"; a plain id < ?1 keeps the primary key usable */
     int n = (int)run(s, "list",
-                     "SELECT " SQ_JOB_COLS ", token_id FROM jobs WHERE id < ?1 AND (?3 = 0 OR token_id = ?3)"
+                     "SELECT " SQ_JOB_COLS ", " EXTRA_COLS " FROM jobs WHERE id < ?1 AND (?3 = 0 OR token_id = ?3)"
                      " ORDER BY id DESC LIMIT ?2",
                      ARGS(I(before == 0 ? INT64_MAX : before), I(limit), I(token_id)), &r, err);
     if (n >= 0) {
         n = r.rows < limit ? r.rows : limit;
         for (int i = 0; i < n; i++) {
             job_from(&r, i, &out[i]);
-            out[i].token_id = v_int(&r, i, TOKEN_COL);
+            extra_from(&r, i, &out[i]);
         }
         res_free(s, &r);
     }
@@ -790,6 +805,75 @@ static bool sq_counts(svc_store *bs, int64_t by_state[SVC_NSTATES], rs_err *err)
             if (k >= 0 && k < SVC_NSTATES)
                 by_state[k] = v_int(&r, i, 1);
         }
+        res_free(s, &r);
+    }
+    pthread_mutex_unlock(&s->mu);
+    return ok;
+}
+
+static int sq_retry(svc_store *bs, int64_t id, rs_err *err)
+{
+    sq_store *s = S(bs);
+    int64_t now;
+    int rc = -1, state = 0;
+    pthread_mutex_lock(&s->mu);
+    if (!tx_begin(s, &now, err))
+        goto out;
+    int l = lock_job(s, id, &state, NULL, err);
+    bool ok = l >= 0, failed = l > 0 && state == SVC_FAILED;
+    if (ok && failed)
+        ok = run(s, "re-queue the units",
+                 "UPDATE units SET state = 0, attempts = 0, lost = 0, error = '', owner = '', claimed_until = 0,"
+                 " frames_done = 0, fps = 0, started = 0, finished = 0, done_by = '', done_attempt = 0"
+                 " WHERE job_id = ?1",
+                 ARGS(I(id)), NULL, err) >= 0 &&
+             run(s, "re-queue the job",
+                 "UPDATE jobs SET state = 0, error = '', desync_tick = -1, started = 0, finished = 0 WHERE id = ?1",
+                 ARGS(I(id)), NULL, err) >= 0 &&
+             refresh(s, id, err);
+    rc = tx_end(s, ok, l == 0 ? 0 : failed ? 1 : 2, err);
+out:
+    pthread_mutex_unlock(&s->mu);
+    return rc;
+}
+
+static int sq_pending(svc_store *bs, svc_pending *out, int max, rs_err *err)
+{
+    sq_store *s = S(bs);
+    if (max <= 0)
+        return 0;
+    sq_res r;
+    pthread_mutex_lock(&s->mu);
+    int n = (int)run(s, "list the queue",
+                     "SELECT id, state, frames_total - frames_done FROM jobs WHERE state IN (0, 1) ORDER BY id LIMIT ?1",
+                     ARGS(I(max)), &r, err);
+    if (n >= 0) {
+        n = r.rows < max ? r.rows : max;
+        for (int i = 0; i < n; i++) {
+            out[i].id = v_int(&r, i, 0);
+            out[i].state = (int)v_int(&r, i, 1);
+            out[i].frames_left = v_int(&r, i, 2) > 0 ? v_int(&r, i, 2) : 0;
+        }
+        res_free(s, &r);
+    }
+    pthread_mutex_unlock(&s->mu);
+    return n < 0 ? -1 : n;
+}
+
+static bool sq_speed(svc_store *bs, int last, double *fps, rs_err *err)
+{
+    sq_store *s = S(bs);
+    sq_res r;
+    *fps = 0;
+    pthread_mutex_lock(&s->mu);
+    bool ok = run(s, "the recent render speed",
+                  "SELECT CAST(COALESCE(SUM(frames_total), 0) AS BIGINT), CAST(COALESCE(SUM(finished - started), 0) AS BIGINT)"
+                  " FROM (SELECT frames_total, finished, started FROM jobs WHERE state = 2 AND started > 0"
+                  " AND finished > started ORDER BY finished DESC LIMIT ?1) recent",
+                  ARGS(I(last)), &r, err) >= 0;
+    if (ok) {
+        if (r.rows == 1 && v_int(&r, 0, 1) > 0)
+            *fps = (double)v_int(&r, 0, 0) / (double)v_int(&r, 0, 1);
         res_free(s, &r);
     }
     pthread_mutex_unlock(&s->mu);
@@ -982,6 +1066,9 @@ static const svc_store_ops sq_ops = {
     .expire = sq_expire,
     .remove = sq_remove,
     .counts = sq_counts,
+    .retry = sq_retry,
+    .pending = sq_pending,
+    .speed = sq_speed,
     .token_add = sq_token_add,
     .token_list = sq_token_list,
     .token_revoke = sq_token_revoke,
@@ -1059,6 +1146,29 @@ bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_er
         bool have = r.rows == 1 && r.v[0].i > 0;
         drv->res_free(&r);
         if (!have && drv->exec(c, "add a column", cols[i][2], NULL, 0, NULL, err) < 0)
+            return false;
+    }
+    return true;
+}
+
+bool sq_schema_meta(const sq_driver *drv, void *c, const char *has_column, rs_err *err)
+{
+    static const char *const cols[][2] = {
+        {"stage", "ALTER TABLE jobs ADD COLUMN stage INTEGER NOT NULL DEFAULT -1"},
+        {"kind1", "ALTER TABLE jobs ADD COLUMN kind1 INTEGER NOT NULL DEFAULT 0"},
+        {"kind2", "ALTER TABLE jobs ADD COLUMN kind2 INTEGER NOT NULL DEFAULT 0"},
+        {"winner", "ALTER TABLE jobs ADD COLUMN winner INTEGER NOT NULL DEFAULT -1"},
+        {"rounds1", "ALTER TABLE jobs ADD COLUMN rounds1 INTEGER NOT NULL DEFAULT 0"},
+        {"rounds2", "ALTER TABLE jobs ADD COLUMN rounds2 INTEGER NOT NULL DEFAULT 0"},
+    };
+    for (size_t i = 0; i < sizeof cols / sizeof *cols; i++) {
+        sq_res r = {0};
+        sq_val a[2] = {{.type = SQ_TEXT, .s = "jobs"}, {.type = SQ_TEXT, .s = cols[i][0]}};
+        if (drv->exec(c, "look for a column", has_column, a, 2, &r, err) < 0)
+            return false;
+        bool have = r.rows == 1 && r.v[0].i > 0;
+        drv->res_free(&r);
+        if (!have && drv->exec(c, "add a column", cols[i][1], NULL, 0, NULL, err) < 0)
             return false;
     }
     return true;

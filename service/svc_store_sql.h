@@ -74,6 +74,12 @@ bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_er
  * adds jobs.token_id to a queue made before tokens existed. */
 bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool migrate, rs_err *err);
 
+/* The replay's header kept with each job (issue 22: the dashboard's
+ * stage, players, winner): jobs.stage, kind1, kind2, winner, rounds1 and
+ * rounds2, added where missing, to new and old queues alike, as
+ * sq_schema_lost does.  Old jobs read stage -1: not known. */
+bool sq_schema_meta(const sq_driver *drv, void *c, const char *has_column, rs_err *err);
+
 /* sql with @NOW, @LOCK and @SKIP spelt the driver's way, and with dollar
  * true ?N as $N (PostgreSQL).  False when out is too small. */
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar);

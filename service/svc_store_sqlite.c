@@ -253,7 +253,9 @@ static bool make_schema(sq_conn *c, rs_err *err)
     }
     ok = ok && sq_schema_units(&sqlite_driver, c, migrate, err) &&
          sq_schema_lost(&sqlite_driver, c, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2", err) &&
-         schema_tokens(c, err) && exec_plain(c, "COMMIT", err);
+         schema_tokens(c, err) &&
+         sq_schema_meta(&sqlite_driver, c, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2", err) &&
+         exec_plain(c, "COMMIT", err);
     if (!ok)
         d_rollback(c);
     return ok;

@@ -569,6 +569,7 @@ static svc_job job(int state)
     snprintf(j.owner, sizeof j.owner, "box:123"); /* shown only while running */
     j.width = 1280, j.height = 720, j.frames_total = 200;
     j.created = 1700000000; /* 2023-11-14T22:13:20Z */
+    j.stage = -1;           /* queued before the replay's header was kept */
     return j;
 }
 
@@ -576,7 +577,7 @@ static svc_job job(int state)
 static void job_is(const svc_job *j, const char *want, bool exact)
 {
     svc_buf b = {0};
-    svc_json_job(&b, j, 3, NULL, 0);
+    svc_json_job(&b, j, 3, NULL, 0, NULL);
     T_ASSERT(b.p && !b.oom);
     if (exact)
         T_ASSERTF(!strcmp(b.p, want), "\ngot  %s\nwant %s", b.p, want);
@@ -592,36 +593,63 @@ static void t_json_job(void)
 {
     svc_job j = job(SVC_QUEUED);
     job_is(&j, JOB_HEAD "\"queued\"," JOB_NAME "\"frames_done\":0,\"frames_total\":200,\"progress\":0.0000,"
-                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":1,\"max_attempts\":3,\"error\":null,"
+                        "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,\"render_s\":null,"
+                        "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
-                        "\"finished\":null,\"url\":\"/jobs/42\"}", true);
+                        "\"finished\":null,\"url\":\"/jobs/42\",\"log\":\"/jobs/42/log\"}", true);
     j = job(SVC_RUNNING);
     j.frames_done = 50, j.fps = 25, j.started = 1700000060;
     job_is(&j, JOB_HEAD "\"running\"," JOB_NAME "\"frames_done\":50,\"frames_total\":200,\"progress\":0.2500,"
-                        "\"fps\":25.00,\"eta_s\":6.0,\"attempts\":1,\"max_attempts\":3,\"error\":null,"
+                        "\"fps\":25.00,\"eta_s\":6.0," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,\"render_s\":null,"
+                        "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"worker\":\"box:123\",\"created\":\"2023-11-14T22:13:20Z\","
-                        "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":null,\"url\":\"/jobs/42\"}", true);
+                        "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":null,\"url\":\"/jobs/42\","
+                        "\"log\":\"/jobs/42/log\"}", true);
     j.fps = 0; /* no speed yet: no guess */
     job_is(&j, "\"fps\":0.00,\"eta_s\":null,", false);
+    /* the replay's header, and what the HTTP side adds */
+    svc_job k = job(SVC_DONE);
+    k.stage = 4, k.kind[0] = RP_HUMAN, k.kind[1] = RP_CPU, k.winner = 2, k.rounds[0] = 1, k.rounds[1] = 2;
+    k.started = 1700000060, k.finished = 1700000072;
+    svc_job_view v = {.eta_s = -1, .bytes = 123456, .poster = true};
+    svc_buf b = {0};
+    svc_json_job(&b, &k, 3, NULL, 0, &v);
+    T_CONTAINS(b.p, "\"eta_s\":null,\"queue_position\":null,\"stage\":\"snowfield\",\"players\":[\"human\",\"cpu\"],"
+                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":123456,\"render_s\":12,");
+    T_CONTAINS(b.p, "\"poster\":\"/jobs/42/poster\",\"log\":\"/jobs/42/log\"}");
+    svc_buf_free(&b);
+    k = job(SVC_QUEUED);
+    v = (svc_job_view){.queue_position = 3, .eta_s = 42.5, .bytes = -1};
+    svc_json_job(&b, &k, 3, NULL, 0, &v);
+    T_CONTAINS(b.p, "\"eta_s\":42.5,\"queue_position\":3,");
+    T_ASSERT(!strstr(b.p, "poster"));
+    svc_buf_free(&b);
     j.fps = 30, j.frames_done = 250; /* a total behind the count must not give a negative ETA */
     job_is(&j, "\"eta_s\":null,", false);
     j = job(SVC_DONE);
     j.frames_done = 190, j.fps = 40; /* the last heartbeat may lag the end */
     j.started = 1700000060, j.finished = 1700000100;
     job_is(&j, JOB_HEAD "\"done\"," JOB_NAME "\"frames_done\":200,\"frames_total\":200,\"progress\":1.0000,"
-                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":1,\"max_attempts\":3,\"error\":null,"
+                        "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,\"render_s\":40,"
+                        "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":\"2023-11-14T22:15:00Z\","
-                        "\"url\":\"/jobs/42\",\"video\":\"/jobs/42/video\",\"hashes\":\"/jobs/42/hashes\"}", true);
+                        "\"url\":\"/jobs/42\",\"video\":\"/jobs/42/video\",\"hashes\":\"/jobs/42/hashes\","
+                        "\"log\":\"/jobs/42/log\"}", true);
     j = job(SVC_FAILED);
     j.attempts = 3, j.frames_done = 120, j.finished = 1700000100;
     j.desync_tick = 0; /* tick 0 is a tick, not "none" */
     snprintf(j.error, sizeof j.error, "desync at tick 0:\n\"want\" \x01 \xff");
     job_is(&j, JOB_HEAD "\"failed\"," JOB_NAME "\"frames_done\":120,\"frames_total\":200,\"progress\":0.6000,"
-                        "\"fps\":0.00,\"eta_s\":null,\"attempts\":3,\"max_attempts\":3,"
+                        "\"fps\":0.00,\"eta_s\":null,\"queue_position\":null,\"stage\":null,\"players\":null,"
+                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,"
+                        "\"render_s\":null,\"attempts\":3,\"max_attempts\":3,"
                         "\"error\":\"desync at tick 0:\\n\\\"want\\\" \\u0001 \\ufffd\",\"desync_tick\":0,"
                         "\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
-                        "\"finished\":\"2023-11-14T22:15:00Z\",\"url\":\"/jobs/42\"}", true);
+                        "\"finished\":\"2023-11-14T22:15:00Z\",\"url\":\"/jobs/42\",\"log\":\"/jobs/42/log\"}", true);
     j.desync_tick = 3600;
     job_is(&j, ",\"desync_tick\":3600,", false);
     j = job(SVC_CANCELLED);
@@ -647,7 +675,7 @@ static void t_json_split_job(void)
     snprintf(u[0].error, sizeof u[0].error, "lease expired");
     snprintf(u[1].owner, sizeof u[1].owner, "box:1-ab/1");
     svc_buf b = {0};
-    svc_json_job(&b, &j, 3, u, 3);
+    svc_json_job(&b, &j, 3, u, 3, NULL);
     T_ASSERT(b.p && !b.oom);
     T_CONTAINS(b.p, "\"segment_seconds\":1,\"segment_count\":2,\"segments\":["
                     "{\"index\":0,\"ticks\":[0,60],\"state\":\"done\",\"attempts\":2,\"renders\":1,"
@@ -655,12 +683,12 @@ static void t_json_split_job(void)
                     "{\"index\":1,\"ticks\":[60,120],\"state\":\"running\",\"attempts\":1,\"renders\":0,"
                     "\"frames_done\":30,\"worker\":\"box:1-ab/1\",\"error\":null}],"
                     "\"join\":{\"state\":\"queued\",\"attempts\":0,\"renders\":0,\"frames_done\":0,"
-                    "\"worker\":null,\"error\":null},\"url\":\"/jobs/42\"}");
+                    "\"worker\":null,\"error\":null},\"url\":\"/jobs/42\",");
     T_CONTAINS(b.p, "\"progress\":0.7500,\"fps\":20.00,\"eta_s\":1.5,");
     svc_buf_free(&b);
     /* unsplit: not a word more than before */
     j = job(SVC_RUNNING);
-    svc_json_job(&b, &j, 3, u, 3);
+    svc_json_job(&b, &j, 3, u, 3, NULL);
     T_ASSERT(!strstr(b.p, "segment"));
     svc_buf_free(&b);
 }

@@ -17,6 +17,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
+#include "../runtime/replay/rp.h"
 #include "../service/svc_store.h"
 #include "t.h"
 
@@ -515,6 +516,50 @@ static void reap(const char *spec)
     T_ASSERT(!strcmp(g.error, SVC_LEASE_EXPIRED));
     T_EQ(g.attempts, 0);
     T_EQ(s->ops->reap(s, true, NULL, 0, &e), 0);
+    s->ops->close(s);
+}
+
+/* The replay's header kept with a job; the queue order (pending); retry
+ * of a failed job only, from scratch; the recent speed. */
+static void retry_and_queue(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    svc_job j = {.width = 64, .height = 36, .frames_total = 600, .replay = (uint8_t *)"x", .replay_len = 1,
+                 .stage = 5, .kind = {RP_HUMAN, RP_CPU}, .winner = 2, .rounds = {1, 2}};
+    snprintf(j.format, sizeof j.format, "mp4");
+    T_ASSERT(s->ops->submit(s, &j, &e));
+    int64_t a = j.id, b = submit(s, "b.rsr", "y", 1), c = submit(s, "c.rsr", "z", 1);
+    svc_job g = get_ok(s, a);
+    T_ASSERT(g.stage == 5 && g.kind[0] == RP_HUMAN && g.kind[1] == RP_CPU && g.winner == 2 && g.rounds[0] == 1 &&
+             g.rounds[1] == 2);
+    svc_job out[2];
+    T_EQ(s->ops->list(s, 0, 0, 2, out, &e), 2);
+    T_ASSERT(out[1].id == b && out[0].stage == 0); /* submit()'s jobs: a zeroed header */
+    svc_job w = claim_ok(s, "host:1", 60);
+    T_EQ(w.id, a);
+    svc_job_free(&w);
+    T_EQ(s->ops->heartbeat(s, a, "host:1", 60, 100, 600, 10.0, &e), 1);
+    svc_pending p[4];
+    T_EQ(s->ops->pending(s, p, 4, &e), 3);
+    T_ASSERT(p[0].id == a && p[0].state == SVC_RUNNING && p[0].frames_left == 500);
+    T_ASSERT(p[1].id == b && p[1].state == SVC_QUEUED && p[1].frames_left == 600 && p[2].id == c);
+    T_EQ(s->ops->finish(s, a, "host:1", SVC_FAILED, "the render failed", 42, 100, &e), 1);
+    T_EQ(s->ops->retry(s, b, &e), 2); /* queued: not failed */
+    T_EQ(s->ops->retry(s, 999999, &e), 0);
+    T_EQ(s->ops->retry(s, a, &e), 1);
+    g = get_ok(s, a);
+    T_ASSERT(g.state == SVC_QUEUED && g.attempts == 0 && g.error[0] == 0 && g.desync_tick == -1 && g.finished == 0);
+    T_EQ(s->ops->pending(s, p, 4, &e), 3);
+    T_ASSERT(p[0].id == a && p[0].state == SVC_QUEUED && p[0].frames_left == 600);
+    w = claim_ok(s, "host:2", 60);
+    T_ASSERT(w.id == a && w.unit.attempts == 1 && w.unit.claim == 1);
+    svc_job_free(&w);
+    T_EQ(s->ops->finish(s, a, "host:2", SVC_DONE, "", -1, 600, &e), 1);
+    T_EQ(s->ops->retry(s, a, &e), 2); /* done */
+    double fps = -1;
+    T_ASSERT(s->ops->speed(s, 20, &fps, &e));
+    T_ASSERT(fps >= 0);
     s->ops->close(s);
 }
 
@@ -1298,6 +1343,7 @@ static void t_pg_migrate_v1(void)
 
 BOTH(roundtrip)
 BOTH(expire_and_remove)
+BOTH(retry_and_queue)
 BOTH(claim_order)
 BOTH(attempts)
 BOTH(heartbeat)
@@ -1458,6 +1504,7 @@ T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), 
        CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), CASES(split_plan), CASES(split_run),
        CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin),
         CASES(split_concurrent), CASES(tokens), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove),
+        CASES(retry_and_queue),
         {"sqlite_bad_files", t_sqlite_bad_files},
        {"pg_unreachable", t_pg_unreachable}, {"pg_foreign_table", t_pg_foreign_table},
        {"pg_reconnect", t_pg_reconnect}, {"error_ids_have_texts", t_error_ids_have_texts})

@@ -197,7 +197,16 @@ async function main() {
     }
     if (opt.token) await tokenForm(page, opt, ctx);
 
-    // 2. fill in the form
+    // 2. fill in the form: the size menu offers the server's default, selected, and nothing over its max_size
+    const health = await (await page.request.get(opt.url + '/healthz')).json();
+    await waitFor(page, 'the size menu built from /healthz', () => page.$eval('#upload-size',
+      (s, def) => s.value === def && Array.from(s.options).some((o) => o.value === def && /default/.test(o.textContent)),
+      health.default_size), ctx);
+    const [mw, mh] = health.max_size.split('x').map(Number);
+    for (const v of await page.$$eval('#upload-size option', (os) => os.map((o) => o.value))) {
+      const [w, h] = v.split('x').map(Number);
+      if (w > mw || h > mh) fail(`the size menu offers ${v}, over max_size ${health.max_size}`);
+    }
     await page.setInputFiles('#upload-file', opt.replay);
     for (const [sel, val] of [['#upload-size', opt.size], ['#upload-format', opt.format]]) {
       const vals = await page.$$eval(`${sel} option`, (os) => os.map((o) => o.value));
@@ -305,10 +314,37 @@ async function main() {
       }
     }
 
-    // 6. screenshot
+    // 6. what the row shows of the job: poster, match, output, render time, the log
+    await waitFor(page, `job ${id}'s poster thumbnail`, () => page.$eval(`${rowSel} img.poster`,
+      (im) => !im.hidden && im.complete && im.naturalWidth > 0), ctx);
+    const row = await page.$eval(rowSel, (tr) => ({
+      poster: [tr.querySelector('img.poster').naturalWidth, tr.querySelector('img.poster').naturalHeight].join('x'),
+      posterSrc: tr.querySelector('img.poster').src,
+      match: tr.querySelector('td.match').textContent, output: tr.querySelector('td.output').textContent,
+    }));
+    if (row.poster !== opt.size) fail(`the poster is ${row.poster}, not the video's ${opt.size}`);
+    if (opt.token && !row.posterSrc.startsWith('blob:')) fail(`with a token the poster came from ${row.posterSrc}`);
+    if (!/^temple · cpu vs cpu · /.test(row.match)) fail(`match cell: '${row.match}'`);
+    if (!row.output.includes(opt.size) || !row.output.includes(opt.format + '/' + (opt.format === 'webm' ? 'vp9' : 'h264')) ||
+        !/ kB| MB/.test(row.output)) fail(`output cell: '${row.output}'`);
+    await page.click(`${rowSel} details.log summary`);
+    await waitFor(page, `job ${id}'s log`, () => page.$eval(`${rowSel} + tr.log-row pre`,
+      (pre) => /== render, attempt 1, process \d+: exit status 0/.test(pre.textContent) &&
+        /ringside render: wrote /.test(pre.textContent)), ctx);
+
+    // 7. screenshot (the table from its first column: opening the log scrolled it)
+    await page.$eval('.table-wrap', (w) => { w.scrollLeft = 0; });
     fs.mkdirSync(path.dirname(path.resolve(opt.shot)), { recursive: true });
     await page.screenshot({ path: opt.shot, fullPage: true });
     checkPageErrors();
+    if (!opt.token) {
+      // 8. delete the finished job: a confirm, then the row and its files go
+      page.once('dialog', (d) => d.accept());
+      await page.click(`${rowSel} button.delete`);
+      await waitFor(page, `job ${id}'s row to go after delete`, async () => await page.locator(rowSel).count() === 0, ctx);
+      const gone = await page.request.get(`${opt.url}/jobs/${id}/poster`);
+      if (gone.status() !== 404) fail(`the deleted job's poster answers ${gone.status()}`);
+    }
     if (opt.token) await reloadAndForget(page, id, ctx);
     if (opt['quota-token']) await overQuota(page, opt, ctx);
     checkPageErrors();
