@@ -77,6 +77,17 @@ static const c_row rows[] = {
      "a new API token's quota: seconds of game time it may submit per hour (0: no cap)"},
     {"retention", C_DURATION, OFF(retention), 0, 0, 100L * 365 * 86400, "0", NULL,
      "how long a finished job's video and hashes are kept (s, m, h or d suffix; 0: keep them)"},
+    {"codecs", C_STR, OFF(codecs), 0, 0, sizeof((svc_config *)0)->codecs - 1, "h264,hevc,vp9,av1", NULL,
+     "the codecs a job may ask for, comma-separated (* = all the render has); a job without one gets the "
+     "format's default (h264, vp9 for webm)"},
+    {"min_crf", C_INT, OFF(min_crf), 0, 1, 63, "15", NULL,
+     "the lowest crf (best quality, largest file) a job may ask for"},
+    {"max_bitrate", C_INT, OFF(max_bitrate), 0, 10, 1000000, "20000", NULL,
+     "the highest average bitrate a job may ask for, in kbit/s"},
+    {"presets", C_STR, OFF(presets), 0, 0, sizeof((svc_config *)0)->presets - 1,
+     "ultrafast,superfast,veryfast,faster,fast,medium,4..13", NULL,
+     "the encoder presets a job may ask for, comma-separated, A..B for numbers (* = any the encoder takes); "
+     "the default leaves out the slow ones"},
 };
 #define NROWS (sizeof rows / sizeof rows[0])
 

@@ -43,6 +43,11 @@ typedef struct svc_config {
     int token_max_queued;    /* a new token's default: its jobs queued or running at once */
     int token_seconds_per_hour; /* a new token's default: seconds of game time it may submit per hour */
     long retention;          /* seconds a finished job's files are kept (0 = keep) */
+    /* the encoder options a job may ask for (svc_encode.c) */
+    char codecs[64];         /* comma-separated; "" or "*" = every one the render has */
+    int min_crf;             /* the best quality (largest files) a job may ask for */
+    int max_bitrate;         /* kbit/s */
+    char presets[256];       /* comma-separated; "" or "*" = any the encoder takes */
 } svc_config;
 
 void svc_config_defaults(svc_config *c);

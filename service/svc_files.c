@@ -37,6 +37,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "svc_encode.h"
 #include "svc_local.h"
 #include "svc_log.h"
 
@@ -176,6 +177,12 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
                                     "--poster", f->poster, "--progress-fd", "3", "--progress", "off", "--backend", cfg->backend};
         for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
             add(&a, tail[i]);
+        char opt[8][24], val[8][CAP_ENC_PRESET_MAX]; /* the job's encoder options (svc_encode.c) */
+        int nenc = svc_encode_argv(j->encode, opt, val, 8);
+        for (int i = 0; i < nenc; i++) {
+            add(&a, opt[i]);
+            add(&a, val[i]);
+        }
     }
     if (a.oom) {
         svc_argv_free(a.v);

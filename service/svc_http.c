@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "svc_auth.h"
+#include "svc_encode.h"
 #include "svc_json.h"
 #include "svc_local.h"
 #include "svc_log.h"
@@ -383,6 +384,7 @@ typedef struct req {
     const char *bad; /* a malformed body: answered 400 once it is read */
     char name[SVC_NAME_MAX];
     char size[32], format[16];
+    char codec[16], crf[8], bitrate[16], preset[CAP_ENC_PRESET_MAX], pix_fmt[16]; /* svc_encode.c */
     /* who asks (authorize): tok.id 0 without a token; all: sees every job
      * (an operator token, or loopback with no tokens at all) */
     svc_token tok;
@@ -513,8 +515,19 @@ static enum MHD_Result post_field(void *cls, enum MHD_ValueKind kind, const char
             set_name(q, filename);
         return append(q, data, size, d->cfg.max_upload) ? MHD_YES : MHD_NO;
     }
-    char *dst = !strcmp(key, "size") ? q->size : !strcmp(key, "format") ? q->format : NULL;
-    size_t room = !strcmp(key, "size") ? sizeof q->size : sizeof q->format;
+    struct {
+        const char *key;
+        char *dst;
+        size_t room;
+    } const fields[] = {{"size", q->size, sizeof q->size},       {"format", q->format, sizeof q->format},
+                        {"codec", q->codec, sizeof q->codec},    {"crf", q->crf, sizeof q->crf},
+                        {"bitrate", q->bitrate, sizeof q->bitrate}, {"preset", q->preset, sizeof q->preset},
+                        {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}};
+    char *dst = NULL;
+    size_t room = 0;
+    for (size_t i = 0; i < sizeof fields / sizeof *fields; i++)
+        if (!strcmp(key, fields[i].key))
+            dst = fields[i].dst, room = fields[i].room;
     if (dst && off + size < room) {
         memcpy(dst + off, data, size);
         dst[off + size] = 0;
@@ -613,6 +626,21 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         snprintf(q->size, sizeof q->size, "%s", v);
     if (!q->format[0] && (v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "format")))
         snprintf(q->format, sizeof q->format, "%s", v);
+    struct {
+        const char *key;
+        char *dst;
+        size_t room;
+    } const enc_args[] = {{"codec", q->codec, sizeof q->codec},
+                          {"crf", q->crf, sizeof q->crf},
+                          {"bitrate", q->bitrate, sizeof q->bitrate},
+                          {"preset", q->preset, sizeof q->preset},
+                          {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}};
+    for (size_t i = 0; i < sizeof enc_args / sizeof *enc_args; i++)
+        if (!enc_args[i].dst[0] && (v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, enc_args[i].key))) {
+            if (strlen(v) >= enc_args[i].room)
+                return reject(d, c, SVC_ERR_BAD_PARAM, "%s: at most %zu characters", enc_args[i].key, enc_args[i].room - 1);
+            snprintf(enc_args[i].dst, enc_args[i].room, "%s", v);
+        }
     if (!q->name[0]) {
         set_name(q, MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "name"));
         if (!q->name[0])
@@ -644,6 +672,9 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         snprintf(j.format, sizeof j.format, "%s", q->format);
     }
     rs_err err = {0};
+    svc_encode_req eq = {q->codec, q->crf, q->bitrate, q->preset, q->pix_fmt};
+    if (!svc_encode_check(&d->cfg, &eq, j.format, j.width, j.height, j.encode, sizeof j.encode, &err))
+        return reject(d, c, err.code, "%s", err.msg);
     if (!svc_check_upload(&d->cfg, q->body, q->len, j.name, &j, &err))
         return reject(d, c, err.code, "%s", err.msg);
     j.replay = q->body;
@@ -1393,7 +1424,7 @@ static bool state_changing(const char *method)
 static const struct {
     const char *method, *path, *params;
 } query_params[] = {
-    {"POST", "/jobs", "size,format,name"},
+    {"POST", "/jobs", "size,format,name,codec,crf,bitrate,preset,pix_fmt"},
     {"GET", "/jobs", "limit,before"},
     {"HEAD", "/jobs", "limit,before"},
 };

@@ -1,5 +1,6 @@
 /* svc_json: see svc_json.h. */
 #include "svc_json.h"
+#include "svc_encode.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -138,10 +139,13 @@ static void json_unit(svc_buf *b, const svc_unit *u)
     svc_buf_add(b, "}", 1);
 }
 
-/* The encoder capture's FFmpeg sink uses for the format (cap_sink_ffmpeg.c). */
-static const char *codec_of(const char *format)
+/* The codec the job asked for (svc_encode.c), else the one capture's
+ * FFmpeg sink uses for the format (cap_enc.c). */
+static void codec_of(const svc_job *j, char *out, size_t n)
 {
-    return !strcmp(format, "webm") ? "vp9" : "h264";
+    svc_encode_get(j->encode, "codec", out, n);
+    if (!out[0])
+        snprintf(out, n, "%s", !strcmp(j->format, "webm") ? "vp9" : "h264");
 }
 
 /* What the replay says (svc_job's header fields), null when not known. */
@@ -182,7 +186,10 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
     else
         svc_buf_add(b, ",\"queue_position\":null", 22);
     json_replay(b, j);
-    svc_buf_printf(b, ",\"length_s\":%.2f,\"codec\":\"%s\"", j->frames_total / 60.0, codec_of(j->format));
+    char codec[16];
+    codec_of(j, codec, sizeof codec);
+    svc_buf_printf(b, ",\"length_s\":%.2f,\"codec\":\"%s\",\"encode\":", j->frames_total / 60.0, codec);
+    svc_json_str(b, j->encode);
     if (v && v->bytes >= 0)
         svc_buf_printf(b, ",\"bytes\":%lld", (long long)v->bytes);
     else

@@ -159,6 +159,10 @@ typedef struct svc_job {
     int kind[2];                 /* RP_HUMAN / RP_CPU */
     int winner;                  /* first match: -1 unfinished, 0 draw, 1, 2 */
     int rounds[2];
+    /* encoder options the job asked for, checked at upload against the
+     * operator's bounds: "codec=hevc crf=24 preset=fast pix_fmt=yuv444p"
+     * (any of them; "" = the render's defaults) */
+    char encode[96];
     svc_unit unit;               /* claim: the unit handed out (the rest leave it zero) */
     /* the replay: submit reads it, claim fills it (malloc'd; svc_job_free) */
     uint8_t *replay;

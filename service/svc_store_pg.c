@@ -442,7 +442,7 @@ static int schema_needs(pg_conn *s, rs_err *err)
                " NOT EXISTS (SELECT 1 FROM information_schema.columns"
                " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'token_id'),"
                " to_regclass('tokens') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
-               " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'stage')",
+               " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'encode')",
                NULL, 0, &r, err) < 0)
         return -1;
     int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2 | r.v[3].i << 3 | r.v[4].i << 4 |

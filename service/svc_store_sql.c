@@ -107,11 +107,12 @@ static void job_from(const sq_res *r, int row, svc_job *j)
     snprintf(j->key, sizeof j->key, "job%" PRId64 "-%s", j->id, nonce);
     j->lost = (int)v_int(r, row, 20);
     j->expired = v_int(r, row, 21) != 0;
+    v_text(j->encode, sizeof j->encode, r, row, 22);
 }
 
 /* get and list read token_id and the replay's header after SQ_JOB_COLS
  * (the claim needs neither) */
-#define TOKEN_COL 22 /* SQ_JOB_COLS has 22 columns */
+#define TOKEN_COL 23 /* SQ_JOB_COLS has 23 columns */
 #define EXTRA_COLS "token_id, stage, kind1, kind2, winner, rounds1, rounds2"
 
 static void extra_from(const sq_res *r, int row, svc_job *j)
@@ -338,11 +339,11 @@ static bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
     sq_res r;
     ok = run(s, "insert job",
              "INSERT INTO jobs (state, name, width, height, format, frames_total, created, replay, segment_ticks,"
-             " segments, seg_key, token_id, stage, kind1, kind2, winner, rounds1, rounds2)"
-             " VALUES (0, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17) RETURNING id",
+             " segments, seg_key, token_id, stage, kind1, kind2, winner, rounds1, rounds2, encode)"
+             " VALUES (0, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18) RETURNING id",
              ARGS(T(j->name), I(j->width), I(j->height), T(j->format), I(j->frames_total), I(now),
                   B(j->replay, j->replay_len), I(seg), I(n), T(nonce), I(j->token_id), I(j->stage), I(j->kind[0]),
-                  I(j->kind[1]), I(j->winner), I(j->rounds[0]), I(j->rounds[1])),
+                  I(j->kind[1]), I(j->winner), I(j->rounds[0]), I(j->rounds[1]), T(j->encode)),
              &r, err) >= 0 &&
          r.rows == 1;
     int64_t id = ok ? v_int(&r, 0, 0) : 0;
@@ -413,7 +414,7 @@ static int claim_once(sq_store *s, const char *owner, int lease_s, svc_job *out,
          r.rows == 1;
     if (ok) {
         job_from(&r, 0, out);
-        const sq_val *rp = cell(&r, 0, 22);
+        const sq_val *rp = cell(&r, 0, 23);
         size_t n = rp->type == SQ_BLOB || rp->type == SQ_TEXT ? rp->n : 0;
         out->replay = malloc(n > 0 ? n : 1);
         if (!out->replay)
@@ -1160,6 +1161,8 @@ bool sq_schema_meta(const sq_driver *drv, void *c, const char *has_column, rs_er
         {"winner", "ALTER TABLE jobs ADD COLUMN winner INTEGER NOT NULL DEFAULT -1"},
         {"rounds1", "ALTER TABLE jobs ADD COLUMN rounds1 INTEGER NOT NULL DEFAULT 0"},
         {"rounds2", "ALTER TABLE jobs ADD COLUMN rounds2 INTEGER NOT NULL DEFAULT 0"},
+        /* the encoder options the job asked for ("codec=hevc crf=24"; svc_encode_argv) */
+        {"encode", "ALTER TABLE jobs ADD COLUMN encode TEXT NOT NULL DEFAULT ''"},
     };
     for (size_t i = 0; i < sizeof cols / sizeof *cols; i++) {
         sq_res r = {0};

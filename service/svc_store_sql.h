@@ -93,6 +93,6 @@ bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char 
 /* The columns of jobs (without replay) every backend checks at open. */
 #define SQ_JOB_COLS                                                                                                   \
     "id, state, name, width, height, format, frames_done, frames_total, fps, attempts, desync_tick, error, owner, "  \
-    "created, started, finished, claimed_until, segment_ticks, segments, seg_key, lost, expired"
+    "created, started, finished, claimed_until, segment_ticks, segments, seg_key, lost, expired, encode"
 
 #endif

@@ -15,6 +15,7 @@
 #include "../runtime/util/rs_img.h"
 #include "../service/svc_auth.h"
 #include "../service/svc_config.h"
+#include "../service/svc_encode.h"
 #include "../service/svc_json.h"
 #include "../service/svc_local.h"
 #include "t.h"
@@ -149,7 +150,7 @@ static const set_case set_cases[] = {
     {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
                         "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, format, backend, log_level, allowed_hosts, cors_origins, "
                         "max_connections, max_connections_per_ip, header_timeout, min_body_rate, upload_memory, "
-                        "token_max_queued, token_seconds_per_hour, retention)"},
+                        "token_max_queued, token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)"},
     {"", "1", 0, "unknown setting ''"},
     {"retention", "0", 1, "retention = 0"}, {"retention", "90", 1, "retention = 90"},
     {"retention", "90s", 1, "retention = 90"}, {"retention", "15m", 1, "retention = 900"},
@@ -279,7 +280,7 @@ static void t_config_load_errors(void)
                                    "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, "
                                    "format, backend, log_level, allowed_hosts, cors_origins, max_connections, "
                                    "max_connections_per_ip, header_timeout, min_body_rate, upload_memory, token_max_queued, "
-                                   "token_seconds_per_hour, retention)");
+                                   "token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)");
     LOAD_BAD("size = 640x360\r\nsize = 640\r\n", ":2: size: '640' is not a size (expected WxH, such as 640x360)");
     LOAD_BAD("workers = # nothing left\n", ":1: workers: '' is not a whole number");
     LOAD_BAD("workers = 2\0\n", ": contains a NUL byte (not a text file)");
@@ -594,7 +595,7 @@ static void t_json_job(void)
     svc_job j = job(SVC_QUEUED);
     job_is(&j, JOB_HEAD "\"queued\"," JOB_NAME "\"frames_done\":0,\"frames_total\":200,\"progress\":0.0000,"
                         "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,\"render_s\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
                         "\"finished\":null,\"url\":\"/jobs/42\",\"log\":\"/jobs/42/log\"}", true);
@@ -602,7 +603,7 @@ static void t_json_job(void)
     j.frames_done = 50, j.fps = 25, j.started = 1700000060;
     job_is(&j, JOB_HEAD "\"running\"," JOB_NAME "\"frames_done\":50,\"frames_total\":200,\"progress\":0.2500,"
                         "\"fps\":25.00,\"eta_s\":6.0," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,\"render_s\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"worker\":\"box:123\",\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":null,\"url\":\"/jobs/42\","
@@ -617,7 +618,7 @@ static void t_json_job(void)
     svc_buf b = {0};
     svc_json_job(&b, &k, 3, NULL, 0, &v);
     T_CONTAINS(b.p, "\"eta_s\":null,\"queue_position\":null,\"stage\":\"snowfield\",\"players\":[\"human\",\"cpu\"],"
-                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":123456,\"render_s\":12,");
+                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":123456,\"render_s\":12,");
     T_CONTAINS(b.p, "\"poster\":\"/jobs/42/poster\",\"log\":\"/jobs/42/log\"}");
     svc_buf_free(&b);
     k = job(SVC_QUEUED);
@@ -633,7 +634,7 @@ static void t_json_job(void)
     j.started = 1700000060, j.finished = 1700000100;
     job_is(&j, JOB_HEAD "\"done\"," JOB_NAME "\"frames_done\":200,\"frames_total\":200,\"progress\":1.0000,"
                         "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,\"render_s\":40,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,\"render_s\":40,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":\"2023-11-14T22:15:00Z\","
@@ -645,7 +646,7 @@ static void t_json_job(void)
     snprintf(j.error, sizeof j.error, "desync at tick 0:\n\"want\" \x01 \xff");
     job_is(&j, JOB_HEAD "\"failed\"," JOB_NAME "\"frames_done\":120,\"frames_total\":200,\"progress\":0.6000,"
                         "\"fps\":0.00,\"eta_s\":null,\"queue_position\":null,\"stage\":null,\"players\":null,"
-                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"bytes\":null,"
+                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,"
                         "\"render_s\":null,\"attempts\":3,\"max_attempts\":3,"
                         "\"error\":\"desync at tick 0:\\n\\\"want\\\" \\u0001 \\ufffd\",\"desync_tick\":0,"
                         "\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
@@ -979,6 +980,45 @@ static void t_error_ids_have_texts(void)
 
 /* The statuses clients have always seen; every id has a row (an id added
  * without one would answer 500). */
+/* A job's encoder options: the bounds (lists with A..B ranges), the
+ * encoder's own checks, the canonical string and its way back to argv. */
+static void t_encode_options(void)
+{
+    svc_config c;
+    svc_config_defaults(&c);
+    char out[96];
+    rs_err err = {0};
+    svc_encode_req q = {.codec = "hevc", .crf = "24", .preset = "fast", .pix_fmt = "yuv444p"};
+    T_ASSERTF(svc_encode_check(&c, &q, "mp4", 640, 360, out, sizeof out, &err), "%s", err.msg);
+    T_ASSERTF(!strcmp(out, "codec=hevc crf=24 preset=fast pix_fmt=yuv444p"), "got %s", out);
+    char opt[8][24], val[8][CAP_ENC_PRESET_MAX];
+    T_ASSERT(svc_encode_argv(out, opt, val, 8) == 4);
+    T_ASSERTF(!strcmp(opt[3], "--pix-fmt"), "got %s", opt[3]);
+    T_ASSERTF(!strcmp(val[3], "yuv444p"), "got %s", val[3]);
+    char codec[16];
+    svc_encode_get(out, "codec", codec, sizeof codec);
+    T_ASSERTF(!strcmp(codec, "hevc"), "got %s", codec);
+    svc_encode_req none = {0};
+    T_ASSERT(svc_encode_check(&c, &none, "webm", 640, 360, out, sizeof out, &err) && !out[0]);
+    /* numbered presets by range: 4..13 takes 8 and 13, not 3 or 14 */
+    const char *ok[] = {"8", "13", "4"}, *bad[] = {"3", "14", "-1", "slow", "placebo"};
+    for (size_t i = 0; i < sizeof ok / sizeof *ok; i++) {
+        svc_encode_req r = {.codec = "av1", .preset = ok[i]};
+        T_ASSERTF(svc_encode_check(&c, &r, "mkv", 640, 360, out, sizeof out, &err), "%s: %s", ok[i], err.msg);
+    }
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        svc_encode_req r = {.codec = "av1", .preset = bad[i]};
+        T_ASSERTF(!svc_encode_check(&c, &r, "mkv", 640, 360, out, sizeof out, &err), "%s was allowed", bad[i]);
+        T_CONTAINS(err.msg, "setting presets");
+    }
+    /* the encoder's word: x264 has no preset "8", MP4 holds no VP9 */
+    svc_encode_req r1 = {.codec = "h264", .preset = "8"}, r2 = {.codec = "vp9"};
+    T_ASSERT(!svc_encode_check(&c, &r1, "mp4", 640, 360, out, sizeof out, &err));
+    T_CONTAINS(err.msg, "preset");
+    T_ASSERT(!svc_encode_check(&c, &r2, "mp4", 640, 360, out, sizeof out, &err));
+    T_CONTAINS(err.msg, "does not hold vp9");
+}
+
 static void t_http_status_table(void)
 {
     static const struct {
@@ -1074,4 +1114,4 @@ T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t
        {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"upload_verified", t_upload_verified},
-       {"http_status_table", t_http_status_table})
+       {"http_status_table", t_http_status_table}, {"encode_options", t_encode_options})

@@ -141,5 +141,32 @@ t_queue_position_counts_down() {
     svc_stop
 }
 
-t_run poster_log_and_fields other_tokens_get_404 retry_a_failed_job paging_covers_every_job queue_position_counts_down
+# Encoder options as job parameters, inside the operator's bounds: a job
+# that asks for HEVC gets an HEVC stream (and the JSON says so); what is
+# outside the bounds or the container is refused at upload, naming it.
+t_encoder_options() {
+    "$RS_BIN" record --ai --quiet --seconds 1 --seed 4 -o a.rsr || return 1
+    svc_start d $SVC_FAST --presets veryfast,fast,4..13 --min-crf 20 --codecs h264,hevc,vp9 || return 1
+    id=$(svc_submit a.rsr "codec=hevc&crf=30&preset=fast") || return 1
+    svc_wait_state "$id" done 60 || return 1
+    [ "$(ffprobe -v error -select_streams v -show_entries stream=codec_name -of csv=p=0 d/videos/$id.mp4)" = hevc ] ||
+        { echo "job $id is not HEVC"; cat d.log; return 1; }
+    curl -sf "$SVC_URL/jobs/$id" >j.json || return 1
+    [ "$(json_get codec <j.json)" = hevc ] && [ "$(json_get encode <j.json)" = "codec=hevc crf=30 preset=fast" ] ||
+        { cat j.json; return 1; }
+    # a form field works like the query parameter
+    id2=$(curl -s -F replay=@a.rsr -F format=webm -F codec=vp9 -F preset=8 "$SVC_URL/jobs" | json_get id) || return 1
+    svc_wait_state "$id2" done 60 || return 1
+    [ "$(ffprobe -v error -select_streams v -show_entries stream=codec_name -of csv=p=0 d/videos/$id2.webm)" = vp9 ] ||
+        { echo "job $id2 is not VP9"; return 1; }
+    for q in "codec=av1:setting codecs" "crf=10:setting min_crf" "preset=placebo:setting presets" \
+        "codec=vp9&format=mp4:MP4 does not hold vp9" "codec=h265:codec 'h265'" "pix_fmt=rgb24:pix_fmt 'rgb24'" \
+        "bitrate=900M:setting max_bitrate" "crf=25&bitrate=1M:exclude each other" "preset=x%3Bid:preset 'x;id'"; do
+        [ "$(code POST "/jobs?${q%%:*}" --data-binary @a.rsr)" = 400 ] && grep -q "${q#*:}" body.txt ||
+            { echo "'${q%%:*}': want 400 naming '${q#*:}'"; cat body.txt; return 1; }
+    done
+    svc_stop
+}
+
+t_run encoder_options poster_log_and_fields other_tokens_get_404 retry_a_failed_job paging_covers_every_job queue_position_counts_down
 t_done
