@@ -28,9 +28,9 @@ extern const cap_sink_ops cap_sink_images;
 const char *cap_sink_formats(void)
 {
 #if defined(RS_HAVE_FFMPEG) && defined(RS_HAVE_OIIO)
-    return ".y4m, .mp4, .mkv, .nut (H.264), .webm (VP9), name%06d.png|.exr|.tif";
+    return ".y4m, .mp4, .mkv, .nut (H.264 unless --codec), .webm (VP9 unless --codec), name%06d.png|.exr|.tif";
 #elif defined(RS_HAVE_FFMPEG)
-    return ".y4m, .mp4, .mkv, .nut (H.264), .webm (VP9) (no OpenImageIO: no image sequences)";
+    return ".y4m, .mp4, .mkv, .nut (H.264 unless --codec), .webm (VP9 unless --codec) (no OpenImageIO: no image sequences)";
 #elif defined(RS_HAVE_OIIO)
     return ".y4m, name%06d.png|.exr|.tif (no FFmpeg: no .mp4/.mkv/.webm)";
 #else
