@@ -830,18 +830,30 @@ static bool may_see(const req *q, const svc_job *j)
     return q->all || (q->tok.id != 0 && j->token_id == q->tok.id);
 }
 
+/* Job id as q may see it: false with the answer in *ret (503 when the
+ * queue is down, 404 for a missing job or another token's). */
+static bool get_visible(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id, svc_job *j,
+                        enum MHD_Result *ret)
+{
+    rs_err err = {0};
+    int r = d->http_store->ops->get(d->http_store, id, j, &err);
+    if (r < 0)
+        *ret = reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
+    else if (r == 0 || !may_see(q, j))
+        *ret = reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    return r == 1 && may_see(q, j);
+}
+
 static enum MHD_Result do_get_job(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
 {
     svc_job j;
-    rs_err err = {0};
-    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
-    if (r < 0)
-        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
-    if (r == 0 || !may_see(q, &j))
-        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    enum MHD_Result answer;
+    if (!get_visible(d, c, q, id, &j, &answer))
+        return answer;
     /* a split job shows its segments: who rendered each, how often */
     svc_unit *units = NULL;
     int n = 0;
+    rs_err err = {0};
     if (j.segments > 0) {
         units = calloc((size_t)j.segments + 1, sizeof *units);
         if (!units)
@@ -964,12 +976,9 @@ static enum MHD_Result do_cancel(svc_daemon *d, struct MHD_Connection *c, const 
 static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id, bool video)
 {
     svc_job j;
-    rs_err err = {0};
-    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
-    if (r < 0)
-        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
-    if (r == 0 || !may_see(q, &j))
-        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    enum MHD_Result answer;
+    if (!get_visible(d, c, q, id, &j, &answer))
+        return answer;
     if (j.state != SVC_DONE)
         return reply_error(c, SVC_ERR_NOT_FOUND, "job %" PRId64 " is %s: its %s exists once it is done", id, svc_state_name(j.state),
                            video ? "video" : "hash list");
@@ -1032,12 +1041,9 @@ static enum MHD_Result do_file(svc_daemon *d, struct MHD_Connection *c, const re
 static enum MHD_Result do_poster(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
 {
     svc_job j;
-    rs_err err = {0};
-    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
-    if (r < 0)
-        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
-    if (r == 0 || !may_see(q, &j))
-        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    enum MHD_Result answer;
+    if (!get_visible(d, c, q, id, &j, &answer))
+        return answer;
     if (j.expired)
         return reply_error(c, SVC_ERR_GONE, "job %" PRId64 "'s poster was removed by retention", id);
     char path[1100];
@@ -1067,12 +1073,9 @@ static enum MHD_Result do_poster(svc_daemon *d, struct MHD_Connection *c, const 
 static enum MHD_Result do_log(svc_daemon *d, struct MHD_Connection *c, const req *q, int64_t id)
 {
     svc_job j;
-    rs_err err = {0};
-    int r = d->http_store->ops->get(d->http_store, id, &j, &err);
-    if (r < 0)
-        return reply_error(c, err.code, "the queue is unavailable: %s", err.msg);
-    if (r == 0 || !may_see(q, &j))
-        return reply_error(c, SVC_ERR_NOT_FOUND, "no job %" PRId64, id);
+    enum MHD_Result answer;
+    if (!get_visible(d, c, q, id, &j, &answer))
+        return answer;
     char path[1100];
     svc_job_file(&d->cfg, id, "log", path, sizeof path);
     size_t len = 0;
