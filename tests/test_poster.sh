@@ -72,5 +72,18 @@ t_help_says_so() {
     grep -q -- "--ticks, written only by the render whose range holds it" h.txt || { cat h.txt; return 1; }
 }
 
-t_run poster_is_the_video_frame only_the_range_holding_it_writes_it missing_folder_named help_says_so
+# like every output (README, Conventions): an existing poster is refused
+# without -y, naming it, and nothing is written; -y replaces it
+t_existing_poster_needs_y() {
+    "$RS_BIN" record --ai --quiet --seconds 1 --seed 5 -o s.rsr || return 1
+    "$RS_BIN" render s.rsr -q --size 64x36 --render-size 128x72 -o v.mp4 --poster p.png || return 1
+    rm -f v.mp4
+    "$RS_BIN" render s.rsr -q --size 64x36 --render-size 128x72 -o v.mp4 --poster p.png 2>err.txt &&
+        { echo "an existing poster was overwritten without -y"; return 1; }
+    grep -q "p.png: exists (use -y to overwrite)" err.txt || { cat err.txt; return 1; }
+    [ ! -e v.mp4 ] || { echo "the video was written although the poster was refused"; return 1; }
+    "$RS_BIN" render s.rsr -q -y --size 64x36 --render-size 128x72 -o v.mp4 --poster p.png || return 1
+}
+
+t_run existing_poster_needs_y poster_is_the_video_frame only_the_range_holding_it_writes_it missing_folder_named help_says_so
 t_done
