@@ -23,13 +23,14 @@ runtime/gl          runtime/util
 runtime/game        runtime/util
 runtime/platform    runtime/util runtime/gl
 runtime/replay      runtime/util runtime/game
-runtime             runtime/util runtime/gl runtime/platform runtime/game runtime/replay
+runtime/audio       runtime/util runtime/game runtime/replay
+runtime             runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/audio
 runtime/render      runtime/util runtime/gl runtime/platform runtime/game runtime/replay
 runtime/fx          runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render
-capture             runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render
-player              runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render
-service             runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render capture
-cmd                 runtime runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render runtime/fx capture player service
+capture             runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render runtime/audio
+player              runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render runtime/audio
+service             runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render capture runtime/audio
+cmd                 runtime runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render runtime/fx capture player service runtime/audio
 '
 # private header            folders besides its own that may include it
 LOCAL_OK='

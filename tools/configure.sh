@@ -22,7 +22,7 @@ probe() { # name pkg-config-module define
 probe egl egl RS_HAVE_EGL
 probe osmesa osmesa RS_HAVE_OSMESA
 probe glfw glfw3 RS_HAVE_GLFW
-probe ffmpeg "libavformat libavcodec libavutil" RS_HAVE_FFMPEG
+probe ffmpeg "libavformat libavcodec libavutil libswresample" RS_HAVE_FFMPEG
 probe oiio OpenImageIO RS_HAVE_OIIO
 # charts (cmd/bench_chart.c): drawn with cairo, text in a fontconfig font
 probe cairo cairo RS_HAVE_CAIRO
@@ -30,6 +30,8 @@ probe cairo cairo RS_HAVE_CAIRO
 probe sqlite sqlite3 RS_HAVE_SQLITE
 probe postgres libpq RS_HAVE_PQ
 probe microhttpd libmicrohttpd RS_HAVE_MHD
+# live sound (play, movie, attract): OpenAL Soft; without it they run silent
+probe openal openal RS_HAVE_OPENAL
 # libpng writes every PNG (runtime/util/rs_img.c): every build needs it,
 # whatever RS_ONLY says
 if pkg-config --exists libpng 2>/dev/null; then
@@ -38,6 +40,16 @@ if pkg-config --exists libpng 2>/dev/null; then
     have="$have png"
 else
     echo "configure: libpng not found by pkg-config; run tools/deps.sh build" >&2
+    exit 1
+fi
+# libebur128 measures loudness (runtime/audio/au_loud.c): every build's
+# soundtracks are normalized with it, whatever RS_ONLY says
+if pkg-config --exists libebur128 2>/dev/null; then
+    cflags="$cflags $(pkg-config --cflags libebur128)"
+    libs="$libs $(pkg-config --libs libebur128)"
+    have="$have ebur128"
+else
+    echo "configure: libebur128 not found by pkg-config; run tools/deps.sh build" >&2
     exit 1
 fi
 case "$have" in

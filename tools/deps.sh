@@ -16,20 +16,24 @@ group_pkgs() {
     # FFmpeg's libraries for video output (x264 and libvpx come with libavcodec),
     # OpenImageIO for image sequences and the reference resize; libpng for every
     # PNG; cairo and a DejaVu font for the benchmarks' charts; SQLite, libpq and
-    # libmicrohttpd for the service (ringside serve)
-    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev libpng-dev libcairo2-dev fonts-dejavu-core libsqlite3-dev libpq-dev libmicrohttpd-dev" ;;
+    # libmicrohttpd for the service (ringside serve); libswresample for movie
+    # sound, libebur128 for loudness, OpenAL Soft for live sound
+    build) echo "build-essential pkg-config libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev libglfw3-dev libavformat-dev libavcodec-dev libavutil-dev libopenimageio-dev libpng-dev libcairo2-dev fonts-dejavu-core libsqlite3-dev libpq-dev libmicrohttpd-dev libswresample-dev libebur128-dev libopenal-dev" ;;
     # X server for the GLFW backend's tests (xvfb-run needs xauth); xdotool
     # presses keys in that window to prove a person can play; ffprobe (in
     # ffmpeg) is the independent player that checks our videos; xz packs the
-    # GPU bundle (tools/gpu-bundle.sh, tests/test_gpu_bundle.sh)
-    test) echo "xvfb xauth xdotool ffmpeg xz-utils" ;;
+    # GPU bundle (tools/gpu-bundle.sh, tests/test_gpu_bundle.sh); sox measures
+    # and compares the soundtracks in the audio tests
+    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox" ;;
     # make test-service: a real PostgreSQL server for the two-daemon test,
     # Debian's Chromium for the dashboard test (driven by playwright-core from npm)
     service) echo "postgresql chromium" ;;
     # make man checks every page it writes with groff -ww; the docs test
     # renders them with man -l
     man) echo "groff-base man-db" ;;
-    *) echo "deps.sh: unknown group '$1' (known: build test service man)" >&2; return 1 ;;
+    # tools/gen-voice.sh: the announcer's lines, rendered once by espeak-ng
+    voice) echo "espeak-ng" ;;
+    *) echo "deps.sh: unknown group '$1' (known: build test service man voice)" >&2; return 1 ;;
     esac
 }
 

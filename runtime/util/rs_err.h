@@ -31,7 +31,8 @@
     X(CAP, "capture")                  \
     X(MV, "movie")                     \
     X(SVC_STORE, "queue store")        \
-    X(SVC, "service")
+    X(SVC, "service")                  \
+    X(AU, "audio")
 
 typedef enum rs_err_module {
 #define X(id, name) RS_ERR_MOD_##id,
