@@ -87,9 +87,11 @@ static size_t header(uint8_t *h, bool float32, uint32_t data_bytes)
     return n;
 }
 
+/* x 32768, clipped at 32767: the inverse of the reader's / 32768, so a
+ * 16-bit file read and written again keeps every sample */
 static int16_t to16(float v)
 {
-    double s = (double)v * 32767.0;
+    double s = (double)v * 32768.0;
     if (!(s > -32768.0)) /* NaN goes to the floor, then clipped like any sample */
         s = s != s ? 0.0 : -32768.0;
     if (s > 32767.0)
