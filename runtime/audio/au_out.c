@@ -12,10 +12,10 @@
  * - openal: one streaming source fed AL_BUF_FRAMES-frame buffers (half a
  *   tick, 8.3 ms).  At most latency_ms of audio is ever queued on the
  *   source: the number of buffers is latency_ms / 8.3 ms (at least two), so
- *   a sound never waits longer than that behind older audio.  The device is
- *   asked to mix in small periods (ALC_REFRESH) so its own latency stays
- *   small too; AL_SOFT_source_latency reports it and it is counted in
- *   latency_ms.  Audio handed to OpenAL cannot be taken back (only played
+ *   a sound never waits longer than that behind older audio.  The device
+ *   adds its own buffer (OpenAL Soft's period_size x periods, from
+ *   alsoft.conf); AL_SOFT_source_latency reports it and the stats count it,
+ *   so latency_ms is event to speaker, not just our queue.  Audio handed to OpenAL cannot be taken back (only played
  *   buffers can be unqueued), so when every buffer is queued the oldest
  *   audio still in our hands (the staged half tick) is dropped: the game
  *   never waits for the speaker.  A source that stopped while we were still
@@ -52,6 +52,7 @@ typedef struct al_out {
     ALuint bufs[AL_MAX_BUFS];
     ALuint idle[AL_MAX_BUFS];
     int nbufs, nidle;
+    int start; /* buffers queued before playback (re)starts */
     ALenum format;
     bool float32, playing;
     LPALGETSOURCEDVSOFT get_sourcedv; /* AL_SOFT_source_latency, or NULL */
@@ -219,11 +220,9 @@ static bool al_write(au_out *o, const float *pcm, int frames, rs_err *err)
         if (a->staged == AL_BUF_FRAMES && !al_queue_stage(o, err))
             return false;
     }
-    /* start (or restart after running dry) once a tick is queued, so the
-     * next tick has a whole tick's time to arrive */
     ALint queued = 0;
     alGetSourcei(a->src, AL_BUFFERS_QUEUED, &queued);
-    if (!a->playing && queued * AL_BUF_FRAMES >= AU_TICK_FRAMES) {
+    if (!a->playing && queued >= a->start) {
         alSourcePlay(a->src);
         a->playing = true;
     }
@@ -306,8 +305,8 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     }
     const ALCchar *dname = alcGetString(a->dev, ALC_DEVICE_SPECIFIER);
     snprintf(o->name, sizeof o->name, "openal (%s)", dname ? dname : opts->device ? opts->device : "default");
-    /* 48 kHz so the device does not resample; mix in 5 ms periods so the
-     * device's own buffer adds little to latency_ms */
+    /* 48 kHz so the device does not resample; 5 ms periods asked for
+     * (honoured by OpenAL Soft releases that read ALC_REFRESH) */
     const ALCint attrs[] = {ALC_FREQUENCY, AU_RATE, ALC_REFRESH, 200, 0};
     a->ctx = alcCreateContext(a->dev, attrs);
     if (!a->ctx || !alcMakeContextCurrent(a->ctx))
@@ -321,8 +320,24 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     }
     if (alIsExtensionPresent("AL_SOFT_source_latency"))
         a->get_sourcedv = (LPALGETSOURCEDVSOFT)alGetProcAddress("alGetSourcedvSOFT");
+    /* The device mixes a period at a time: playback starts (and restarts
+     * after running dry) with a period and a tick queued, so the source
+     * still has a period's worth when the next tick comes.  The queue holds
+     * latency_ms, or that and two buffers of slack when a period is long
+     * (OpenAL Soft 1.19 ignores ALC_REFRESH: the period is alsoft.conf's
+     * period_size, 1024 frames unless set), never less or it would drop
+     * audio at a steady 60 Hz. */
+    ALCint refresh = 0, freq = 0;
+    alcGetIntegerv(a->dev, ALC_REFRESH, 1, &refresh);
+    alcGetIntegerv(a->dev, ALC_FREQUENCY, 1, &freq);
+    long period = refresh > 0 && freq > 0 ? (long)AU_RATE / refresh : AU_TICK_FRAMES;
+    a->start = (int)((period + AU_TICK_FRAMES + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES);
     long n = (long)latency_ms * AU_RATE / 1000 / AL_BUF_FRAMES;
-    a->nbufs = n < 2 ? 2 : n > AL_MAX_BUFS ? AL_MAX_BUFS : (int)n;
+    if (n < a->start + 2)
+        n = a->start + 2;
+    a->nbufs = n > AL_MAX_BUFS ? AL_MAX_BUFS : (int)n;
+    if (a->start > a->nbufs)
+        a->start = a->nbufs;
     alGenSources(1, &a->src);
     alGenBuffers(a->nbufs, a->bufs);
     ALenum e = alGetError();
