@@ -356,8 +356,10 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     memcpy(a->idle, a->bufs, sizeof a->bufs);
     a->nidle = a->nbufs;
     /* the source plays the mix as it is: no distance, no 3-D panning, and
-     * (AL_SOFT_direct_channels) left and right straight to the speakers
-     * instead of panned as two virtual speakers at +-30 degrees */
+     * (AL_SOFT_direct_channels) left and right straight to the front
+     * speakers whatever the layout (5.1, HRTF) instead of as two virtual
+     * speakers at +-30 degrees; on a stereo device 1.19 plays them bit for
+     * bit either way (test_au_out's wave driver case) */
     if (alIsExtensionPresent("AL_SOFT_direct_channels"))
         alSourcei(a->src, AL_DIRECT_CHANNELS_SOFT, AL_TRUE);
     alSourcei(a->src, AL_SOURCE_RELATIVE, AL_TRUE);
