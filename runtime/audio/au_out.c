@@ -6,20 +6,22 @@
  * two are OpenAL's own calls (queue, unqueue processed, query offset).
  *
  * DESIGN
- * - Backends are a table of two functions (write, close); adding one is a
- *   row, its functions and a case in au_out_open.  Volume is applied here, before any
- *   backend sees the samples, so the WAV of a run is what the speaker got.
+ * - Backends are a table of two functions (write, close); adding one is
+ *   a row, its functions and a case in au_out_open.  Volume is applied
+ *   here, before any backend sees the samples, so the WAV of a run is what
+ *   the speaker got.
  * - openal: one streaming source fed AL_BUF_FRAMES-frame buffers (a
- *   quarter tick, 4.2 ms).  At most latency_ms of audio is ever queued on
- *   the source (the number of buffers), so a sound never waits longer than
- *   that behind older audio.  Playback starts (and restarts after running
- *   dry) with all but one tick of that queued: the tick left free takes a
- *   late tick's catch-up, the rest is what a tick may come late by before
- *   the source runs dry, beyond the device's period, which the device
- *   takes at once (al_open has the sums).  The device adds its own buffer
+ *   quarter tick, 4.2 ms).  At most latency_ms of audio is queued on the
+ *   source (the number of buffers), so a sound never waits longer than
+ *   that behind older audio; only a device period too long for that
+ *   raises it, to the least that plays without gaps.  Playback starts
+ *   (and restarts after running dry) with all but a tick of that queued:
+ *   the free tick takes a late tick's catch-up, and what is queued beyond
+ *   a tick and the device's period (which it takes at once) is how late a
+ *   tick may come (al_open has the sums).  The device adds its own buffer
  *   (OpenAL Soft's period_size x periods, from alsoft.conf);
- *   AL_SOFT_source_latency reports it and the stats count it, so latency_ms
- *   in the stats is event to speaker, not just our queue.
+ *   AL_SOFT_source_latency reports it and the stats count it, so
+ *   latency_ms in the stats is event to speaker, not just our queue.
  * - Audio handed to OpenAL cannot be taken back (only played buffers can be
  *   unqueued), so when every buffer is queued the oldest audio still in our
  *   hands (the staged quarter tick) is dropped: the game never waits for
@@ -49,6 +51,7 @@ typedef struct au_out_ops {
 #ifdef RS_HAVE_OPENAL
 #define AL_BUF_FRAMES 200
 #define AL_MAX_BUFS 512
+#define AL_SLACK_FRAMES 480 /* 10 ms: how late a tick may come, at least */
 typedef struct al_out {
     ALCdevice *dev;
     ALCcontext *ctx;
@@ -325,27 +328,29 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     if (alIsExtensionPresent("AL_SOFT_source_latency"))
         a->get_sourcedv = (LPALGETSOURCEDVSOFT)alGetProcAddress("alGetSourcedvSOFT");
     /* The sums.  The queue holds latency_ms (nbufs buffers).  Playback
-     * starts with all but a tick of it queued (start).  Just before the
+     * starts with all but a tick of it queued (start), or all but a period
+     * when a period is longer: the device takes whole periods, so the
+     * queue swings by that much at a steady rate.  Just before the
      * next tick arrives the source holds start - 1 tick, and the device
      * takes a whole period at once, so what is left, start - tick -
      * period, is how late a tick may be without a gap: at 50 ms with
      * 256-frame periods, 1600 - 800 - 256 = 544 frames, 11 ms.  When the
-     * period is too long for that (OpenAL Soft 1.19 ignores ALC_REFRESH:
-     * the period is alsoft.conf's period_size, 1024 frames at 44.1 kHz
-     * unless set), start grows to a period, a tick and a buffer, and the
-     * queue to that and a tick: more latency, rather than a gap at every
-     * tick. */
+     * period is too long to leave AL_SLACK_FRAMES so (OpenAL Soft 1.19
+     * ignores ALC_REFRESH: the period is alsoft.conf's period_size, 1024
+     * frames at 44.1 kHz unless set), start grows to a period, a tick and
+     * that slack, and the queue to that and a tick: more latency, rather
+     * than gaps whenever a frame of the game runs long. */
     ALCint refresh = 0, freq = 0;
     alcGetIntegerv(a->dev, ALC_REFRESH, 1, &refresh);
     alcGetIntegerv(a->dev, ALC_FREQUENCY, 1, &freq);
     long period = refresh > 0 && freq > 0 ? (long)AU_RATE / refresh : AU_TICK_FRAMES;
-    long tick_bufs = AU_TICK_FRAMES / AL_BUF_FRAMES;
-    long least = (period + AU_TICK_FRAMES) / AL_BUF_FRAMES + 1;
+    long room = ((period > AU_TICK_FRAMES ? period : AU_TICK_FRAMES) + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES;
+    long least = (period + AU_TICK_FRAMES + AL_SLACK_FRAMES + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES;
     long n = (long)latency_ms * AU_RATE / 1000 / AL_BUF_FRAMES;
-    if (n < least + tick_bufs)
-        n = least + tick_bufs;
+    if (n < least + room)
+        n = least + room;
     a->nbufs = n > AL_MAX_BUFS ? AL_MAX_BUFS : (int)n;
-    a->start = a->nbufs - (int)tick_bufs;
+    a->start = a->nbufs - (int)room;
     alGenSources(1, &a->src);
     alGenBuffers(a->nbufs, a->bufs);
     ALenum e = alGetError();
