@@ -34,11 +34,13 @@ static void help(void)
            "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
            "                     [--stage-file FILE] [--passes[=summary|frames]]\n"
            "                     [--hdr-format rgba16f|r11g11b10f]\n"
-           "                     [--audio-out FILE.wav] [--mute] [--volume V] [--audio-device NAME]\n\n"
+           "                     [--audio-out FILE.wav] [--mute] [--volume V] [--audio-device D]\n\n"
            "Plays the game at a fixed 60 Hz in a window (GLFW; needs X, or xvfb-run -a).\n"
            "Keys: player 1 W A S D, J punch, K kick, L guard; player 2 arrows, numpad\n"
            "1 2 3 (or , . /); gamepads 1 and 2 too.  The 2-3-6 motion + punch is the\n"
-           "special move.  Escape quits.  Matches follow one another until you quit.\n\n"
+           "special move.  Escape quits.  Matches follow one another until you quit.\n"
+           "Sound plays through OpenAL Soft; with no audio device, one warning and the\n"
+           "game runs silent.\n\n"
            "  --p1 / --p2 K    who plays each side (default: human vs cpu)\n"
            "  --stage NAME     dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry\n"
            "                   (default dojo)\n"
@@ -60,7 +62,7 @@ static void help(void)
            "                   headless, without it, the game is silent\n"
            "  --mute           no sound at all (the mixer does not run)\n"
            "  --volume V       output volume, 0..1 (linear; default 1; 0 is --mute)\n"
-           "  --audio-device N the OpenAL device to play on (default: the system's)\n");
+           "  --audio-device D  the OpenAL device to play on (default: the system's)\n");
 }
 
 typedef struct play {
