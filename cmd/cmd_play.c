@@ -189,10 +189,11 @@ static bool parse_volume(const char *arg, float *v)
     return true;
 }
 
-/* The output the options ask for, opened before the game starts so a bad
- * --audio-out stops the run before anything else.  A device that cannot be
- * opened is one warning: the game runs silent.  false: a fatal error, in
- * s->err. */
+/* The output the options ask for.  --audio-out is opened before anything
+ * else, so a bad path stops the run at once; the device after the window,
+ * so a run that cannot open a window says only that.  A device that
+ * cannot be opened is one warning: the game runs silent.  false: a fatal
+ * error, in s->err. */
 static bool audio_open(play *s, const char *wav, bool mute, float volume, const char *device, bool headless,
                        int stage)
 {
@@ -367,7 +368,7 @@ int cmd_play(int argc, char **argv)
         stage = watch.stage;
         seed = watch.seed;
     }
-    if (!audio_open(s, audio_out, mute, volume, audio_device, headless, stage))
+    if (audio_out && !audio_open(s, audio_out, mute, volume, audio_device, headless, stage))
         goto done;
     pd.backend = headless ? NULL : "glfw";
     pd.width = s->w;
@@ -385,6 +386,8 @@ int cmd_play(int argc, char **argv)
         goto done;
     if (passes)
         r_game_passes(s->r, passes == 2, stderr);
+    if (!audio_out && !audio_open(s, NULL, mute, volume, audio_device, headless, stage))
+        goto done;
     g_init(&s->cur, stage, seed);
     s->prev = s->cur;
     g_ai_init(&s->ai[0], 0, (int)level, seed);
@@ -397,6 +400,11 @@ int cmd_play(int argc, char **argv)
     if (!headless && !replay && s->kind[0] == RP_CPU && s->kind[1] == RP_CPU && !seconds && !quiet)
         fprintf(stderr, "ringside play: CPU vs CPU; Escape quits\n");
 
+    /* the first frame compiles shaders and fills caches (a tenth of a
+     * second and more): drawn here, it does not hold up the first ticks,
+     * which would then come in a burst that the audio queue cannot hold */
+    if (!headless)
+        on_render(s, 1.0f);
     lp_game g = {s, on_input, on_step, on_render, on_running};
     lp_stats st;
     lp_run(&(lp_desc){.headless = headless}, &g, &st);

@@ -31,11 +31,13 @@
  *   is played, so the audio stays a pure function of the caller's samples. */
 #include "au_out.h"
 
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #ifdef RS_HAVE_OPENAL
 #include <AL/al.h>
@@ -298,13 +300,45 @@ static bool al_close(au_out *o, bool ok, rs_err *err)
 
 static const au_out_ops al_ops = {al_write, al_close};
 
+/* OpenAL Soft and the libraries under it print their own lines while they
+ * look for a device ("AL lib: (EE) ...", "ALSA lib pcm.c: Unknown PCM
+ * default"); the caller says what failed once, from err.  So standard
+ * error is /dev/null while the device opens, unless the user asked for
+ * OpenAL Soft's log (ALSOFT_LOGLEVEL).  Returns the saved descriptor, or
+ * -1 when nothing was changed. */
+static int quiet_stderr(void)
+{
+    if (getenv("ALSOFT_LOGLEVEL"))
+        return -1;
+    fflush(stderr);
+    int saved = dup(2), null = open("/dev/null", O_WRONLY);
+    if (saved < 0 || null < 0 || dup2(null, 2) < 0) {
+        if (saved >= 0)
+            close(saved);
+        saved = -1;
+    }
+    if (null >= 0)
+        close(null);
+    return saved;
+}
+
+static void restore_stderr(int saved)
+{
+    if (saved < 0)
+        return;
+    dup2(saved, 2);
+    close(saved);
+}
+
 static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *err)
 {
     al_out *a = calloc(1, sizeof *a);
     if (!a)
         return rs_fail(err, AU_ERR_NOMEM, "out of memory for the audio output");
     o->al = a;
+    int saved = quiet_stderr();
     a->dev = alcOpenDevice(opts->device);
+    restore_stderr(saved);
     if (!a->dev) {
         if (opts->device)
             return rs_fail(err, AU_ERR_DEVICE, "audio device '%s': OpenAL Soft cannot open it", opts->device);
@@ -315,7 +349,9 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     /* 48 kHz so the device does not resample; 5 ms periods asked for
      * (honoured by OpenAL Soft releases that read ALC_REFRESH) */
     const ALCint attrs[] = {ALC_FREQUENCY, AU_RATE, ALC_REFRESH, 200, 0};
+    saved = quiet_stderr();
     a->ctx = alcCreateContext(a->dev, attrs);
+    restore_stderr(saved);
     if (!a->ctx || !alcMakeContextCurrent(a->ctx))
         return rs_fail(err, AU_ERR_DEVICE, "%s: cannot create an OpenAL context", o->name);
     alGetError();
