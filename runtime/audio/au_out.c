@@ -1,0 +1,473 @@
+/* au_out: live audio output, one tick of stereo float in per call, to
+ * OpenAL Soft, a WAV file or nowhere (the contract is au_out.h).
+ *
+ * One caller thread owns an au_out; OpenAL Soft's mixer thread reads the
+ * buffers we queue on its source, and the only things crossing between the
+ * two are OpenAL's own calls (queue, unqueue processed, query offset).
+ *
+ * DESIGN
+ * - Backends are a table of three functions (write, close, a name); adding
+ *   one is a row and its functions.  Volume is applied here, before any
+ *   backend sees the samples, so the WAV of a run is what the speaker got.
+ * - openal: one streaming source fed AL_BUF_FRAMES-frame buffers (half a
+ *   tick, 8.3 ms).  At most latency_ms of audio is ever queued on the
+ *   source: the number of buffers is latency_ms / 8.3 ms (at least two), so
+ *   a sound never waits longer than that behind older audio.  The device
+ *   adds its own buffer (OpenAL Soft's period_size x periods, from
+ *   alsoft.conf); AL_SOFT_source_latency reports it and the stats count it,
+ *   so latency_ms is event to speaker, not just our queue.  Audio handed to OpenAL cannot be taken back (only played
+ *   buffers can be unqueued), so when every buffer is queued the oldest
+ *   audio still in our hands (the staged half tick) is dropped: the game
+ *   never waits for the speaker.  A source that stopped while we were still
+ *   feeding it ran dry (the loop stalled): counted as an underrun, and it
+ *   restarts once a tick is queued again.
+ * - write_ms reads the monotonic clock; it measures, it never changes what
+ *   is played, so the audio stays a pure function of the caller's samples. */
+#include "au_out.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifdef RS_HAVE_OPENAL
+#include <AL/al.h>
+#include <AL/alc.h>
+#include <AL/alext.h>
+#endif
+
+typedef struct au_out_ops {
+    bool (*write)(au_out *o, const float *pcm, int frames, rs_err *err);
+    bool (*close)(au_out *o, bool ok, rs_err *err);
+} au_out_ops;
+
+#ifdef RS_HAVE_OPENAL
+#define AL_BUF_FRAMES 400
+#define AL_MAX_BUFS 128
+typedef struct al_out {
+    ALCdevice *dev;
+    ALCcontext *ctx;
+    ALuint src;
+    ALuint bufs[AL_MAX_BUFS];
+    ALuint idle[AL_MAX_BUFS];
+    int nbufs, nidle;
+    int start; /* buffers queued before playback (re)starts */
+    ALenum format;
+    bool float32, playing;
+    LPALGETSOURCEDVSOFT get_sourcedv; /* AL_SOFT_source_latency, or NULL */
+    float stage[AL_BUF_FRAMES * AU_CHANNELS]; /* the half tick being filled */
+    int staged;
+    int16_t conv[AL_BUF_FRAMES * AU_CHANNELS]; /* without AL_EXT_FLOAT32 */
+} al_out;
+#endif
+
+struct au_out {
+    const au_out_ops *ops;
+    char name[320];
+    float volume;
+    float *scaled; /* the caller's block times volume */
+    int scaled_cap;
+    au_out_stats st;
+    au_wav *wav;
+#ifdef RS_HAVE_OPENAL
+    al_out *al;
+#endif
+};
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+/* ---- null ---- */
+
+static bool null_write(au_out *o, const float *pcm, int frames, rs_err *err)
+{
+    (void)pcm;
+    (void)err;
+    o->st.played += (uint64_t)frames;
+    return true;
+}
+
+static bool null_close(au_out *o, bool ok, rs_err *err)
+{
+    (void)o;
+    (void)ok;
+    (void)err;
+    return true;
+}
+
+static const au_out_ops null_ops = {null_write, null_close};
+
+/* ---- wav ---- */
+
+static bool wav_write(au_out *o, const float *pcm, int frames, rs_err *err)
+{
+    if (!au_wav_append(o->wav, pcm, (size_t)frames, err))
+        return false;
+    o->st.played += (uint64_t)frames;
+    return true;
+}
+
+static bool wav_close(au_out *o, bool ok, rs_err *err)
+{
+    bool r = au_wav_close(o->wav, ok, err);
+    o->wav = NULL;
+    return r;
+}
+
+static const au_out_ops wav_ops = {wav_write, wav_close};
+
+/* ---- openal ---- */
+
+#ifdef RS_HAVE_OPENAL
+static const char *al_error_name(ALenum e)
+{
+    switch (e) {
+    case AL_INVALID_NAME: return "invalid name";
+    case AL_INVALID_ENUM: return "invalid enum";
+    case AL_INVALID_VALUE: return "invalid value";
+    case AL_INVALID_OPERATION: return "invalid operation";
+    case AL_OUT_OF_MEMORY: return "out of memory";
+    default: return "unknown error";
+    }
+}
+
+/* Takes back the buffers the device has played. */
+static void al_reclaim(au_out *o)
+{
+    al_out *a = o->al;
+    ALint n = 0;
+    alGetSourcei(a->src, AL_BUFFERS_PROCESSED, &n);
+    if (n <= 0)
+        return;
+    alSourceUnqueueBuffers(a->src, n, a->idle + a->nidle);
+    a->nidle += n;
+    o->st.played += (uint64_t)n * AL_BUF_FRAMES;
+}
+
+static bool al_queue_stage(au_out *o, rs_err *err)
+{
+    al_out *a = o->al;
+    a->staged = 0;
+    if (!a->nidle) {
+        o->st.dropped += AL_BUF_FRAMES;
+        return true;
+    }
+    ALuint b = a->idle[--a->nidle];
+    if (a->float32) {
+        alBufferData(b, a->format, a->stage, (ALsizei)sizeof a->stage, AU_RATE);
+    } else {
+        for (int i = 0; i < AL_BUF_FRAMES * AU_CHANNELS; i++) {
+            float v = a->stage[i] < -1.0f ? -1.0f : a->stage[i] > 1.0f ? 1.0f : a->stage[i];
+            a->conv[i] = (int16_t)lrintf(v * 32767.0f);
+        }
+        alBufferData(b, a->format, a->conv, (ALsizei)sizeof a->conv, AU_RATE);
+    }
+    alSourceQueueBuffers(a->src, 1, &b);
+    ALenum e = alGetError();
+    if (e != AL_NO_ERROR)
+        return rs_fail(err, AU_ERR_DEVICE, "%s: queueing audio failed (%s)", o->name, al_error_name(e));
+    return true;
+}
+
+/* Audio queued ahead of the speaker, in ms: the source's unplayed buffers,
+ * what we still stage, and the device's own latency when it tells us. */
+static double al_latency(au_out *o)
+{
+    al_out *a = o->al;
+    ALint queued = 0;
+    alGetSourcei(a->src, AL_BUFFERS_QUEUED, &queued);
+    double ahead = (double)queued * AL_BUF_FRAMES / AU_RATE, dev = 0;
+    if (a->get_sourcedv) {
+        ALdouble v[2] = {0, 0};
+        a->get_sourcedv(a->src, AL_SEC_OFFSET_LATENCY_SOFT, v);
+        ahead -= v[0];
+        dev = v[1];
+    } else {
+        ALint off = 0;
+        alGetSourcei(a->src, AL_SAMPLE_OFFSET, &off);
+        ahead -= (double)off / AU_RATE;
+    }
+    if (ahead < 0)
+        ahead = 0;
+    return (ahead + dev + (double)a->staged / AU_RATE) * 1e3;
+}
+
+static bool al_write(au_out *o, const float *pcm, int frames, rs_err *err)
+{
+    al_out *a = o->al;
+    if (alcGetCurrentContext() != a->ctx)
+        alcMakeContextCurrent(a->ctx);
+    al_reclaim(o);
+    if (a->playing) {
+        ALint state = AL_PLAYING;
+        alGetSourcei(a->src, AL_SOURCE_STATE, &state);
+        if (state != AL_PLAYING) {
+            o->st.underruns++;
+            a->playing = false;
+        }
+    }
+    for (int done = 0; done < frames;) {
+        int n = frames - done < AL_BUF_FRAMES - a->staged ? frames - done : AL_BUF_FRAMES - a->staged;
+        memcpy(a->stage + (size_t)a->staged * AU_CHANNELS, pcm + (size_t)done * AU_CHANNELS,
+               (size_t)n * AU_CHANNELS * sizeof *pcm);
+        a->staged += n;
+        done += n;
+        if (a->staged == AL_BUF_FRAMES && !al_queue_stage(o, err))
+            return false;
+    }
+    ALint queued = 0;
+    alGetSourcei(a->src, AL_BUFFERS_QUEUED, &queued);
+    if (!a->playing && queued >= a->start) {
+        alSourcePlay(a->src);
+        a->playing = true;
+    }
+    double lat = al_latency(o);
+    o->st.latency_ms = lat;
+    if (lat > o->st.max_latency_ms)
+        o->st.max_latency_ms = lat;
+    ALenum e = alGetError();
+    if (e != AL_NO_ERROR)
+        return rs_fail(err, AU_ERR_DEVICE, "%s: playback failed (%s)", o->name, al_error_name(e));
+    return true;
+}
+
+static void al_free(al_out *a)
+{
+    if (a->ctx) {
+        alcMakeContextCurrent(a->ctx);
+        if (a->src) {
+            alSourceStop(a->src);
+            alSourcei(a->src, AL_BUFFER, 0);
+            alDeleteSources(1, &a->src);
+        }
+        if (a->nbufs)
+            alDeleteBuffers(a->nbufs, a->bufs);
+        alcMakeContextCurrent(NULL);
+        alcDestroyContext(a->ctx);
+    }
+    if (a->dev)
+        alcCloseDevice(a->dev);
+    free(a);
+}
+
+static bool al_close(au_out *o, bool ok, rs_err *err)
+{
+    (void)err;
+    al_out *a = o->al;
+    if (ok) {
+        alcMakeContextCurrent(a->ctx);
+        /* play out what is queued (at most latency_ms and a half tick),
+         * so the last sound is not cut; the partial half tick is padded */
+        if (a->staged) {
+            memset(a->stage + (size_t)a->staged * AU_CHANNELS, 0,
+                   (size_t)(AL_BUF_FRAMES - a->staged) * AU_CHANNELS * sizeof(float));
+            a->staged = AL_BUF_FRAMES;
+            al_reclaim(o);
+            al_queue_stage(o, NULL);
+        }
+        ALint queued = 0, state = AL_STOPPED;
+        alGetSourcei(a->src, AL_BUFFERS_QUEUED, &queued);
+        alGetSourcei(a->src, AL_SOURCE_STATE, &state);
+        if (queued && state != AL_PLAYING)
+            alSourcePlay(a->src);
+        double give_up = now_ms() + 1e3 * queued * AL_BUF_FRAMES / AU_RATE + 250;
+        for (;;) {
+            alGetSourcei(a->src, AL_SOURCE_STATE, &state);
+            if (state != AL_PLAYING || now_ms() > give_up)
+                break;
+            nanosleep(&(struct timespec){0, 2000000}, NULL);
+        }
+        al_reclaim(o);
+    }
+    al_free(a);
+    o->al = NULL;
+    return true;
+}
+
+static const au_out_ops al_ops = {al_write, al_close};
+
+static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *err)
+{
+    al_out *a = calloc(1, sizeof *a);
+    if (!a)
+        return rs_fail(err, AU_ERR_NOMEM, "out of memory for the audio output");
+    o->al = a;
+    a->dev = alcOpenDevice(opts->device);
+    if (!a->dev) {
+        if (opts->device)
+            return rs_fail(err, AU_ERR_DEVICE, "audio device '%s': OpenAL Soft cannot open it", opts->device);
+        return rs_fail(err, AU_ERR_DEVICE, "the default audio device: OpenAL Soft cannot open it (none found?)");
+    }
+    const ALCchar *dname = alcGetString(a->dev, ALC_DEVICE_SPECIFIER);
+    snprintf(o->name, sizeof o->name, "openal (%s)", dname ? dname : opts->device ? opts->device : "default");
+    /* 48 kHz so the device does not resample; 5 ms periods asked for
+     * (honoured by OpenAL Soft releases that read ALC_REFRESH) */
+    const ALCint attrs[] = {ALC_FREQUENCY, AU_RATE, ALC_REFRESH, 200, 0};
+    a->ctx = alcCreateContext(a->dev, attrs);
+    if (!a->ctx || !alcMakeContextCurrent(a->ctx))
+        return rs_fail(err, AU_ERR_DEVICE, "%s: cannot create an OpenAL context", o->name);
+    alGetError();
+    a->float32 = alIsExtensionPresent("AL_EXT_FLOAT32");
+    a->format = a->float32 ? alGetEnumValue("AL_FORMAT_STEREO_FLOAT32") : AL_FORMAT_STEREO16;
+    if (!a->format) {
+        a->float32 = false;
+        a->format = AL_FORMAT_STEREO16;
+    }
+    if (alIsExtensionPresent("AL_SOFT_source_latency"))
+        a->get_sourcedv = (LPALGETSOURCEDVSOFT)alGetProcAddress("alGetSourcedvSOFT");
+    /* The device mixes a period at a time: playback starts (and restarts
+     * after running dry) with a period and a tick queued, so the source
+     * still has a period's worth when the next tick comes.  The queue holds
+     * latency_ms, or that and two buffers of slack when a period is long
+     * (OpenAL Soft 1.19 ignores ALC_REFRESH: the period is alsoft.conf's
+     * period_size, 1024 frames unless set), never less or it would drop
+     * audio at a steady 60 Hz. */
+    ALCint refresh = 0, freq = 0;
+    alcGetIntegerv(a->dev, ALC_REFRESH, 1, &refresh);
+    alcGetIntegerv(a->dev, ALC_FREQUENCY, 1, &freq);
+    long period = refresh > 0 && freq > 0 ? (long)AU_RATE / refresh : AU_TICK_FRAMES;
+    a->start = (int)((period + AU_TICK_FRAMES + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES);
+    long n = (long)latency_ms * AU_RATE / 1000 / AL_BUF_FRAMES;
+    if (n < a->start + 2)
+        n = a->start + 2;
+    a->nbufs = n > AL_MAX_BUFS ? AL_MAX_BUFS : (int)n;
+    if (a->start > a->nbufs)
+        a->start = a->nbufs;
+    alGenSources(1, &a->src);
+    alGenBuffers(a->nbufs, a->bufs);
+    ALenum e = alGetError();
+    if (e != AL_NO_ERROR) {
+        a->nbufs = 0;
+        return rs_fail(err, AU_ERR_DEVICE, "%s: cannot make a source and its buffers (%s)", o->name, al_error_name(e));
+    }
+    memcpy(a->idle, a->bufs, sizeof a->bufs);
+    a->nidle = a->nbufs;
+    /* the source plays the mix as it is: no distance, no 3-D panning */
+    alSourcei(a->src, AL_SOURCE_RELATIVE, AL_TRUE);
+    alSource3f(a->src, AL_POSITION, 0, 0, 0);
+    alSourcef(a->src, AL_ROLLOFF_FACTOR, 0);
+    o->ops = &al_ops;
+    return true;
+}
+#endif
+
+/* ---- the contract ---- */
+
+static void out_free(au_out *o)
+{
+#ifdef RS_HAVE_OPENAL
+    if (o->al)
+        al_free(o->al);
+#endif
+    if (o->wav)
+        au_wav_close(o->wav, false, NULL);
+    free(o->scaled);
+    free(o);
+}
+
+au_out *au_out_open(const au_out_opts *opts, rs_err *err)
+{
+    static const au_out_opts none = {0};
+    if (!opts)
+        opts = &none;
+    float vol = opts->volume == 0 ? 1.0f : opts->volume;
+    if (!(vol > 0 && vol <= 1)) {
+        rs_fail(err, AU_ERR_ARG, "audio volume %g: expected 0..1 (linear)", (double)opts->volume);
+        return NULL;
+    }
+    int latency = opts->latency_ms == 0 ? 50 : opts->latency_ms;
+    if (latency < 10 || latency > 2000) {
+        rs_fail(err, AU_ERR_ARG, "audio latency %d ms: expected 10..2000", opts->latency_ms);
+        return NULL;
+    }
+    au_out_backend kind = opts->backend;
+    if (kind == AU_OUT_AUTO)
+        kind = opts->wav_path ? AU_OUT_WAV : AU_OUT_OPENAL;
+    au_out *o = calloc(1, sizeof *o);
+    if (!o) {
+        rs_fail(err, AU_ERR_NOMEM, "out of memory for the audio output");
+        return NULL;
+    }
+    o->volume = vol;
+    switch (kind) {
+    case AU_OUT_NULL:
+        o->ops = &null_ops;
+        snprintf(o->name, sizeof o->name, "null");
+        break;
+    case AU_OUT_WAV:
+        if (!opts->wav_path || !*opts->wav_path) {
+            rs_fail(err, AU_ERR_ARG, "the wav audio output needs a file name");
+            goto fail;
+        }
+        o->wav = au_wav_open(opts->wav_path, opts->wav_float, err);
+        if (!o->wav)
+            goto fail;
+        o->ops = &wav_ops;
+        snprintf(o->name, sizeof o->name, "wav %s", opts->wav_path);
+        break;
+    case AU_OUT_OPENAL:
+#ifdef RS_HAVE_OPENAL
+        if (!al_open(o, opts, latency, err))
+            goto fail;
+#else
+        rs_fail(err, AU_ERR_DEVICE, "audio device '%s': this build has no OpenAL (install libopenal-dev and rebuild)",
+                opts->device ? opts->device : "default");
+        goto fail;
+#endif
+        break;
+    default:
+        rs_fail(err, AU_ERR_ARG, "audio output backend %d: unknown", (int)kind);
+        goto fail;
+    }
+    return o;
+fail:
+    out_free(o);
+    return NULL;
+}
+
+const char *au_out_backend_name(const au_out *o)
+{
+    return o ? o->name : "none";
+}
+
+bool au_out_write(au_out *o, const float *pcm, int frames, rs_err *err)
+{
+    if (frames <= 0)
+        return true;
+    double t0 = now_ms();
+    o->st.frames += (uint64_t)frames;
+    if (o->volume != 1.0f) {
+        if (frames > o->scaled_cap) {
+            float *p = realloc(o->scaled, (size_t)frames * AU_CHANNELS * sizeof *p);
+            if (!p)
+                return rs_fail(err, AU_ERR_NOMEM, "out of memory for %d frames of audio", frames);
+            o->scaled = p;
+            o->scaled_cap = frames;
+        }
+        for (int i = 0; i < frames * AU_CHANNELS; i++)
+            o->scaled[i] = pcm[i] * o->volume;
+        pcm = o->scaled;
+    }
+    bool ok = o->ops->write(o, pcm, frames, err);
+    o->st.write_ms += now_ms() - t0;
+    return ok;
+}
+
+void au_out_stats_get(const au_out *o, au_out_stats *st)
+{
+    *st = o->st;
+}
+
+bool au_out_close(au_out *o, bool ok, rs_err *err)
+{
+    if (!o)
+        return true;
+    bool r = o->ops->close(o, ok, err);
+    out_free(o);
+    return r;
+}

@@ -1,0 +1,260 @@
+/* runtime/audio/au_out: the null, wav and openal backends, their stats,
+ * volume, and the errors that name what is wrong.  The openal cases run on
+ * OpenAL Soft's null driver (ALSOFT_DRIVERS=null: no sound card needed),
+ * in real time, a second each. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "../runtime/audio/au_out.h"
+#include "t.h"
+
+/* Tick t of a test signal: a ramp on the left, its negative on the right,
+ * different on every frame so a lost or repeated frame shows. */
+static void tick_pcm(int t, float *pcm)
+{
+    for (int i = 0; i < AU_TICK_FRAMES; i++) {
+        float v = (float)((t * AU_TICK_FRAMES + i) % 1000) / 1000.0f - 0.5f;
+        pcm[2 * i] = v;
+        pcm[2 * i + 1] = -v;
+    }
+}
+
+static void t_null_counts(void)
+{
+    rs_err err = {0};
+    au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_NULL}, &err);
+    T_ASSERTF(o, "%s", err.msg);
+    T_CONTAINS(au_out_backend_name(o), "null");
+    float pcm[AU_TICK_FRAMES * 2];
+    for (int t = 0; t < 10; t++) {
+        tick_pcm(t, pcm);
+        T_ASSERT(au_out_write(o, pcm, AU_TICK_FRAMES, &err));
+    }
+    au_out_stats st;
+    au_out_stats_get(o, &st);
+    T_EQ(st.frames, 10 * AU_TICK_FRAMES);
+    T_EQ(st.played, 10 * AU_TICK_FRAMES);
+    T_EQ(st.underruns, 0);
+    T_EQ(st.dropped, 0);
+    T_ASSERT(st.write_ms >= 0);
+    T_ASSERT(au_out_close(o, true, &err));
+}
+
+/* Writes `ticks` ticks through a wav output and reads the file back. */
+static float *wav_round_trip(const char *path, float volume, bool flt, int ticks, size_t *frames)
+{
+    rs_err err = {0};
+    au_out *o = au_out_open(&(au_out_opts){.wav_path = path, .wav_float = flt, .volume = volume}, &err);
+    T_ASSERTF(o, "%s", err.msg);
+    T_CONTAINS(au_out_backend_name(o), "wav");
+    T_CONTAINS(au_out_backend_name(o), path);
+    float pcm[AU_TICK_FRAMES * 2];
+    for (int t = 0; t < ticks; t++) {
+        tick_pcm(t, pcm);
+        T_ASSERTF(au_out_write(o, pcm, AU_TICK_FRAMES, &err), "%s", err.msg);
+    }
+    au_out_stats st;
+    au_out_stats_get(o, &st);
+    T_EQ(st.frames, (uint64_t)ticks * AU_TICK_FRAMES);
+    T_EQ(st.played, st.frames);
+    T_ASSERTF(au_out_close(o, true, &err), "%s", err.msg);
+    float *got = NULL;
+    int ch = 0, rate = 0;
+    T_ASSERTF(au_wav_read(path, &got, frames, &ch, &rate, &err), "%s", err.msg);
+    T_EQ(ch, 2);
+    T_EQ(rate, AU_RATE);
+    return got;
+}
+
+static void t_wav_frame_for_frame(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/out.wav", t_tmpdir());
+    size_t frames = 0;
+    float *got = wav_round_trip(path, 0, true, 7, &frames);
+    T_EQ(frames, 7 * AU_TICK_FRAMES);
+    float pcm[AU_TICK_FRAMES * 2];
+    for (int t = 0; t < 7; t++) {
+        tick_pcm(t, pcm);
+        T_ASSERTF(!memcmp(pcm, got + (size_t)t * AU_TICK_FRAMES * 2, sizeof pcm), "tick %d differs", t);
+    }
+    free(got);
+}
+
+static void t_wav_16bit(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/out16.wav", t_tmpdir());
+    size_t frames = 0;
+    float *got = wav_round_trip(path, 0, false, 3, &frames);
+    T_EQ(frames, 3 * AU_TICK_FRAMES);
+    float pcm[AU_TICK_FRAMES * 2];
+    tick_pcm(2, pcm);
+    for (int i = 0; i < AU_TICK_FRAMES * 2; i++)
+        T_ASSERTF(fabsf(got[2 * AU_TICK_FRAMES * 2 + i] - pcm[i]) < 2.0f / 32767, "sample %d", i);
+    free(got);
+}
+
+static void t_volume_at_output(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/half.wav", t_tmpdir());
+    size_t frames = 0;
+    float *got = wav_round_trip(path, 0.5f, true, 2, &frames);
+    float pcm[AU_TICK_FRAMES * 2];
+    tick_pcm(1, pcm);
+    for (int i = 0; i < AU_TICK_FRAMES * 2; i++)
+        T_ASSERTF(got[AU_TICK_FRAMES * 2 + i] == pcm[i] * 0.5f, "sample %d: %g, want %g", i,
+                  (double)got[AU_TICK_FRAMES * 2 + i], (double)(pcm[i] * 0.5f));
+    free(got);
+}
+
+static void t_bad_settings_named(void)
+{
+    rs_err err = {0};
+    T_ASSERT(!au_out_open(&(au_out_opts){.backend = AU_OUT_NULL, .volume = 1.5f}, &err));
+    T_EQ(err.code, AU_ERR_ARG);
+    T_CONTAINS(err.msg, "volume 1.5");
+    T_ASSERT(!au_out_open(&(au_out_opts){.backend = AU_OUT_NULL, .volume = -0.25f}, &err));
+    T_EQ(err.code, AU_ERR_ARG);
+    T_ASSERT(!au_out_open(&(au_out_opts){.backend = AU_OUT_NULL, .volume = NAN}, &err));
+    T_EQ(err.code, AU_ERR_ARG);
+    T_ASSERT(!au_out_open(&(au_out_opts){.backend = AU_OUT_NULL, .latency_ms = 3}, &err));
+    T_EQ(err.code, AU_ERR_ARG);
+    T_CONTAINS(err.msg, "latency 3 ms");
+    T_ASSERT(!au_out_open(&(au_out_opts){.backend = AU_OUT_WAV}, &err));
+    T_EQ(err.code, AU_ERR_ARG);
+}
+
+static void t_wav_bad_path_named(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/no-such-folder/out.wav", t_tmpdir());
+    rs_err err = {0};
+    T_ASSERT(!au_out_open(&(au_out_opts){.wav_path = path}, &err));
+    T_EQ(err.code, AU_ERR_WAV_OPEN);
+    T_CONTAINS(err.msg, path);
+}
+
+/* A run that failed leaves no file behind (nor its temporary). */
+static void t_wav_not_ok_removed(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/failed.wav", t_tmpdir());
+    rs_err err = {0};
+    au_out *o = au_out_open(&(au_out_opts){.wav_path = path}, &err);
+    T_ASSERTF(o, "%s", err.msg);
+    float pcm[AU_TICK_FRAMES * 2];
+    tick_pcm(0, pcm);
+    T_ASSERT(au_out_write(o, pcm, AU_TICK_FRAMES, &err));
+    au_out_close(o, false, &err);
+    T_ASSERT(access(path, F_OK) != 0);
+}
+
+/* ---- openal, on OpenAL Soft's null driver ---- */
+
+static void need_openal(void)
+{
+#ifndef RS_HAVE_OPENAL
+    T_SKIP("built without OpenAL");
+#endif
+    /* OpenAL Soft reads its settings on the first device opened, so this
+     * process (one case) can pick the driver and the period here */
+    setenv("ALSOFT_DRIVERS", "null", 1);
+    char conf[512];
+    snprintf(conf, sizeof conf, "%s/alsoft.conf", t_tmpdir());
+    t_write(t_tmpdir(), "alsoft.conf", "[general]\nperiod_size = 256\nperiods = 2\n");
+    setenv("ALSOFT_CONF", conf, 1);
+}
+
+static void t_openal_no_device_named(void)
+{
+    need_openal();
+    rs_err err = {0};
+    T_ASSERT(!au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL, .device = "no-such-card"}, &err));
+    T_EQ(err.code, AU_ERR_DEVICE);
+    T_CONTAINS(err.msg, "no-such-card");
+}
+
+/* One second at a steady 60 Hz: nothing dropped, no underrun, and a sound
+ * reaches the (null) speaker within 50 ms of its tick. */
+static void t_openal_realtime(void)
+{
+    need_openal();
+    rs_err err = {0};
+    au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL}, &err);
+    T_ASSERTF(o, "%s", err.msg);
+    T_CONTAINS(au_out_backend_name(o), "openal");
+    float pcm[AU_TICK_FRAMES * 2];
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (int t = 0; t < 60; t++) {
+        tick_pcm(t, pcm);
+        T_ASSERTF(au_out_write(o, pcm, AU_TICK_FRAMES, &err), "%s", err.msg);
+        long ns = t0.tv_nsec + (long)((t + 1) * (1e9 / 60));
+        struct timespec due = {t0.tv_sec + ns / 1000000000L, ns % 1000000000L};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, NULL);
+    }
+    au_out_stats st;
+    au_out_stats_get(o, &st);
+    printf("openal null driver: latency %.1f ms (max %.1f), %llu underruns, %llu dropped, %.3f ms in writes\n",
+           st.latency_ms, st.max_latency_ms, (unsigned long long)st.underruns, (unsigned long long)st.dropped,
+           st.write_ms);
+    T_EQ(st.frames, 60 * AU_TICK_FRAMES);
+    T_EQ(st.underruns, 0);
+    T_EQ(st.dropped, 0);
+    T_ASSERT(st.played > 0 && st.played <= st.frames);
+    T_ASSERTF(st.max_latency_ms > 0 && st.max_latency_ms <= 50, "max latency %.1f ms", st.max_latency_ms);
+    T_ASSERT(au_out_close(o, true, &err));
+}
+
+/* The game stalls for a quarter second: the queue runs dry, that is one
+ * underrun, and playback picks up again with the next ticks. */
+static void t_openal_underrun_counted(void)
+{
+    need_openal();
+    rs_err err = {0};
+    au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL}, &err);
+    T_ASSERTF(o, "%s", err.msg);
+    float pcm[AU_TICK_FRAMES * 2];
+    for (int t = 0; t < 40; t++) {
+        tick_pcm(t, pcm);
+        T_ASSERT(au_out_write(o, pcm, AU_TICK_FRAMES, &err));
+        nanosleep(&(struct timespec){0, t == 20 ? 250000000L : 16666667L}, NULL);
+    }
+    au_out_stats st;
+    au_out_stats_get(o, &st);
+    T_EQ(st.underruns, 1);
+    T_ASSERT(au_out_close(o, true, &err));
+}
+
+/* Written faster than it plays (a headless loop on a device): the queue
+ * stays within its bound and the excess is dropped, the writes never wait. */
+static void t_openal_drops_never_blocks(void)
+{
+    need_openal();
+    rs_err err = {0};
+    au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL}, &err);
+    T_ASSERTF(o, "%s", err.msg);
+    float pcm[AU_TICK_FRAMES * 2];
+    for (int t = 0; t < 600; t++) {
+        tick_pcm(t, pcm);
+        T_ASSERT(au_out_write(o, pcm, AU_TICK_FRAMES, &err));
+    }
+    au_out_stats st;
+    au_out_stats_get(o, &st);
+    T_ASSERT(st.dropped > 500 * AU_TICK_FRAMES);
+    T_ASSERTF(st.write_ms < 1000, "600 writes took %.0f ms", st.write_ms);
+    T_ASSERTF(st.max_latency_ms <= 60, "max latency %.1f ms", st.max_latency_ms);
+    au_out_close(o, false, &err);
+}
+
+T_MAIN({"null_counts", t_null_counts}, {"wav_frame_for_frame", t_wav_frame_for_frame}, {"wav_16bit", t_wav_16bit},
+       {"volume_at_output", t_volume_at_output}, {"bad_settings_named", t_bad_settings_named},
+       {"wav_bad_path_named", t_wav_bad_path_named}, {"wav_not_ok_removed", t_wav_not_ok_removed},
+       {"openal_no_device_named", t_openal_no_device_named}, {"openal_realtime", t_openal_realtime},
+       {"openal_underrun_counted", t_openal_underrun_counted},
+       {"openal_drops_never_blocks", t_openal_drops_never_blocks})
