@@ -187,6 +187,7 @@ typedef struct ff_audio {
     int in_channels;
     bool placed;        /* the first frame has been put on the timeline */
     int64_t in_next;    /* the next input sample's timeline position, at in_rate */
+    int last_nb;        /* the last frame's samples */
     float *out;         /* resampler output */
     int out_cap;        /* in frames */
 } ff_audio;
@@ -288,6 +289,12 @@ static bool put_frame(mv_audio *a, ff_audio *f, AVFrame *fr)
             if (!f->placed && gap > 0) /* audio starting far later than the picture: as ffmpeg would, keep it */
                 gap = 0;
         } else if (gap > tol) {
+            /* Lost frames: a container's rounded timestamps (Matroska's are
+             * whole milliseconds) make a gap of k frames look a few samples
+             * off; take it as k frames when it is within a millisecond. */
+            int64_t fs = f->last_nb, k = fs > 0 ? (gap + fs / 2) / fs : 0;
+            if (k >= 1 && llabs(gap - k * fs) <= fr->sample_rate / 1000)
+                gap = k * fs;
             pthread_mutex_lock(&a->mu);
             a->st.filled += av_rescale(gap, AU_RATE, fr->sample_rate);
             pthread_mutex_unlock(&a->mu);
@@ -299,6 +306,7 @@ static bool put_frame(mv_audio *a, ff_audio *f, AVFrame *fr)
         }
     }
     f->placed = true;
+    f->last_nb = fr->nb_samples;
     int n = fr->nb_samples - (int)skip;
     if (n <= 0)
         return true;
@@ -469,7 +477,7 @@ mv_audio *mv_audio_open(const char *path, rs_err *err)
         if ((int)k != f->stream)
             f->fmt->streams[k]->discard = AVDISCARD_ALL;
     mv_audio_info *i = &a->info;
-    snprintf(i->codec, sizeof i->codec, "%s", codec->name);
+    snprintf(i->codec, sizeof i->codec, "%s", avcodec_get_name(st->codecpar->codec_id));
     const char *sf = av_get_sample_fmt_name(st->codecpar->format);
     snprintf(i->format, sizeof i->format, "%s", sf ? sf : "?");
     if (av_channel_layout_describe(&st->codecpar->ch_layout, i->layout, sizeof i->layout) < 0)
