@@ -50,46 +50,6 @@ struct mv_audio {
     void *dec; /* ff_audio, below */
 };
 
-static double thread_cpu_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
-/* The thread's output: n frames at position wr.  False when told to stop. */
-static bool push(mv_audio *a, const float *pcm, int64_t n)
-{
-    pthread_mutex_lock(&a->mu);
-    a->st.frames += n;
-    while (n > 0 && !a->stop) {
-        if (a->wr < a->rd) { /* the reader has passed these: drop */
-            int64_t d = a->rd - a->wr < n ? a->rd - a->wr : n;
-            a->st.discarded += d;
-            a->wr += d;
-            pcm += 2 * d;
-            n -= d;
-            continue;
-        }
-        int64_t room = a->rd + MV_AUDIO_AHEAD - a->wr;
-        if (room <= 0) {
-            pthread_cond_wait(&a->has_room, &a->mu);
-            continue;
-        }
-        int64_t k = room < n ? room : n, at = a->wr % MV_AUDIO_AHEAD;
-        if (k > MV_AUDIO_AHEAD - at)
-            k = MV_AUDIO_AHEAD - at; /* the rest after the wrap, next time round */
-        memcpy(a->ring + 2 * at, pcm, (size_t)k * 2 * sizeof *pcm);
-        a->wr += k;
-        pcm += 2 * k;
-        n -= k;
-        pthread_cond_broadcast(&a->has_data);
-    }
-    bool ok = !a->stop;
-    pthread_mutex_unlock(&a->mu);
-    return ok;
-}
-
 bool mv_audio_read(mv_audio *a, int64_t pos, float *out, int frames, bool wait)
 {
     memset(out, 0, (size_t)frames * 2 * sizeof *out);
@@ -172,6 +132,46 @@ void mv_audio_close(mv_audio *a)
 #include <libavutil/channel_layout.h>
 #include <libavutil/samplefmt.h>
 #include <libswresample/swresample.h>
+
+static double thread_cpu_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+/* The thread's output: n frames at position wr.  False when told to stop. */
+static bool push(mv_audio *a, const float *pcm, int64_t n)
+{
+    pthread_mutex_lock(&a->mu);
+    a->st.frames += n;
+    while (n > 0 && !a->stop) {
+        if (a->wr < a->rd) { /* the reader has passed these: drop */
+            int64_t d = a->rd - a->wr < n ? a->rd - a->wr : n;
+            a->st.discarded += d;
+            a->wr += d;
+            pcm += 2 * d;
+            n -= d;
+            continue;
+        }
+        int64_t room = a->rd + MV_AUDIO_AHEAD - a->wr;
+        if (room <= 0) {
+            pthread_cond_wait(&a->has_room, &a->mu);
+            continue;
+        }
+        int64_t k = room < n ? room : n, at = a->wr % MV_AUDIO_AHEAD;
+        if (k > MV_AUDIO_AHEAD - at)
+            k = MV_AUDIO_AHEAD - at; /* the rest after the wrap, next time round */
+        memcpy(a->ring + 2 * at, pcm, (size_t)k * 2 * sizeof *pcm);
+        a->wr += k;
+        pcm += 2 * k;
+        n -= k;
+        pthread_cond_broadcast(&a->has_data);
+    }
+    bool ok = !a->stop;
+    pthread_mutex_unlock(&a->mu);
+    return ok;
+}
 
 typedef struct ff_audio {
     AVFormatContext *fmt;
