@@ -269,6 +269,8 @@ static bool start_next(attract *a)
             if (a->mp) {
                 const mv_info *i = mv_player_info(a->mp);
                 logf_(a, "movie %s (%s %dx%d, %d/%d fps)", it->path, i->codec, i->w, i->h, i->fps_num, i->fps_den);
+                if (mv_player_audio_why(a->mp)[0])
+                    logf_(a, "%s: playing it silent", mv_player_audio_why(a->mp));
                 a->on = true;
                 return true;
             }

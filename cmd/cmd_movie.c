@@ -212,11 +212,12 @@ static void summary(mv_cmd *s, const lp_stats *ls)
                 " damaged packets skipped; decode+resample %.4f ms CPU per tick\n",
                 src, st.audio.reads, st.audio.late, st.audio.bad_packets,
                 st.audio.reads ? st.audio.cpu_ms / (double)st.audio.reads : 0.0);
-    } else {
+    } else if (!s->po.mute) {
         const char *why = mv_player_audio_why(s->mp);
-        snprintf(src, sizeof src, "%s", s->po.mute ? "muted" : why[0] ? "unplayable" : "none");
-        if (!s->po.mute)
-            fprintf(stderr, "ringside movie: sound: %s\n", why[0] ? why : "none (no audio stream)");
+        snprintf(src, sizeof src, "%s", why[0] ? "unplayable" : "none");
+        fprintf(stderr, "ringside movie: sound: %s\n", why[0] ? why : "none (no audio stream)");
+    } else {
+        snprintf(src, sizeof src, "muted");
     }
     snd_summary("movie", s->out, src);
 }
@@ -306,7 +307,6 @@ int cmd_movie(int argc, char **argv)
     }
     s->path = argv[optind];
     s->po.wait = s->headless;
-    s->po.mute = snd.mute;
     status = RS_EXIT_FAIL;
     struct stat dst;
     /* --dump DIR is created, as an output is, when the folder it is in exists */
@@ -325,6 +325,7 @@ int cmd_movie(int argc, char **argv)
     /* a --audio-out that cannot be written stops us before anything plays */
     if (!(s->out = snd_open("movie", &snd, s->headless, s->overwrite, &fatal)) && fatal)
         goto done;
+    s->po.mute = snd.mute || !s->out; /* nothing to play it on: do not decode it */
     pd.backend = s->headless ? NULL : "glfw";
     pd.width = s->w ? s->w : 1280;
     pd.height = s->h ? s->h : 720;

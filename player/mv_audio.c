@@ -180,7 +180,7 @@ typedef struct ff_audio {
     AVFrame *frame;
     int stream;
     AVRational tb;      /* the audio stream's time base */
-    int64_t start;      /* the video's first presentation time, in tb */
+    int64_t start;      /* the video's first presentation time, in tb (audio only: the first frame's) */
     SwrContext *swr;
     int in_rate, in_fmt; /* what swr was set up for */
     AVChannelLayout in_layout; /* the frames' layout, as they say it */
@@ -281,6 +281,8 @@ static bool put_frame(mv_audio *a, ff_audio *f, AVFrame *fr)
     }
     int64_t ts = fr->best_effort_timestamp, skip = 0;
     AVRational in_tb = {1, fr->sample_rate};
+    if (ts != AV_NOPTS_VALUE && f->start == AV_NOPTS_VALUE)
+        f->start = ts;
     if (ts != AV_NOPTS_VALUE) {
         int64_t at = av_rescale_q(ts - f->start, f->tb, in_tb);
         int64_t jump = (int64_t)MAX_JUMP_S * fr->sample_rate, tol = f->placed ? fr->sample_rate / 50 : 0;
@@ -457,7 +459,7 @@ mv_audio *mv_audio_open(const char *path, rs_err *err)
     if (video >= 0 && f->fmt->streams[video]->start_time != AV_NOPTS_VALUE)
         f->start = av_rescale_q(f->fmt->streams[video]->start_time, f->fmt->streams[video]->time_base, f->tb);
     else
-        f->start = st->start_time != AV_NOPTS_VALUE ? st->start_time : 0;
+        f->start = AV_NOPTS_VALUE; /* no picture: the first decoded sample is the start */
     f->dec = avcodec_alloc_context3(codec);
     f->pkt = av_packet_alloc();
     f->frame = av_frame_alloc();
@@ -467,6 +469,7 @@ mv_audio *mv_audio_open(const char *path, rs_err *err)
         goto fail;
     }
     f->dec->thread_count = 1;
+    f->dec->pkt_timebase = st->time_base; /* so the decoder moves a frame's pts past the priming it drops */
     if ((r = avcodec_parameters_to_context(f->dec, st->codecpar)) < 0 || (r = avcodec_open2(f->dec, codec, NULL)) < 0) {
         rs_fail(err, MV_ERR_UNSUPPORTED, "%s: cannot open the %s audio decoder: %s", path, codec->name,
                 av_msg(r, m, sizeof m));

@@ -32,15 +32,18 @@ mkmovie() {
 f32() { ffmpeg -nostdin -hide_banner -loglevel error -y -i "$1" -vn -ac 2 -ar 48000 -f f32le "$2"; }
 
 # ref MOVIE OUT: ffmpeg's decode of MOVIE's audio from the picture's first
-# frame on: the player's tick 0.  ffmpeg's raw decode starts at the audio's
-# first sample, which for AAC in Matroska is the encoder's priming, 1024
-# samples before the picture (the muxer starts the video at 23 ms); the
-# player cuts those samples, so ffmpeg is told to cut them too (atrim, at
-# the track's own rate, before resampling, as the player does).
+# frame on: the player's tick 0.  ffmpeg's raw decode starts at the first
+# decoded sample, which can lie before the picture: AAC in Matroska keeps
+# the encoder's 1024 priming samples (the muxer starts the video 23 ms in),
+# Opus in WebM starts 7 ms before.  The player cuts what lies before the
+# picture, so ffmpeg is told to cut it too (atrim at the track's own rate,
+# before resampling, as the player does).  In MP4 (edit lists) both start at 0.
 ref() {
-    va=$(ffprobe -v error -show_entries stream=codec_type,start_time,sample_rate -of csv=p=0 "$1") || return 1
-    skip=$(echo "$va" | awk -F, '$1 == "video" { v = $2 } $1 == "audio" { r = $2; a = $3 }
-        END { d = (v - a) * r; printf "%d", (d > 0 ? d + 0.5 : 0) }')
+    v=$(ffprobe -v error -select_streams v:0 -show_entries stream=start_time -of csv=p=0 "$1") &&
+        a=$(ffprobe -v error -select_streams a:0 -read_intervals %+#1 -show_entries frame=best_effort_timestamp_time \
+            -of csv=p=0 "$1" | head -n 1) &&
+        r=$(ffprobe -v error -select_streams a:0 -show_entries stream=sample_rate -of csv=p=0 "$1") || return 1
+    skip=$(awk -v v="$v" -v a="$a" -v r="$r" 'BEGIN { d = (v - a) * r; printf "%d", (d > 0 ? d + 0.5 : 0) }')
     echo "  $1: the picture starts $skip samples into the sound"
     ffmpeg -nostdin -hide_banner -loglevel error -y -i "$1" -vn -af "atrim=start_sample=$skip" -ac 2 -ar 48000 -f f32le "$2"
 }
@@ -65,6 +68,18 @@ t_attract_movie_matches_ffmpeg() {
     f32 x.wav got.f32 && ref m.mkv ref.f32 || return 1
     xc got.f32 ref.f32 || return 1
     ge "$corr" 0.99 && [ "$lag" -ge -48 ] && [ "$lag" -le 48 ] || { echo "corr $corr at offset $lag frames"; return 1; }
+    # WebM with Opus (its pre-skip), and MP4 with AAC against ffmpeg's raw decode as is
+    ffmpeg -nostdin -hide_banner -loglevel error -y -f lavfi -i testsrc2=size=64x36:rate=30:d=2 \
+        -f lavfi -i "anoisesrc=d=2:c=pink:r=48000:a=0.25" -c:v libvpx-vp9 -deadline realtime -c:a libopus -ac 2 w.webm &&
+        ffmpeg -nostdin -hide_banner -loglevel error -y -f lavfi -i testsrc2=size=64x36:rate=30:d=2 \
+            -f lavfi -i "anoisesrc=d=2:c=pink:r=44100:a=0.25" -c:v libx264 -preset ultrafast -c:a aac -ac 2 a.mp4 || return 1
+    "$RS_BIN" attract w.webm --headless --ticks 120 --size 64x36 --audio-out w.wav -q &&
+        "$RS_BIN" attract a.mp4 --headless --ticks 120 --size 64x36 --audio-out a.wav -q || return 1
+    f32 w.wav gotw.f32 && ref w.webm refw.f32 && f32 a.wav gota.f32 && f32 a.mp4 rawa.f32 || return 1
+    xc gotw.f32 refw.f32 || return 1
+    ge "$corr" 0.99 && [ "$lag" -ge -48 ] && [ "$lag" -le 48 ] || { echo "webm: corr $corr at offset $lag frames"; return 1; }
+    xc gota.f32 rawa.f32 || return 1
+    ge "$corr" 0.99 && [ "$lag" -ge -48 ] && [ "$lag" -le 48 ] || { echo "mp4: corr $corr at offset $lag frames"; return 1; }
 }
 
 # a button press starts a match: the movie's sound stops on that tick, the
