@@ -52,9 +52,11 @@ struct mv_audio {
 
 bool mv_audio_read(mv_audio *a, int64_t pos, float *out, int frames, bool wait)
 {
-    memset(out, 0, (size_t)frames * 2 * sizeof *out);
     if (frames <= 0)
         return true;
+    memset(out, 0, (size_t)frames * 2 * sizeof *out);
+    if (frames > MV_AUDIO_AHEAD)
+        wait = false; /* more than the ring holds can never all be there at once */
     pthread_mutex_lock(&a->mu);
     int64_t end = pos + frames;
     if (pos > a->rd) {
