@@ -1,7 +1,10 @@
 /* ringside play: the game in a window (or headless), live or from a replay.
  *
  * One thread: the loop (loop.c) owns the GL context, the game state and
- * the recorder; input devices are polled on the same thread between ticks. */
+ * the recorder; input devices are polled on the same thread between ticks.
+ * Sound is made on that thread too: each tick's cues are mixed and handed
+ * to au_out (runtime/audio/au_out.h), which never blocks for longer than a
+ * tick; OpenAL Soft's own thread plays what was queued. */
 #include <getopt.h>
 #include <inttypes.h>
 #include <stdio.h>
@@ -10,6 +13,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "../runtime/audio/au_out.h"
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/input.h"
@@ -20,6 +24,8 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_img.h"
+#include "../runtime/util/rs_out.h"
+#include "../runtime/util/rs_progress.h"
 
 static void help(void)
 {
@@ -27,11 +33,14 @@ static void help(void)
            "                     [--record FILE] [--replay FILE] [--seconds N] [--screenshot FILE]\n"
            "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
            "                     [--stage-file FILE] [--passes[=summary|frames]]\n"
-           "                     [--hdr-format rgba16f|r11g11b10f]\n\n"
+           "                     [--hdr-format rgba16f|r11g11b10f]\n"
+           "                     [--audio-out FILE.wav] [--mute] [--volume V] [--audio-device D]\n\n"
            "Plays the game at a fixed 60 Hz in a window (GLFW; needs X, or xvfb-run -a).\n"
            "Keys: player 1 W A S D, J punch, K kick, L guard; player 2 arrows, numpad\n"
            "1 2 3 (or , . /); gamepads 1 and 2 too.  The 2-3-6 motion + punch is the\n"
-           "special move.  Escape quits.  Matches follow one another until you quit.\n\n"
+           "special move.  Escape quits.  Matches follow one another until you quit.\n"
+           "Sound plays through OpenAL Soft; with no audio device, one warning and the\n"
+           "game runs silent.\n\n"
            "  --p1 / --p2 K    who plays each side (default: human vs cpu)\n"
            "  --stage NAME     dojo, harbor, temple, shallows, snowfield, mistvale, plaza or quarry\n"
            "                   (default dojo)\n"
@@ -48,7 +57,12 @@ static void help(void)
            "  --quiet          no summary line\n"
            "  --stage-file F   the look to use instead of stages/<stage>.stage (docs/stages.md)\n"
            "  --passes[=MODE]  time every render pass: a table at the end, or one line per frame\n"
-           "  --hdr-format F   the HDR buffer: rgba16f (default) or r11g11b10f\n");
+           "  --hdr-format F   the HDR buffer: rgba16f (default) or r11g11b10f\n"
+           "  --audio-out F    write the sound to F (.wav, 16-bit) instead of the audio device;\n"
+           "                   headless, without it, the game is silent\n"
+           "  --mute           no sound at all (the mixer does not run)\n"
+           "  --volume V       output volume, 0..1 (linear; default 1; 0 is --mute)\n"
+           "  --audio-device D  the OpenAL device to play on (default: the system's)\n");
 }
 
 typedef struct play {
@@ -64,6 +78,11 @@ typedef struct play {
     uint64_t limit;
     bool quit, failed;
     rs_err err;
+    /* sound: NULL mixer when muted or silent */
+    au_mixer *mix;
+    au_out *out;
+    float pcm[AU_TICK_FRAMES * AU_CHANNELS];
+    double audio_ms; /* mixing and output, summed over the ticks */
 } play;
 
 static void on_input(void *user, g_input in[2])
@@ -79,13 +98,33 @@ static void on_input(void *user, g_input in[2])
     }
 }
 
+/* The tick's sound: the cues of the step that took prev to cur, mixed as
+ * au_replay_track mixes them, so a headless --audio-out run of a replay
+ * is that replay's unnormalized soundtrack, sample for sample. */
+static void play_sound(play *s, const g_events *ev)
+{
+    double t0 = rs_now();
+    au_cue cues[AU_MAX_CUES];
+    int n = au_game_cues(&s->prev, &s->cur, ev, cues, AU_MAX_CUES);
+    for (int i = 0; i < n; i++)
+        au_mixer_cue(s->mix, &cues[i]);
+    au_mixer_music(s->mix, s->cur.stage);
+    au_mixer_mix(s->mix, s->pcm, AU_TICK_FRAMES, NULL, 0);
+    if (!au_out_write(s->out, s->pcm, AU_TICK_FRAMES, &s->err))
+        s->failed = true;
+    s->audio_ms += (rs_now() - t0) * 1e3;
+}
+
 static void on_step(void *user, const g_input in[2])
 {
     play *s = user;
+    g_events ev;
     s->prev = s->cur;
-    g_step(&s->cur, in, NULL);
+    g_step(&s->cur, in, &ev);
     if (s->rec && !rp_rec_tick(s->rec, in, &s->cur, &s->err))
         s->failed = true;
+    if (s->mix)
+        play_sound(s, &ev);
 }
 
 static void on_render(void *user, float alpha)
@@ -137,6 +176,67 @@ static bool screenshot(play *s, const char *path, rs_err *err)
     return ok;
 }
 
+/* --volume: a number in 0..1. */
+static bool parse_volume(const char *arg, float *v)
+{
+    char *end;
+    double d = strtod(arg, &end);
+    if (end == arg || *end || !(d >= 0 && d <= 1)) {
+        cli_error("play", "--volume '%s': expected a number in 0..1 (linear; 0 is --mute)", arg);
+        return false;
+    }
+    *v = (float)d;
+    return true;
+}
+
+/* The output the options ask for, opened before the game starts so a bad
+ * --audio-out stops the run before anything else.  A device that cannot be
+ * opened is one warning: the game runs silent.  false: a fatal error, in
+ * s->err. */
+static bool audio_open(play *s, const char *wav, bool mute, float volume, const char *device, bool headless,
+                       int stage)
+{
+    if (mute || volume == 0 || (headless && !wav))
+        return true;
+    if (wav && !rs_out_check(wav, true, &s->err))
+        return false;
+    rs_err err = {0};
+    s->out = au_out_open(&(au_out_opts){.wav_path = wav, .device = device, .volume = volume}, &err);
+    if (!s->out) {
+        if (wav || err.code != AU_ERR_DEVICE) {
+            s->err = err;
+            return false;
+        }
+        fprintf(stderr, "ringside play: warning: %s; the game runs silent\n", err.msg);
+        return true;
+    }
+    s->mix = au_mixer_new(NULL, &s->err);
+    if (!s->mix)
+        return false;
+    /* the bank and the stage's music are built on first use: here, not in
+     * the first tick, where it would be a hitch (the same music the tick
+     * would choose, so the samples do not change) */
+    au_bank_get(0);
+    au_mixer_music(s->mix, stage);
+    return true;
+}
+
+/* "; audio: BACKEND, ..." for the summary line. */
+static void audio_summary(const play *s, uint64_t ticks, char *buf, size_t size)
+{
+    if (!s->out) {
+        snprintf(buf, size, "; audio: off");
+        return;
+    }
+    au_out_stats st;
+    au_out_stats_get(s->out, &st);
+    int n = snprintf(buf, size, "; audio: %s, %.3f ms a tick (mix and output)", au_out_backend_name(s->out),
+                     ticks ? s->audio_ms / (double)ticks : 0.0);
+    if (strncmp(au_out_backend_name(s->out), "openal", 6) == 0 && n > 0 && (size_t)n < size)
+        snprintf(buf + n, size - (size_t)n, ", latency max %.1f ms, %" PRIu64 " underruns, %" PRIu64 " frames dropped",
+                 st.max_latency_ms, st.underruns, st.dropped);
+}
+
 static bool parse_kind(const char *opt, const char *arg, int *kind)
 {
     if (!strcmp(arg, "human"))
@@ -162,6 +262,8 @@ int cmd_play(int argc, char **argv)
         {"headless", no_argument, 0, 'H'},     {"quiet", no_argument, 0, 'q'},
         {"stage-file", required_argument, 0, 'T'}, {"passes", optional_argument, 0, 'P'},
         {"hdr-format", required_argument, 0, 'X'},
+        {"audio-out", required_argument, 0, 'A'}, {"mute", no_argument, 0, 'M'},
+        {"volume", required_argument, 0, 'V'}, {"audio-device", required_argument, 0, 'D'},
         {"help", no_argument, 0, 'h'},         {0}};
     play *s = calloc(1, sizeof *s);
     if (!s)
@@ -174,7 +276,9 @@ int cmd_play(int argc, char **argv)
     long level = 2, seconds = 0;
     uint64_t seed = (uint64_t)time(NULL);
     const char *record = NULL, *replay = NULL, *shot = NULL;
-    bool headless = false, quiet = false;
+    const char *audio_out = NULL, *audio_device = NULL;
+    bool headless = false, quiet = false, mute = false;
+    float volume = 1;
     r_game_opts go = {0};
     int passes = 0;
     plat_desc pd = {.title = "ringside"};
@@ -214,6 +318,10 @@ int cmd_play(int argc, char **argv)
             break;
         }
         case 'q': quiet = true; break;
+        case 'A': audio_out = optarg; break;
+        case 'M': mute = true; break;
+        case 'V': if (!parse_volume(optarg, &volume)) goto done; break;
+        case 'D': audio_device = optarg; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
             status = cli_bad_option("play", argv);
@@ -240,6 +348,17 @@ int cmd_play(int argc, char **argv)
         cli_error("play", "--replay and --record together: the replay is already recorded");
         goto done;
     }
+    if (audio_out) {
+        const char *dot = strrchr(audio_out, '.');
+        if (!dot || strcmp(dot, ".wav")) {
+            cli_error("play", "--audio-out %s: expected a .wav file", audio_out);
+            goto done;
+        }
+        if (mute || volume == 0) {
+            cli_error("play", "--audio-out with %s: nothing would be written", mute ? "--mute" : "--volume 0");
+            goto done;
+        }
+    }
     status = RS_EXIT_FAIL;
     if (replay) {
         if (!rp_read(replay, &watch, &s->err))
@@ -248,6 +367,8 @@ int cmd_play(int argc, char **argv)
         stage = watch.stage;
         seed = watch.seed;
     }
+    if (!audio_open(s, audio_out, mute, volume, audio_device, headless, stage))
+        goto done;
     pd.backend = headless ? NULL : "glfw";
     pd.width = s->w;
     pd.height = s->h;
@@ -288,11 +409,20 @@ int cmd_play(int argc, char **argv)
     if (s->rec && !rp_rec_save(s->rec, record, &s->err))
         goto done;
     if (!quiet) {
+        char audio[512];
+        audio_summary(s, st.ticks, audio, sizeof audio);
         fprintf(stderr,
                 "ringside play: %" PRIu64 " ticks (%.1f s of game) in %.1f s, %" PRIu64 " frames, %" PRIu64
-                " late ticks, %" PRIu64 " stalls; rounds %d-%d%s%s\n",
+                " late ticks, %" PRIu64 " stalls; rounds %d-%d%s%s%s\n",
                 st.ticks, st.ticks / (double)G_HZ, st.seconds, st.frames, st.late_ticks, st.stalls,
-                s->cur.f[0].rounds_won, s->cur.f[1].rounds_won, record ? "; recorded " : "", record ? record : "");
+                s->cur.f[0].rounds_won, s->cur.f[1].rounds_won, record ? "; recorded " : "", record ? record : "",
+                audio);
+    }
+    if (s->out) {
+        au_out *o = s->out;
+        s->out = NULL;
+        if (!au_out_close(o, true, &s->err))
+            goto done;
     }
     status = RS_EXIT_OK;
 done:
@@ -303,6 +433,10 @@ done:
         r_game_destroy(s->r);
         plat_destroy(s->p);
     }
+    if (s->out)
+        au_out_close(s->out, false, NULL);
+    if (s->mix)
+        au_mixer_free(s->mix);
     if (s->rec)
         rp_free(&s->rec->rp);
     rp_free(&watch);

@@ -179,39 +179,91 @@ static void t_openal_no_device_named(void)
     T_CONTAINS(err.msg, "no-such-card");
 }
 
-/* One second at a steady 60 Hz: nothing dropped, no underrun, and a sound
- * reaches the (null) speaker within 50 ms of its tick. */
-static void t_openal_realtime(void)
+/* With 50 ms queued and 256-frame periods a tick may come 11 ms late
+ * without a gap (au_out.c).  A machine busy with other work (builds, other
+ * tests) can wake us, or OpenAL's mixer thread, tens of ms late: then a
+ * gap or a drop is right.  So the real-time cases try three times, judge
+ * only runs where every write came within ON_TIME_MS of its time, and
+ * fail when none of those was clean. */
+#define ON_TIME_MS 4.0
+
+/* Writes `ticks` ticks at 60 Hz, odd ticks `jitter` ms late (pcm: that
+ * many ticks, or NULL for the test signal); returns how much later than
+ * that the latest write was, in ms. */
+static double paced(au_out *o, const float *pcm, int ticks, double jitter)
 {
-    need_openal();
     rs_err err = {0};
-    au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL}, &err);
-    T_ASSERTF(o, "%s", err.msg);
-    T_CONTAINS(au_out_backend_name(o), "openal");
-    float pcm[AU_TICK_FRAMES * 2];
-    struct timespec t0;
+    float sig[AU_TICK_FRAMES * 2];
+    struct timespec t0, now;
+    double late = 0;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (int t = 0; t < 60; t++) {
-        tick_pcm(t, pcm);
-        T_ASSERTF(au_out_write(o, pcm, AU_TICK_FRAMES, &err), "%s", err.msg);
-        long ns = t0.tv_nsec + (long)((t + 1) * (1e9 / 60));
-        struct timespec due = {t0.tv_sec + ns / 1000000000L, ns % 1000000000L};
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, NULL);
+    for (int t = 0; t < ticks; t++) {
+        double due_ms = t * (1e3 / 60) + (t % 2 ? jitter : 0);
+        long ns = t0.tv_nsec + (long)(due_ms * 1e6);
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME,
+                        &(struct timespec){t0.tv_sec + ns / 1000000000L, ns % 1000000000L}, NULL);
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        double l = (double)(now.tv_sec - t0.tv_sec) * 1e3 + (now.tv_nsec - t0.tv_nsec) / 1e6 - due_ms;
+        late = l > late ? l : late;
+        if (!pcm)
+            tick_pcm(t, sig);
+        T_ASSERTF(au_out_write(o, pcm ? pcm + (size_t)t * AU_TICK_FRAMES * 2 : sig, AU_TICK_FRAMES, &err), "%s",
+                  err.msg);
     }
-    au_out_stats st;
-    au_out_stats_get(o, &st);
-    printf("openal null driver: latency %.1f ms (max %.1f), %llu underruns, %llu dropped, %.3f ms in writes\n",
-           st.latency_ms, st.max_latency_ms, (unsigned long long)st.underruns, (unsigned long long)st.dropped,
-           st.write_ms);
-    T_EQ(st.frames, 60 * AU_TICK_FRAMES);
-    T_EQ(st.underruns, 0);
-    T_EQ(st.dropped, 0);
-    T_ASSERT(st.played > 0 && st.played <= st.frames);
-    T_ASSERTF(st.max_latency_ms > 0 && st.max_latency_ms <= 50, "max latency %.1f ms", st.max_latency_ms);
-    T_ASSERT(au_out_close(o, true, &err));
+    return late;
 }
 
-/* The game stalls for a quarter second: the queue runs dry, that is one
+/* One second of ticks `jitter` ms late every other tick: nothing dropped,
+ * no underrun; the stats of the clean run in *st. */
+static void realtime(double jitter, au_out_stats *st)
+{
+    need_openal();
+    bool gaps = false;
+    for (int attempt = 1; attempt <= 3; attempt++) {
+        rs_err err = {0};
+        au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL}, &err);
+        T_ASSERTF(o, "%s", err.msg);
+        T_CONTAINS(au_out_backend_name(o), "openal");
+        double late = paced(o, NULL, 60, jitter);
+        au_out_stats_get(o, st);
+        T_ASSERT(au_out_close(o, true, &err));
+        printf("openal null driver, odd ticks %.0f ms late: latency %.1f ms (max %.1f), %llu underruns, %llu dropped, "
+               "%.3f ms in writes, writer up to %.1f ms later still\n",
+               jitter, st->latency_ms, st->max_latency_ms, (unsigned long long)st->underruns,
+               (unsigned long long)st->dropped, st->write_ms, late);
+        if (late > ON_TIME_MS)
+            continue;
+        if (st->underruns || st->dropped) {
+            gaps = true;
+            continue;
+        }
+        T_EQ(st->frames, 60 * AU_TICK_FRAMES);
+        T_ASSERT(st->played > 0 && st->played <= st->frames);
+        return;
+    }
+    T_ASSERTF(!gaps, "underruns or drops in every run, though the writer kept to its times within %.0f ms",
+              ON_TIME_MS);
+    T_SKIP("the machine is too busy: no run kept 60 Hz within %.0f ms", ON_TIME_MS);
+}
+
+/* A steady 60 Hz: a sound reaches the (null) speaker within 50 ms of its
+ * tick (the stats count the device's own buffer). */
+static void t_openal_realtime(void)
+{
+    au_out_stats st;
+    realtime(0, &st);
+    T_ASSERTF(st.max_latency_ms > 0 && st.max_latency_ms <= 50, "max latency %.1f ms", st.max_latency_ms);
+}
+
+/* A loop whose frames alternate long and short: every other tick 6 ms
+ * late, still no gap. */
+static void t_openal_jitter(void)
+{
+    au_out_stats st;
+    realtime(6, &st);
+}
+
+/* The game stalls for a quarter second: the queue runs dry, that is an
  * underrun, and playback picks up again with the next ticks. */
 static void t_openal_underrun_counted(void)
 {
@@ -227,7 +279,8 @@ static void t_openal_underrun_counted(void)
     }
     au_out_stats st;
     au_out_stats_get(o, &st);
-    T_EQ(st.underruns, 1);
+    /* one for the stall; a machine busy with other work may add more */
+    T_ASSERTF(st.underruns >= 1, "%llu underruns", (unsigned long long)st.underruns);
     T_ASSERT(au_out_close(o, true, &err));
 }
 
@@ -252,9 +305,101 @@ static void t_openal_drops_never_blocks(void)
     au_out_close(o, false, &err);
 }
 
+/* The device path end to end: a replay's soundtrack played in real time
+ * through OpenAL Soft's wave driver (it writes what the device would have
+ * played to a file) is the soundtrack the wav backend writes (the samples
+ * au_replay_track mixes, t_wav_frame_for_frame), shifted by the device's
+ * start-up.  1.5 s of real time. */
+static void t_openal_wave_driver_plays_the_mix(void)
+{
+#ifndef RS_HAVE_OPENAL
+    T_SKIP("built without OpenAL");
+#endif
+    char conf[512], dev_wav[512], text[1200];
+    snprintf(conf, sizeof conf, "%s/alsoft.conf", t_tmpdir());
+    snprintf(dev_wav, sizeof dev_wav, "%s/device.wav", t_tmpdir());
+    snprintf(text, sizeof text,
+             "[general]\nperiod_size = 256\nperiods = 2\nfrequency = 48000\nchannels = stereo\n"
+             "sample-type = float32\n[wave]\nfile = %s\n", dev_wav);
+    t_write(t_tmpdir(), "alsoft.conf", text);
+    setenv("ALSOFT_DRIVERS", "wave", 1);
+    setenv("ALSOFT_CONF", conf, 1);
+
+    rs_err err = {0};
+    rp_replay rp = {0};
+    T_ASSERTF(rp_read(RS_SOURCE_DIR "/demos/harbor.rsr", &rp, &err), "%s", err.msg);
+    au_track tr;
+    enum { TICKS = 90 };
+    T_ASSERTF(au_replay_track(&rp, "harbor", 0, TICKS, &(au_replay_opts){.target_lufs = NAN}, &tr, &err), "%s",
+              err.msg);
+    bool gaps = false;
+    for (int attempt = 1;; attempt++) {
+        au_out *o = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL}, &err);
+        T_ASSERTF(o, "%s", err.msg);
+        double late = paced(o, tr.pcm, TICKS, 0);
+        au_out_stats st;
+        au_out_stats_get(o, &st);
+        T_ASSERT(au_out_close(o, true, &err));
+        printf("attempt %d: writer up to %.1f ms late, %llu underruns, %llu frames dropped\n", attempt, late,
+               (unsigned long long)st.underruns, (unsigned long long)st.dropped);
+        gaps |= late <= ON_TIME_MS && (st.underruns || st.dropped);
+        if (late <= ON_TIME_MS && !st.underruns && !st.dropped)
+            break;
+        T_ASSERTF(attempt < 3 || !gaps, "underruns or drops in every run, though the writer kept 60 Hz within %.0f ms",
+                  ON_TIME_MS);
+        if (attempt == 3)
+            T_SKIP("the machine is too busy: no run kept 60 Hz within %.0f ms", ON_TIME_MS);
+    }
+
+    float *dev = NULL;
+    size_t dev_frames = 0;
+    int ch = 0, rate = 0;
+    T_ASSERTF(au_wav_read(dev_wav, &dev, &dev_frames, &ch, &rate, &err), "%s", err.msg);
+    T_EQ(ch, 2);
+    T_EQ(rate, AU_RATE);
+    /* the lag: where 0.1 s from the middle matches best (normalized, or a
+     * louder passage would win), within 0.3 s */
+    const size_t win = AU_RATE / 10, at = tr.frames / 2, max_lag = AU_RATE * 3 / 10;
+    T_ASSERT(dev_frames > at + win + max_lag);
+    size_t lag = 0;
+    double best = -2;
+    for (size_t l = 0; l <= max_lag; l++) {
+        double xy = 0, yy = 0;
+        for (size_t i = 2 * at; i < 2 * (at + win); i++) {
+            xy += (double)tr.pcm[i] * dev[i + 2 * l];
+            yy += (double)dev[i + 2 * l] * dev[i + 2 * l];
+        }
+        double c = yy > 0 ? xy / sqrt(yy) : -1;
+        if (c > best) {
+            best = c;
+            lag = l;
+        }
+    }
+    /* the correlation over everything both hold at that lag */
+    size_t n = dev_frames - lag < tr.frames ? dev_frames - lag : tr.frames;
+    double xy = 0, xx = 0, yy = 0, diff = 0;
+    for (size_t i = 0; i < 2 * n; i++) {
+        double x = tr.pcm[i], y = dev[i + 2 * lag];
+        xy += x * y;
+        xx += x * x;
+        yy += y * y;
+        diff = fabs(x - y) > diff ? fabs(x - y) : diff;
+    }
+    double corr = xy / sqrt(xx * yy);
+    printf("openal wave driver: offset %.2f ms, correlation %.7f, largest difference %.2g, over %zu frames\n",
+           lag * 1e3 / AU_RATE, corr, diff, n);
+    T_ASSERTF(corr >= 0.99, "correlation %.4f at offset %zu frames", corr, lag);
+    T_EQ(n, tr.frames); /* the last sound was played out, not cut */
+    free(dev);
+    au_track_free(&tr);
+    rp_free(&rp);
+}
+
 T_MAIN({"null_counts", t_null_counts}, {"wav_frame_for_frame", t_wav_frame_for_frame}, {"wav_16bit", t_wav_16bit},
        {"volume_at_output", t_volume_at_output}, {"bad_settings_named", t_bad_settings_named},
        {"wav_bad_path_named", t_wav_bad_path_named}, {"wav_not_ok_removed", t_wav_not_ok_removed},
        {"openal_no_device_named", t_openal_no_device_named}, {"openal_realtime", t_openal_realtime},
+       {"openal_jitter", t_openal_jitter},
        {"openal_underrun_counted", t_openal_underrun_counted},
-       {"openal_drops_never_blocks", t_openal_drops_never_blocks})
+       {"openal_drops_never_blocks", t_openal_drops_never_blocks},
+       {"openal_wave_driver_plays_the_mix", t_openal_wave_driver_plays_the_mix})

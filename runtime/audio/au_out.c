@@ -6,21 +6,27 @@
  * two are OpenAL's own calls (queue, unqueue processed, query offset).
  *
  * DESIGN
- * - Backends are a table of three functions (write, close, a name); adding
- *   one is a row and its functions.  Volume is applied here, before any
- *   backend sees the samples, so the WAV of a run is what the speaker got.
- * - openal: one streaming source fed AL_BUF_FRAMES-frame buffers (half a
- *   tick, 8.3 ms).  At most latency_ms of audio is ever queued on the
- *   source: the number of buffers is latency_ms / 8.3 ms (at least two), so
- *   a sound never waits longer than that behind older audio.  The device
- *   adds its own buffer (OpenAL Soft's period_size x periods, from
- *   alsoft.conf); AL_SOFT_source_latency reports it and the stats count it,
- *   so latency_ms is event to speaker, not just our queue.  Audio handed to OpenAL cannot be taken back (only played
- *   buffers can be unqueued), so when every buffer is queued the oldest
- *   audio still in our hands (the staged half tick) is dropped: the game
- *   never waits for the speaker.  A source that stopped while we were still
- *   feeding it ran dry (the loop stalled): counted as an underrun, and it
- *   restarts once a tick is queued again.
+ * - Backends are a table of two functions (write, close); adding one is
+ *   a row, its functions and a case in au_out_open.  Volume is applied
+ *   here, before any backend sees the samples, so the WAV of a run is what
+ *   the speaker got.
+ * - openal: one streaming source fed AL_BUF_FRAMES-frame buffers (a
+ *   quarter tick, 4.2 ms).  At most latency_ms of audio is queued on the
+ *   source (the number of buffers), so a sound never waits longer than
+ *   that behind older audio; only a device period too long for that
+ *   raises it, to the least that plays without gaps.  Playback starts
+ *   (and restarts after running dry) with all but a tick of that queued:
+ *   the free tick takes a late tick's catch-up, and what is queued beyond
+ *   a tick and the device's period (which it takes at once) is how late a
+ *   tick may come (al_open has the sums).  The device adds its own buffer
+ *   (OpenAL Soft's period_size x periods, from alsoft.conf);
+ *   AL_SOFT_source_latency reports it and the stats count it, so
+ *   latency_ms in the stats is event to speaker, not just our queue.
+ * - Audio handed to OpenAL cannot be taken back (only played buffers can be
+ *   unqueued), so when every buffer is queued the oldest audio still in our
+ *   hands (the staged quarter tick) is dropped: the game never waits for
+ *   the speaker.  A source that stopped while we were still feeding it ran
+ *   dry (the loop stalled): counted as an underrun; it restarts as above.
  * - write_ms reads the monotonic clock; it measures, it never changes what
  *   is played, so the audio stays a pure function of the caller's samples. */
 #include "au_out.h"
@@ -43,8 +49,9 @@ typedef struct au_out_ops {
 } au_out_ops;
 
 #ifdef RS_HAVE_OPENAL
-#define AL_BUF_FRAMES 400
-#define AL_MAX_BUFS 128
+#define AL_BUF_FRAMES 200
+#define AL_MAX_BUFS 512
+#define AL_SLACK_FRAMES 480 /* 10 ms: how late a tick may come, at least */
 typedef struct al_out {
     ALCdevice *dev;
     ALCcontext *ctx;
@@ -56,7 +63,7 @@ typedef struct al_out {
     ALenum format;
     bool float32, playing;
     LPALGETSOURCEDVSOFT get_sourcedv; /* AL_SOFT_source_latency, or NULL */
-    float stage[AL_BUF_FRAMES * AU_CHANNELS]; /* the half tick being filled */
+    float stage[AL_BUF_FRAMES * AU_CHANNELS]; /* the quarter tick being filled */
     int staged;
     int16_t conv[AL_BUF_FRAMES * AU_CHANNELS]; /* without AL_EXT_FLOAT32 */
 } al_out;
@@ -261,8 +268,8 @@ static bool al_close(au_out *o, bool ok, rs_err *err)
     al_out *a = o->al;
     if (ok) {
         alcMakeContextCurrent(a->ctx);
-        /* play out what is queued (at most latency_ms and a half tick),
-         * so the last sound is not cut; the partial half tick is padded */
+        /* play out what is queued (at most latency_ms and a quarter tick),
+         * so the last sound is not cut; the partial quarter tick is padded */
         if (a->staged) {
             memset(a->stage + (size_t)a->staged * AU_CHANNELS, 0,
                    (size_t)(AL_BUF_FRAMES - a->staged) * AU_CHANNELS * sizeof(float));
@@ -320,24 +327,30 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     }
     if (alIsExtensionPresent("AL_SOFT_source_latency"))
         a->get_sourcedv = (LPALGETSOURCEDVSOFT)alGetProcAddress("alGetSourcedvSOFT");
-    /* The device mixes a period at a time: playback starts (and restarts
-     * after running dry) with a period and a tick queued, so the source
-     * still has a period's worth when the next tick comes.  The queue holds
-     * latency_ms, or that and two buffers of slack when a period is long
-     * (OpenAL Soft 1.19 ignores ALC_REFRESH: the period is alsoft.conf's
-     * period_size, 1024 frames unless set), never less or it would drop
-     * audio at a steady 60 Hz. */
+    /* The sums.  The queue holds latency_ms (nbufs buffers).  Playback
+     * starts with all but a tick of it queued (start), or all but a period
+     * when a period is longer: the device takes whole periods, so the
+     * queue swings by that much at a steady rate.  Just before the
+     * next tick arrives the source holds start - 1 tick, and the device
+     * takes a whole period at once, so what is left, start - tick -
+     * period, is how late a tick may be without a gap: at 50 ms with
+     * 256-frame periods, 1600 - 800 - 256 = 544 frames, 11 ms.  When the
+     * period is too long to leave AL_SLACK_FRAMES so (OpenAL Soft 1.19
+     * ignores ALC_REFRESH: the period is alsoft.conf's period_size, 1024
+     * frames at 44.1 kHz unless set), start grows to a period, a tick and
+     * that slack, and the queue to that and a tick: more latency, rather
+     * than gaps whenever a frame of the game runs long. */
     ALCint refresh = 0, freq = 0;
     alcGetIntegerv(a->dev, ALC_REFRESH, 1, &refresh);
     alcGetIntegerv(a->dev, ALC_FREQUENCY, 1, &freq);
     long period = refresh > 0 && freq > 0 ? (long)AU_RATE / refresh : AU_TICK_FRAMES;
-    a->start = (int)((period + AU_TICK_FRAMES + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES);
+    long room = ((period > AU_TICK_FRAMES ? period : AU_TICK_FRAMES) + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES;
+    long least = (period + AU_TICK_FRAMES + AL_SLACK_FRAMES + AL_BUF_FRAMES - 1) / AL_BUF_FRAMES;
     long n = (long)latency_ms * AU_RATE / 1000 / AL_BUF_FRAMES;
-    if (n < a->start + 2)
-        n = a->start + 2;
+    if (n < least + room)
+        n = least + room;
     a->nbufs = n > AL_MAX_BUFS ? AL_MAX_BUFS : (int)n;
-    if (a->start > a->nbufs)
-        a->start = a->nbufs;
+    a->start = a->nbufs - (int)room;
     alGenSources(1, &a->src);
     alGenBuffers(a->nbufs, a->bufs);
     ALenum e = alGetError();
@@ -347,7 +360,13 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
     }
     memcpy(a->idle, a->bufs, sizeof a->bufs);
     a->nidle = a->nbufs;
-    /* the source plays the mix as it is: no distance, no 3-D panning */
+    /* the source plays the mix as it is: no distance, no 3-D panning, and
+     * (AL_SOFT_direct_channels) left and right straight to the front
+     * speakers whatever the layout (5.1, HRTF) instead of as two virtual
+     * speakers at +-30 degrees; on a stereo device 1.19 plays them bit for
+     * bit either way (test_au_out's wave driver case) */
+    if (alIsExtensionPresent("AL_SOFT_direct_channels"))
+        alSourcei(a->src, AL_DIRECT_CHANNELS_SOFT, AL_TRUE);
     alSourcei(a->src, AL_SOURCE_RELATIVE, AL_TRUE);
     alSource3f(a->src, AL_POSITION, 0, 0, 0);
     alSourcef(a->src, AL_ROLLOFF_FACTOR, 0);
