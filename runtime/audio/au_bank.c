@@ -250,12 +250,17 @@ static void crowd(float *b, size_t n, au_rng *r, int voices, double f1, double f
             b[i] += (float)(g * env * (au_bq_run(&a, buzz) + 0.6 * au_bq_run(&c, buzz)));
         }
     }
-    au_biquad bed;
+    au_biquad bed, lp1, lp2;
     au_bq_bandpass(&bed, 900, 0.5);
     for (size_t i = 0; i < n; i++) {
         double t = tsec(i), env = (t < attack ? t / attack : 1) * exp(-t / (hold * 1.2));
         b[i] += (float)(0.8 * env * au_bq_run(&bed, au_rng_white(r)));
     }
+    /* a hall full of people, heard from the ring: no hiss above 4 kHz */
+    au_bq_lowpass(&lp1, 4000, 0.7);
+    au_bq_lowpass(&lp2, 4000, 0.7);
+    for (size_t i = 0; i < n; i++)
+        b[i] = (float)au_bq_run(&lp2, au_bq_run(&lp1, b[i]));
 }
 static void s_crowd_cheer(float *b, size_t n, au_rng *r)
 {
