@@ -10,7 +10,16 @@
  *
  * Everything runs on the 60 Hz loop (loop.c); movies decode on their own
  * thread (player/).  --headless with --script drives the same state
- * machine from a file of timed button presses, for tests. */
+ * machine from a file of timed button presses, for tests.
+ *
+ * Sound: one mixer (runtime/audio) makes each tick's 800 frames after the
+ * tick is stepped: a movie's soundtrack as the mixer's external input, a
+ * demo's or a match's game sounds (au_game_cues) and stage music.  The
+ * mixer is reset whenever an item or a match starts, so a demo sounds
+ * exactly like `ringside replay sound` of its replay (delayed by the tick
+ * that loads it) and a button press that starts a match cuts the movie's
+ * sound at once.  The operator's --attract-sound off silences the loop
+ * (movies and demos) but never a match being played. */
 #include <ctype.h>
 #include <stdarg.h>
 #include <errno.h>
@@ -23,6 +32,7 @@
 
 #include "../player/mv_player.h"
 #include "cli.h"
+#include "snd_out.h"
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/input.h"
@@ -38,7 +48,8 @@ static void help(void)
 {
     printf("usage: ringside attract [MOVIE ...] [--demo REPLAY ...] [--idle SECONDS] [--fullscreen]\n"
            "                        [--size WxH] [--upload MODE] [--headless --script FILE --ticks N]\n"
-           "                        [--screenshot FILE] [--quiet]\n\n"
+           "                        [--screenshot FILE] [--quiet] [--attract-sound on|off] [--mute]\n"
+           "                        [--volume V] [--audio-out FILE.wav] [--audio-device NAME] [-y]\n\n"
            "The cabinet's attract loop: plays the movies and demo replays in the order given,\n"
            "over and over, until a player presses any button; then a match against the CPU.\n"
            "After the match, or after --idle seconds without input, back to the loop.  A file\n"
@@ -55,11 +66,24 @@ static void help(void)
            "                  by '+': up down left right punch kick guard start\n"
            "  --ticks N       stop after N ticks\n"
            "  --screenshot F  save the last frame (.png or .ppm)\n"
-           "  --quiet         no log lines\n");
+           "  --quiet         no log lines\n"
+           "  --attract-sound on|off\n"
+           "                  the operator's attract-sound setting: off silences the loop (movies'\n"
+           "                  soundtracks, demos' game sound and music); a match always has sound\n"
+           "                  (default on)\n"
+           "  --mute          no sound at all (with --audio-out: a silent WAV)\n"
+           "  --volume V      sound level, linear 0..1 (default 1; 0 is --mute)\n"
+           "  --audio-out F   write the sound to F.wav (16-bit, 48 kHz stereo) instead of the device:\n"
+           "                  800 frames per tick, headless or not\n"
+           "  --audio-device N\n"
+           "                  the OpenAL device (default: the system's); without one: one\n"
+           "                  warning line, and the loop runs silent\n"
+           "  -y, --overwrite replace an existing --audio-out file\n");
 }
 
 enum { ITEM_MOVIE, ITEM_DEMO };
 enum { MODE_LOOP, MODE_MATCH };
+enum { SOUND_NONE, SOUND_GAME, SOUND_MOVIE }; /* what the tick just stepped sounds like */
 
 typedef struct item {
     int kind;
@@ -105,6 +129,13 @@ typedef struct attract {
     bool quiet, quit, failed, headless;
     uint64_t seed;
     rs_err err;
+    /* sound */
+    snd_opts snd;
+    bool attract_sound, overwrite;
+    au_out *out;  /* NULL: silent */
+    au_mixer *mix;
+    int sound;    /* SOUND_*, set by this tick's step */
+    float pcm[AU_TICK_FRAMES * 2], ext[AU_TICK_FRAMES * 2];
 } attract;
 
 static void logf_(attract *a, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -208,6 +239,10 @@ static void stop_item(attract *a)
     a->demo_loaded = false;
     a->cpu_demo = false;
     a->on = false;
+    if (a->mix) { /* whatever was sounding stops with its item */
+        au_mixer_reset(a->mix);
+        au_mixer_music(a->mix, -1); /* a game's steps set it again */
+    }
 }
 
 static bool prepare_stage(attract *a, int stage)
@@ -234,6 +269,8 @@ static bool start_next(attract *a)
             if (a->mp) {
                 const mv_info *i = mv_player_info(a->mp);
                 logf_(a, "movie %s (%s %dx%d, %d/%d fps)", it->path, i->codec, i->w, i->h, i->fps_num, i->fps_den);
+                if (mv_player_audio_why(a->mp)[0])
+                    logf_(a, "%s: playing it silent", mv_player_audio_why(a->mp));
                 a->on = true;
                 return true;
             }
@@ -309,6 +346,49 @@ static void back_to_loop(attract *a, const char *why)
         a->failed = true;
 }
 
+/* --- sound --- */
+
+static bool audible(const attract *a)
+{
+    return a->out && !a->snd.mute && (a->mode == MODE_MATCH || a->attract_sound);
+}
+
+/* One tick of the game, its sounds cued. */
+static void game_step(attract *a, const g_input in[2])
+{
+    g_events events;
+    a->prev = a->st;
+    g_step(&a->st, in, &events);
+    if (!audible(a))
+        return;
+    au_cue cues[AU_MAX_CUES];
+    int n = au_game_cues(&a->prev, &a->st, &events, cues, AU_MAX_CUES);
+    for (int i = 0; i < n; i++)
+        au_mixer_cue(a->mix, &cues[i]);
+    au_mixer_music(a->mix, a->st.stage);
+    a->sound = SOUND_GAME;
+}
+
+/* The tick's audio, after its step: silence on a tick that started
+ * something (nothing was stepped yet) or when the loop is silenced. */
+static void emit_sound(attract *a)
+{
+    if (!a->out)
+        return;
+    int what = audible(a) ? a->sound : SOUND_NONE;
+    a->sound = SOUND_NONE;
+    if (what == SOUND_NONE) {
+        memset(a->pcm, 0, sizeof a->pcm);
+    } else if (what == SOUND_MOVIE) {
+        mv_player_audio(a->mp, a->ext, AU_TICK_FRAMES);
+        au_mixer_mix(a->mix, a->pcm, AU_TICK_FRAMES, a->ext, 1.0f);
+    } else {
+        au_mixer_mix(a->mix, a->pcm, AU_TICK_FRAMES, NULL, 0);
+    }
+    if (!au_out_write(a->out, a->pcm, AU_TICK_FRAMES, &a->err))
+        a->failed = true;
+}
+
 /* --- the loop's callbacks --- */
 
 static void on_input(void *user, g_input in[2])
@@ -327,6 +407,43 @@ static void on_input(void *user, g_input in[2])
     }
 }
 
+/* Plays the loop item's tick.  False when it is over or broken: it is
+ * stopped, and the caller starts the next. */
+static bool play_item(attract *a)
+{
+    if (a->mp) {
+        rs_err e = {0};
+        int r = mv_player_tick(a->mp, &e);
+        if (r == 1) {
+            a->sound = SOUND_MOVIE;
+            return true;
+        }
+        if (r < 0) {
+            logf_(a, "skipping %s from now on: %s", a->items[a->cur].path, e.msg);
+            a->items[a->cur].bad = true;
+        } else if (mv_player_frame(a->mp) < 0) {
+            logf_(a, "skipping %s from now on: it has no frames", a->items[a->cur].path);
+            a->items[a->cur].bad = true;
+        }
+        stop_item(a);
+        return false;
+    }
+    if (a->cpu_demo) {
+        g_input ai[2] = {g_ai_input(&a->ai[0], &a->st), g_ai_input(&a->ai[1], &a->st)};
+        game_step(a, ai);
+        if (a->st.matches > a->matches0 && a->st.phase != G_PHASE_MATCH_END)
+            a->on = false; /* its last picture and sound stay this tick; the next item starts on the next */
+        return true;
+    }
+    if (a->demo_tick >= a->demo.ticks) {
+        stop_item(a);
+        return false;
+    }
+    game_step(a, &a->demo.inputs[2 * a->demo_tick]);
+    a->demo_tick++;
+    return true;
+}
+
 static void on_step(void *user, const g_input in[2])
 {
     attract *a = user;
@@ -339,35 +456,14 @@ static void on_step(void *user, const g_input in[2])
         if (pressed[0] || pressed[1]) {
             if (!start_match(a, pressed[0] ? 0 : 1))
                 a->failed = true;
-        } else if (!a->on) {
-            if (!loop_next(a))
-                a->failed = true;
-        } else if (a->mp) {
-            rs_err e = {0};
-            int r = mv_player_tick(a->mp, &e);
-            if (r < 0) {
-                logf_(a, "skipping %s from now on: %s", a->items[a->cur].path, e.msg);
-                a->items[a->cur].bad = true;
-            } else if (r == 0 && mv_player_frame(a->mp) < 0) {
-                logf_(a, "skipping %s from now on: it has no frames", a->items[a->cur].path);
-                a->items[a->cur].bad = true;
-            }
-            if (r <= 0 && !loop_next(a))
-                a->failed = true;
-        } else if (a->cpu_demo) {
-            g_input ai[2] = {g_ai_input(&a->ai[0], &a->st), g_ai_input(&a->ai[1], &a->st)};
-            a->prev = a->st;
-            g_step(&a->st, ai, NULL);
-            if (a->st.matches > a->matches0 && a->st.phase != G_PHASE_MATCH_END && !loop_next(a))
-                a->failed = true;
-        } else if (a->demo_loaded) {
-            if (a->demo_tick >= a->demo.ticks) {
-                if (!loop_next(a))
+        } else {
+            /* an item that ends hands its tick to the next one: no dead
+             * tick (a black frame, a gap in the sound) between items */
+            for (int k = 0; k <= a->nitems + 1 && !a->failed; k++) {
+                if (!a->on && !loop_next(a))
                     a->failed = true;
-            } else {
-                a->prev = a->st;
-                g_step(&a->st, &a->demo.inputs[2 * a->demo_tick], NULL);
-                a->demo_tick++;
+                else if (play_item(a))
+                    break;
             }
         }
     } else {
@@ -377,8 +473,7 @@ static void on_step(void *user, const g_input in[2])
         gi[1 - h] = g_ai_input(&a->ai[1 - h], &a->st);
         if (in[0] || in[1])
             a->last_input = a->tick;
-        a->prev = a->st;
-        g_step(&a->st, gi, NULL);
+        game_step(a, gi);
         if (a->st.matches > a->matches0 && a->st.phase != G_PHASE_MATCH_END) {
             char why[64];
             snprintf(why, sizeof why, "match over (winner: %s)",
@@ -390,6 +485,7 @@ static void on_step(void *user, const g_input in[2])
             back_to_loop(a, why);
         }
     }
+    emit_sound(a);
     a->tick++;
 }
 
@@ -461,7 +557,10 @@ int cmd_attract(int argc, char **argv)
         {"upload", required_argument, 0, 'u'}, {"headless", no_argument, 0, 'H'},
         {"script", required_argument, 0, 's'}, {"ticks", required_argument, 0, 'n'},
         {"screenshot", required_argument, 0, 'o'}, {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},         {0}};
+        {"help", no_argument, 0, 'h'},         {"attract-sound", required_argument, 0, 'S'},
+        {"mute", no_argument, 0, 'M'},         {"volume", required_argument, 0, 'V'},
+        {"audio-out", required_argument, 0, 'A'}, {"audio-device", required_argument, 0, 'D'},
+        {"overwrite", no_argument, 0, 'y'},    {0}};
     attract *a = calloc(1, sizeof *a);
     item *items = calloc((size_t)argc + 1, sizeof *items);
     if (!a || !items) {
@@ -476,6 +575,7 @@ int cmd_attract(int argc, char **argv)
     a->h = 720;
     a->idle_ticks = 30 * G_HZ;
     a->seed = (uint64_t)time(NULL);
+    a->attract_sound = true;
     int c, status = RS_EXIT_USAGE;
     long n;
     const char *script = NULL, *shot = NULL;
@@ -483,7 +583,7 @@ int cmd_attract(int argc, char **argv)
     optind = 1;
     opterr = 0;
     /* "-" first: movies and --demo keep their command-line order */
-    while ((c = getopt_long(argc, argv, "-qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "-qhy", opts, NULL)) != -1) {
         switch (c) {
         case 1: items[a->nitems++] = (item){ITEM_MOVIE, optarg, false}; break;
         case 'd': items[a->nitems++] = (item){ITEM_DEMO, optarg, false}; break;
@@ -509,6 +609,18 @@ int cmd_attract(int argc, char **argv)
             break;
         case 'o': shot = optarg; break;
         case 'q': a->quiet = true; break;
+        case 'S':
+            if (strcmp(optarg, "on") && strcmp(optarg, "off")) {
+                cli_error("attract", "--attract-sound '%s': expected on or off", optarg);
+                goto done;
+            }
+            a->attract_sound = !strcmp(optarg, "on");
+            break;
+        case 'M': a->snd.mute = true; break;
+        case 'V': if (!snd_volume_arg("attract", optarg, &a->snd)) goto done; break;
+        case 'A': a->snd.wav = optarg; break;
+        case 'D': a->snd.device = optarg; break;
+        case 'y': a->overwrite = true; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
             status = cli_bad_option("attract", argv);
@@ -536,6 +648,12 @@ int cmd_attract(int argc, char **argv)
     if (a->headless)
         a->seed = 1; /* the same run every time */
     a->po.wait = a->headless;
+    bool fatal;
+    if (!(a->out = snd_open("attract", &a->snd, a->headless, a->overwrite, &fatal)) && fatal)
+        goto done;
+    if (a->out && !(a->mix = au_mixer_new(NULL, &a->err)))
+        goto done;
+    a->po.mute = !a->out || a->snd.mute || !a->attract_sound; /* movies play only in the loop */
     pd.backend = a->headless ? NULL : "glfw";
     pd.width = a->w;
     pd.height = a->h;
@@ -557,11 +675,19 @@ int cmd_attract(int argc, char **argv)
     if (shot && !screenshot(a, shot))
         goto done;
     logf_(a, "stopped (%s) after %.1f s", a->quit ? "quit" : "--ticks", ls.seconds);
+    if (!a->quiet)
+        snd_summary("attract", a->out, a->snd.mute ? "muted" : a->attract_sound ? "mixer" : "mixer (attract sound off)");
+    bool aok = snd_close("attract", a->out, true);
+    a->out = NULL;
+    if (!aok)
+        goto done;
     status = RS_EXIT_OK;
 done:
     if (status == RS_EXIT_FAIL && a->err.msg[0])
         cli_error("attract", "%s", a->err.msg);
     stop_item(a);
+    snd_close("attract", a->out, false);
+    au_mixer_free(a->mix);
     if (a->p) {
         r_target_destroy(&a->target);
         r_game_destroy(a->r);

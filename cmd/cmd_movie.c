@@ -3,7 +3,9 @@
  * Headless (--dump, --hashes or --headless) plays every tick as fast as
  * possible and waits for the decoder, so the output is exact: the frames
  * the display would have shown, tick by tick.  That is what the colour and
- * pacing tests read. */
+ * pacing tests read.  The soundtrack goes out tick by tick too, 800 frames
+ * after each picture (player/mv_audio.h): to the audio device, or with
+ * --audio-out to a WAV that holds exactly the played ticks' audio. */
 #include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
@@ -15,6 +17,7 @@
 #include "../player/mv_csp.h"
 #include "../player/mv_player.h"
 #include "cli.h"
+#include "snd_out.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/input.h"
 #include "../runtime/loop.h"
@@ -28,11 +31,14 @@ static void help(void)
 {
     printf("usage: ringside movie FILE [--dump DIR] [--hashes FILE] [-y|-n] [--headless] [--ticks N]\n"
            "                      [--upload pbo|direct|persistent] [--matrix bt601|bt709]\n"
-           "                      [--range limited|full] [--size WxH] [--fullscreen] [--loop] [--quiet]\n\n"
+           "                      [--range limited|full] [--size WxH] [--fullscreen] [--loop] [--quiet]\n"
+           "                      [--mute] [--volume V] [--audio-out FILE.wav] [--audio-device NAME]\n\n"
            "Plays a movie on the 60 Hz tick: Y4M (8-bit 4:2:0, 4:2:2, 4:4:4, mono) or anything\n"
            "FFmpeg decodes (H.264, VP9, AV1, ...).  Frames are decoded on their own thread,\n"
            "streamed into Y, Cb, Cr textures and converted with the stream's matrix and range.\n"
            "A 24 fps movie shows its frames for 2 and 3 ticks in turn; 30 fps for 2 (docs/player.md).\n"
+           "The movie's sound (its best audio stream: any rate, format and layout, downmixed to\n"
+           "stereo 48 kHz) plays in step with the picture through OpenAL.\n"
            "In a window (GLFW; needs X, or xvfb-run -a) Escape quits.\n\n"
            "  --dump DIR      headless: write each displayed frame as DIR/frameNNNNNN.ppm (NNNNNN is\n"
            "                  the movie frame number)\n"
@@ -52,7 +58,14 @@ static void help(void)
            "  --size WxH      output size (default: the movie's display size)\n"
            "  --fullscreen    window: primary monitor\n"
            "  --loop          window: start again at the end (Escape quits)\n"
-           "  --quiet         no summary line\n");
+           "  --quiet         no summary line\n"
+           "  --mute          no sound (with --audio-out: a silent WAV of the same length)\n"
+           "  --volume V      sound level, linear 0..1 (default 1; 0 is --mute)\n"
+           "  --audio-out F   write the sound to F.wav (16-bit, 48 kHz stereo) instead of the device,\n"
+           "                  one tick of audio per tick played; headless or not (-y replaces F)\n"
+           "  --audio-device N\n"
+           "                  the OpenAL device to play on (default: the system's).  Without a\n"
+           "                  device: one warning line, and the movie plays silent\n");
 }
 
 typedef struct mv_cmd {
@@ -67,6 +80,8 @@ typedef struct mv_cmd {
     const char *dump;
     FILE *hashes;
     uint8_t *px;
+    au_out *out; /* NULL: silent */
+    float pcm[AU_TICK_FRAMES * 2];
     int ended; /* tick returned 0 */
     rs_err err;
 } mv_cmd;
@@ -75,6 +90,16 @@ static void on_input(void *user, g_input in[2])
 {
     (void)user;
     in[0] = in[1] = 0;
+}
+
+/* The sound of the tick just played, after its picture. */
+static void play_audio(mv_cmd *s)
+{
+    if (!s->out)
+        return;
+    mv_player_audio(s->mp, s->pcm, AU_TICK_FRAMES);
+    if (!au_out_write(s->out, s->pcm, AU_TICK_FRAMES, &s->err))
+        s->failed = true;
 }
 
 static void on_step(void *user, const g_input in[2])
@@ -95,11 +120,14 @@ static void on_step(void *user, const g_input in[2])
             }
             if (mv_player_tick(s->mp, &s->err) < 0)
                 s->failed = true;
+            else
+                play_audio(s);
             return;
         }
         s->ended = 1;
         return;
     }
+    play_audio(s);
     s->ticks++;
 }
 
@@ -175,6 +203,23 @@ static void summary(mv_cmd *s, const lp_stats *ls)
             st.up.uploads ? st.up.copy_ms / (double)st.up.uploads : 0.0,
             st.up.uploads ? st.up.upload_ms / (double)st.up.uploads : 0.0, st.up.staged,
             st.decoded ? st.decode_ms / (double)st.decoded : 0.0);
+    const mv_audio_info *ai = mv_player_audio_info(s->mp);
+    char src[160];
+    if (ai) {
+        snprintf(src, sizeof src, "%s %d Hz %s %s", ai->codec, ai->rate, ai->layout, ai->format);
+        fprintf(stderr,
+                "ringside movie: sound: %s: %" PRId64 " ticks, %" PRId64 " late (silent), %" PRId64
+                " damaged packets skipped; decode+resample %.4f ms CPU per tick\n",
+                src, st.audio.reads, st.audio.late, st.audio.bad_packets,
+                st.audio.reads ? st.audio.cpu_ms / (double)st.audio.reads : 0.0);
+    } else if (!s->po.mute) {
+        const char *why = mv_player_audio_why(s->mp);
+        snprintf(src, sizeof src, "%s", why[0] ? "unplayable" : "none");
+        fprintf(stderr, "ringside movie: sound: %s\n", why[0] ? why : "none (no audio stream)");
+    } else {
+        snprintf(src, sizeof src, "muted");
+    }
+    snd_summary("movie", s->out, src);
 }
 
 int cmd_movie(int argc, char **argv)
@@ -187,6 +232,8 @@ int cmd_movie(int argc, char **argv)
         {"fullscreen", no_argument, 0, 'f'},    {"loop", no_argument, 0, 'L'},
         {"quiet", no_argument, 0, 'q'},         {"help", no_argument, 0, 'h'},
         {"overwrite", no_argument, 0, 'y'},     {"no-overwrite", no_argument, 0, 'n'},
+        {"mute", no_argument, 0, 'M'},          {"volume", required_argument, 0, 'V'},
+        {"audio-out", required_argument, 0, 'A'}, {"audio-device", required_argument, 0, 'D'},
         {0}};
     mv_cmd *s = calloc(1, sizeof *s);
     if (!s)
@@ -194,8 +241,9 @@ int cmd_movie(int argc, char **argv)
     s->last_dumped = -1;
     int c, status = RS_EXIT_USAGE;
     long n;
-    bool quiet = false;
+    bool quiet = false, fatal;
     const char *hashes = NULL;
+    snd_opts snd = {0};
     plat_desc pd = {.title = "ringside movie"};
     optind = 1;
     opterr = 0;
@@ -241,6 +289,10 @@ int cmd_movie(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'y': s->overwrite = true; break;
         case 'n': s->overwrite = false; break;
+        case 'M': snd.mute = true; break;
+        case 'V': if (!snd_volume_arg("movie", optarg, &snd)) goto done; break;
+        case 'A': snd.wav = optarg; break;
+        case 'D': snd.device = optarg; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:
             status = cli_bad_option("movie", argv);
@@ -270,6 +322,10 @@ int cmd_movie(int argc, char **argv)
     if (!probe)
         goto done;
     mv_close(probe);
+    /* a --audio-out that cannot be written stops us before anything plays */
+    if (!(s->out = snd_open("movie", &snd, s->headless, s->overwrite, &fatal)) && fatal)
+        goto done;
+    s->po.mute = snd.mute || !s->out; /* nothing to play it on: do not decode it */
     pd.backend = s->headless ? NULL : "glfw";
     pd.width = s->w ? s->w : 1280;
     pd.height = s->h ? s->h : 720;
@@ -301,6 +357,10 @@ int cmd_movie(int argc, char **argv)
         summary(s, &ls);
     if (s->failed)
         goto done;
+    bool aok = snd_close("movie", s->out, true);
+    s->out = NULL;
+    if (!aok)
+        goto done;
     if (s->hashes) {
         bool hok = cli_text_close("movie", hashes, s->hashes);
         s->hashes = NULL;
@@ -311,6 +371,7 @@ int cmd_movie(int argc, char **argv)
 done:
     if (status == RS_EXIT_FAIL && s->err.msg[0])
         cli_error("movie", "%s", s->err.msg);
+    snd_close("movie", s->out, false);
     if (s->hashes && s->hashes != stdout)
         fclose(s->hashes);
     if (s->p) {

@@ -12,6 +12,8 @@ struct mv_player {
     mv_src *src;
     mv_dec *dec;
     mv_up *up;
+    mv_audio *audio;    /* NULL: silent (audio_err says why) */
+    rs_err audio_err;
     int nslots;
     int64_t tick;       /* the next tick to play */
     int64_t shown;      /* frame on the textures */
@@ -66,6 +68,10 @@ mv_player *mv_player_open(const char *path, const mv_player_opts *o, rs_err *err
         rs_err_prefix(err, "%s", path);
         goto fail;
     }
+    /* Y4M has no sound; anything else may.  A soundtrack that cannot be
+     * played leaves the movie silent, never unplayable. */
+    if (!o->mute && strcmp(i->codec, "y4m") && (p->audio = mv_audio_open(path, &p->audio_err)))
+        mv_audio_prime(p->audio, AU_TICK_FRAMES, 250); /* the first tick on time; a load-time wait */
     return p;
 fail:
     mv_player_close(p);
@@ -186,6 +192,25 @@ int64_t mv_player_frame(const mv_player *p)
     return p->shown;
 }
 
+bool mv_player_audio(mv_player *p, float *out, int frames)
+{
+    if (!p->audio || p->tick == 0) {
+        memset(out, 0, (size_t)frames * 2 * sizeof *out);
+        return true;
+    }
+    return mv_audio_read(p->audio, (p->tick - 1) * AU_TICK_FRAMES, out, frames, p->wait);
+}
+
+const mv_audio_info *mv_player_audio_info(const mv_player *p)
+{
+    return p->audio ? mv_audio_info_get(p->audio) : NULL;
+}
+
+const char *mv_player_audio_why(const mv_player *p)
+{
+    return p->audio_err.msg;
+}
+
 void mv_player_draw(mv_player *p, int vw, int vh)
 {
     if (p->shown < 0) {
@@ -204,12 +229,15 @@ void mv_player_stats(const mv_player *p, mv_stats *st)
         mv_dec_stats(p->dec, &st->decode_ms, &st->decoded);
     if (p->up)
         mv_up_stats_get(p->up, &st->up);
+    if (p->audio)
+        mv_audio_stats_get(p->audio, &st->audio);
 }
 
 void mv_player_close(mv_player *p)
 {
     if (!p)
         return;
+    mv_audio_close(p->audio);
     mv_dec_stop(p->dec); /* before the slot memory goes */
     mv_up_destroy(p->up);
     mv_close(p->src);

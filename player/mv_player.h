@@ -20,6 +20,7 @@
 #include <stdint.h>
 
 #include "mv.h"
+#include "mv_audio.h"
 #include "mv_up.h"
 
 enum { MV_OVERRIDE_601 = 1, MV_OVERRIDE_709, MV_OVERRIDE_LIMITED = 1, MV_OVERRIDE_FULL };
@@ -30,6 +31,7 @@ typedef struct mv_player_opts {
     int matrix;     /* 0: the stream's; MV_OVERRIDE_601 / _709 */
     int range;      /* 0: the stream's; MV_OVERRIDE_LIMITED / _FULL */
     int slots;      /* decode queue depth; 0 -> 4 */
+    bool mute;      /* do not decode the soundtrack (mv_player_audio gives silence) */
 } mv_player_opts;
 
 typedef struct mv_stats {
@@ -42,6 +44,7 @@ typedef struct mv_stats {
     int64_t decoded;
     double decode_ms; /* decoder thread time */
     mv_up_stats up;
+    mv_audio_stats audio; /* zero without a soundtrack */
 } mv_stats;
 
 typedef struct mv_player mv_player;
@@ -61,6 +64,17 @@ int mv_player_upload(const mv_player *p); /* MV_UP_* */
 int mv_player_tick(mv_player *p, rs_err *err);
 /* The frame index on the textures, -1 before the first. */
 int64_t mv_player_frame(const mv_player *p);
+/* The soundtrack of the tick just played (mv_audio.h: tick t is frames
+ * [t * AU_TICK_FRAMES, t * AU_TICK_FRAMES + frames) of the track), frames
+ * stereo 48 kHz float frames into out.  Silence before the first tick,
+ * after the track's end, and for a movie without sound.  Not decoded in
+ * time: silence, counted late, false; in `wait` mode it waits instead. */
+bool mv_player_audio(mv_player *p, float *out, int frames);
+/* The soundtrack's stream, or NULL when the movie plays silent; then
+ * mv_player_audio_why says why ("" for a movie with no audio stream,
+ * else the message: an undecodable codec, ...). */
+const mv_audio_info *mv_player_audio_info(const mv_player *p);
+const char *mv_player_audio_why(const mv_player *p);
 void mv_player_draw(mv_player *p, int vw, int vh);
 void mv_player_stats(const mv_player *p, mv_stats *st);
 void mv_player_close(mv_player *p);
