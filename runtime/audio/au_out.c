@@ -330,6 +330,90 @@ static void restore_stderr(int saved)
     close(saved);
 }
 
+/* Whether an OpenAL Soft config file the user or the system keeps sets the
+ * mixing period (period_size or periods, in any section). */
+static bool al_conf_sets_period(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return false;
+    char line[512];
+    bool found = false;
+    while (!found && fgets(line, sizeof line, f)) {
+        const char *p = line + strspn(line, " \t");
+        found = !strncmp(p, "period_size", 11) || !strncmp(p, "periods", 7);
+    }
+    fclose(f);
+    return found;
+}
+
+/* OpenAL Soft 1.19 takes its mixing period from its config files, not from
+ * the program (it ignores ALC_REFRESH), and Debian's default (1024 frames x
+ * 3) alone adds about 64 ms at 48 kHz: over the 50 ms the game allows.  So
+ * before OpenAL reads its config (once, at the first device call) we lay a
+ * file of our own over the others through ALSOFT_CONF, which it reads last
+ * and key by key: period_size 256, periods 2 (about 11 ms).  Not when the
+ * user has set ALSOFT_CONF, nor when a config they or the system keep
+ * (/etc/openal/alsoft.conf, $XDG_CONFIG_DIRS, ~/.alsoftrc,
+ * $XDG_CONFIG_HOME/alsoft.conf) sets the period itself: theirs wins.  The
+ * file is removed once read (al_conf_unlayer, after the first device
+ * call).  path gets the file's name, or "" when none was laid. */
+static void al_conf_layer(char *path, size_t size)
+{
+    static bool done;
+    path[0] = 0;
+    if (done)
+        return;
+    done = true;
+    if (getenv("ALSOFT_CONF"))
+        return;
+    char conf[1024]; /* the user's and the system's files, only read */
+    const char *home = getenv("HOME"), *xdg = getenv("XDG_CONFIG_HOME"), *dirs = getenv("XDG_CONFIG_DIRS");
+    if (al_conf_sets_period("/etc/openal/alsoft.conf"))
+        return;
+    snprintf(conf, sizeof conf, "%s/alsoft.conf", dirs && *dirs && !strchr(dirs, ':') ? dirs : "/etc/xdg");
+    if (al_conf_sets_period(conf))
+        return;
+    if (home) {
+        snprintf(conf, sizeof conf, "%s/.alsoftrc", home);
+        if (al_conf_sets_period(conf))
+            return;
+    }
+    if (xdg && *xdg)
+        snprintf(conf, sizeof conf, "%s/alsoft.conf", xdg);
+    else if (home)
+        snprintf(conf, sizeof conf, "%s/.config/alsoft.conf", home);
+    if ((xdg && *xdg) || home) {
+        if (al_conf_sets_period(conf))
+            return;
+    }
+    const char *tmp = getenv("TMPDIR");
+    snprintf(path, size, "%s/ringside-alsoft-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    int fd = mkstemp(path);
+    if (fd < 0) {
+        path[0] = 0;
+        return; /* OpenAL's own periods: more latency, still sound */
+    }
+    static const char layer[] = "# ringside (au_out.c): OpenAL Soft's mixing period for 50 ms of latency\n"
+                                "[general]\nperiod_size = 256\nperiods = 2\n";
+    bool ok = write(fd, layer, sizeof layer - 1) == (ssize_t)(sizeof layer - 1);
+    close(fd);
+    if (!ok || setenv("ALSOFT_CONF", path, 1)) {
+        unlink(path);
+        path[0] = 0;
+    }
+}
+
+/* After the first device call: OpenAL Soft has read its config. */
+static void al_conf_unlayer(char *path)
+{
+    if (!path[0])
+        return;
+    unsetenv("ALSOFT_CONF");
+    unlink(path);
+    path[0] = 0;
+}
+
 static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *err)
 {
     al_out *a = calloc(1, sizeof *a);
@@ -337,7 +421,10 @@ static bool al_open(au_out *o, const au_out_opts *opts, int latency_ms, rs_err *
         return rs_fail(err, AU_ERR_NOMEM, "out of memory for the audio output");
     o->al = a;
     int saved = quiet_stderr();
+    char layer[1024];
+    al_conf_layer(layer, sizeof layer);
     a->dev = alcOpenDevice(opts->device);
+    al_conf_unlayer(layer);
     restore_stderr(saved);
     if (!a->dev) {
         if (opts->device)
