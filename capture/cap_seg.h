@@ -17,6 +17,7 @@
  *   render: cap_seg_seal(seg, key, A, B, hashes)       after the files are in place
  *   join:   j = cap_join_open(&desc)                    output directory writable?
  *           cap_seg_verify(segs, n, &want, bad, ctx)    every segment, and all together
+ *           cap_join_audio(j, sink)                     optional: the whole job's track
  *           cap_join_copy(j, segs, n, &bad)             stream copy
  *           cap_join_close(j, ok)                       faststart, rename into place
  *
@@ -110,6 +111,11 @@ typedef struct cap_join_desc {
 /* Creates OUT.part (and HASHES.part): fails with CAP_ERR_CREATE when the
  * output directory is gone or not writable, before any segment is read. */
 cap_join *cap_join_open(const cap_join_desc *d, rs_err *err);
+/* Optional, before cap_join_copy: an audio stream, the track, codec and
+ * bitrate of `audio` (a sink of the output given them by cap_sink_audio:
+ * the track covers the joined ticks, 800 sample frames each), encoded as
+ * the video is copied, so the sound is one piece across segment joins. */
+void cap_join_audio(cap_join *j, const cap_sink *audio);
 /* Stream-copies the verified segments in order: pts continue from one
  * segment to the next (the video starts at pts 0, as any render does),
  * dts = position - the largest B-frame delay, so they rise by one a
