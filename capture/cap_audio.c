@@ -69,11 +69,11 @@ const char *cap_sink_audio_codec(const cap_sink *s)
 
 /* The encoder of each codec, and the bitrates it takes (stereo, 48 kHz). */
 static const struct {
-    const char *codec, *encoder;
+    const char *codec, *encoder, *shown;
     int64_t lo, hi, def;
 } acodecs[] = {
-    {"aac", "aac", 32000, 512000, AAC_DEFAULT},
-    {"opus", "libopus", 16000, 510000, OPUS_DEFAULT},
+    {"aac", "aac", "AAC", 32000, 512000, AAC_DEFAULT},
+    {"opus", "libopus", "Opus", 16000, 510000, OPUS_DEFAULT},
 };
 
 bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrate, rs_err *err)
@@ -90,7 +90,7 @@ bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrat
                            acodecs[i].encoder, codec);
         if (bitrate && (bitrate < acodecs[i].lo || bitrate > acodecs[i].hi))
             return rs_fail(err, CAP_ERR_ENC_SETTING, "%s: --audio-bitrate %lldk: %s takes %lldk..%lldk", s->path,
-                           (long long)(bitrate / 1000), codec, (long long)(acodecs[i].lo / 1000), (long long)(acodecs[i].hi / 1000));
+                           (long long)(bitrate / 1000), acodecs[i].shown, (long long)(acodecs[i].lo / 1000), (long long)(acodecs[i].hi / 1000));
         s->audio = pcm;
         s->audio_frames = frames;
         s->audio_bitrate = bitrate ? bitrate : acodecs[i].def;

@@ -76,11 +76,11 @@ bool job_audio_check(job_audio *a, const char *cmd, cap_sink *s, bool *usage, rs
             return false;
         s->audio = NULL;
     }
+    *usage = false; /* an output that exists or has no folder: exit 1, as for the others */
     if (a->wav && !cli_out_ok(cmd, a->wav, a->overwrite)) {
         err->msg[0] = 0; /* said */
         return false;
     }
-    *usage = false;
     return true;
 }
 
