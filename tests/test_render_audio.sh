@@ -24,7 +24,7 @@ durations() {
         awk -F, '{e = $1 + $2; if (e > m) m = e} END {print m}')
     [ "$a" = N/A ] && a=$(ffprobe -v error -select_streams a:0 -show_entries packet=pts_time,duration_time -of csv=p=0 "$1" |
         awk -F, '{e = $1 + $2; if (e > m) m = e} END {print m}')
-    echo "$v $a"
+    echo "${v:-none} ${a:-none}"
 }
 
 codec_of() { # FILE STREAM -> codec name, or nothing
