@@ -85,6 +85,9 @@ TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
 LIB_CXX  := $(wildcard runtime/util/*.cpp)
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
+# the announcer's clips, embedded in the binary (runtime/audio/au_voice_data.S)
+VOICE_OBJ := $(BUILD)/obj/runtime/audio/au_voice_data.o
+LIB_OBJ  += $(VOICE_OBJ)
 MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 
 # lower layers never include higher ones (docs/architecture.md, Layers);
@@ -122,6 +125,10 @@ $(BUILD)/obj/%.o: %.c $(BUILD)/config.mk $(BUILD)/flags
 $(BUILD)/obj/%.o: %.cpp $(BUILD)/config.mk $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -c $< -o $@
+
+$(VOICE_OBJ): runtime/audio/au_voice_data.S $(wildcard runtime/audio/voice/*.wav) $(BUILD)/config.mk $(BUILD)/flags
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Wa,-I,$(CURDIR) -c $< -o $@
 
 $(BUILD)/libringside.a: $(LIB_OBJ)
 	@rm -f $@

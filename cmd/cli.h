@@ -48,6 +48,7 @@ int cmd_movie(int argc, char **argv);
 int cmd_attract(int argc, char **argv);
 int bench_upload(int argc, char **argv);
 int bench_encode(int argc, char **argv);
+int bench_audio(int argc, char **argv);
 int cmd_serve(int argc, char **argv);
 int cmd_join(int argc, char **argv);
 

@@ -26,7 +26,8 @@ static void help(void)
            "       ringside bench capture [--frames N] [--sink mp4|y4m|null] ... (see bench capture --help)\n"
            "       ringside bench accuracy [--frames N] ... (see bench accuracy --help)\n"
            "       ringside bench upload [--frames N] [--modes LIST] ... (see bench upload --help)\n"
-           "       ringside bench encode [--frames N] [--codecs LIST] ... (see bench encode --help)\n\n"
+           "       ringside bench encode [--frames N] [--codecs LIST] ... (see bench encode --help)\n"
+           "       ringside bench audio [--replay FILE] [--csv FILE] ... (see bench audio --help)\n\n"
            "bench platform times every headless backend built in (egl, osmesa) in one run\n"
            "on the smoke scene: context start-up, draw (glFinish), and draw + full-frame\n"
            "glReadPixels.  Each figure is the median over the runs; the ratio line compares\n"
@@ -261,8 +262,11 @@ int cmd_bench(int argc, char **argv)
         return bench_upload(argc - 1, argv + 1);
     if (!strcmp(argv[1], "encode"))
         return bench_encode(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "audio"))
+        return bench_audio(argc - 1, argv + 1);
     if (strcmp(argv[1], "platform") != 0) {
-        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim, capture, accuracy, upload, encode)", argv[1]);
+        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim, capture, accuracy, upload, encode, audio)",
+                  argv[1]);
         return RS_EXIT_USAGE;
     }
     static const struct option opts[] = {{"size", required_argument, 0, 's'},  {"frames", required_argument, 0, 'f'},

@@ -1,30 +1,45 @@
-/* ringside replay info|verify: look into a replay, or re-simulate it and
- * check every checkpoint.  No GL. */
+/* ringside replay info|verify|sound|events: look into a replay,
+ * re-simulate it and check every checkpoint, write its soundtrack, or list
+ * the sounds each tick starts.  No GL. */
 #include <getopt.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "../runtime/audio/au.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_progress.h"
 
 static void help(void)
 {
     printf("usage: ringside replay info FILE\n"
-           "       ringside replay verify FILE [--hashes OUT] [-y|-n] [--progress tty|plain|off] [--quiet]\n\n"
+           "       ringside replay verify FILE [--hashes OUT] [-y|-n] [--progress tty|plain|off] [--quiet]\n"
+           "       ringside replay sound FILE -o OUT.wav [--ticks A:B] [--loudness LUFS|off] [--float] [-y|-n]\n"
+           "       ringside replay events FILE [--ticks A:B]\n\n"
            "info    prints the header: stage, seed, duration, players, winner, sizes.\n"
            "verify  re-simulates every tick from the recorded inputs (no GL) and checks\n"
            "        every state-hash checkpoint and the final hash.  On a mismatch it\n"
            "        prints the first checkpoint tick that differs and exits 1; a replay\n"
-           "        recorded by another version of the game is refused before that.\n\n"
+           "        recorded by another version of the game is refused before that.\n"
+           "sound   writes the replay's soundtrack as a WAV (48 kHz stereo), the same\n"
+           "        samples a render puts in its video: the whole match is mixed and\n"
+           "        brought to the loudness target, then ticks A..B-1 are cut out.\n"
+           "events  prints one line per sound a tick starts: \"TICK SOUND PAN GAIN\",\n"
+           "        then the game's events of that tick in brackets.\n\n"
            "  --hashes OUT  also write \"tick hash\" for every tick to OUT ('-' for stdout)\n"
            "  -y, -n        replace an existing OUT, or refuse it, naming it (the default)\n"
            "  --progress M  tty (a line redrawn in place), plain (a line every 5 s and the\n"
            "                last, for logs) or off; default tty on a terminal, else plain\n"
-           "  --quiet       no progress line\n");
+           "  --quiet       no progress line\n"
+           "  -o OUT.wav    the WAV to write ('-' for stdout)\n"
+           "  --ticks A:B   only ticks A to B-1 (default: the whole replay)\n"
+           "  --loudness L  integrated loudness target in LUFS, -70..0 (default -16; true\n"
+           "                peak at most -1 dBTP), or off: the mixer's level as it is\n"
+           "  --float       32-bit float samples (default 16-bit PCM)\n");
 }
 
 static void duration(uint64_t ticks, char *buf, size_t n)
@@ -136,6 +151,117 @@ static int verify(const char *path, const char *hashes_path, bool overwrite, rs_
     return status;
 }
 
+/* "A:B" into first, end (end > first); prints a usage error. */
+static bool ticks_arg(const char *arg, uint64_t *first, uint64_t *end)
+{
+    const char *colon = strchr(arg, ':');
+    char a[32];
+    long f, e;
+    if (!colon || (size_t)(colon - arg) >= sizeof a) {
+        cli_error("replay", "--ticks '%s': expected A:B, such as 600:660", arg);
+        return false;
+    }
+    memcpy(a, arg, (size_t)(colon - arg));
+    a[colon - arg] = 0;
+    if (!cli_int("--ticks start", a, 0, 100000000, &f) || !cli_int("--ticks end", colon + 1, 1, 100000000, &e))
+        return false;
+    if (e <= f) {
+        cli_error("replay", "--ticks '%s': the end must be after the start", arg);
+        return false;
+    }
+    *first = (uint64_t)f;
+    *end = (uint64_t)e;
+    return true;
+}
+
+static bool read_for_sound(const char *path, uint64_t end, rp_replay *rp)
+{
+    rs_err err = {0};
+    if (!rp_read(path, rp, &err)) {
+        cli_error("replay", "%s", err.msg);
+        return false;
+    }
+    if (end > rp->ticks) {
+        cli_error("replay", "%s: --ticks ends at %" PRIu64 ", past the replay's end (%" PRIu64 " ticks)", path, end,
+                  rp->ticks);
+        rp_free(rp);
+        return false;
+    }
+    return true;
+}
+
+static int sound(const char *path, const char *out, uint64_t first, uint64_t end, double lufs, bool float32,
+                 bool overwrite)
+{
+    if (!cli_out_ok("replay", out, overwrite))
+        return RS_EXIT_FAIL;
+    rp_replay rp;
+    if (!read_for_sound(path, end, &rp))
+        return RS_EXIT_FAIL;
+    rs_err err = {0};
+    au_replay_opts o = {.target_lufs = lufs};
+    au_track t;
+    int status = RS_EXIT_FAIL;
+    if (!au_replay_track(&rp, path, first, end, &o, &t, &err)) {
+        cli_error("replay", "%s", err.msg);
+    } else if (!au_wav_write(out, t.pcm, t.frames, float32, &err)) {
+        cli_error("replay", "%s", err.msg);
+    } else {
+        if (isnan(lufs))
+            fprintf(stderr, "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames, not normalized\n", out,
+                    t.first, t.end, t.frames);
+        else
+            fprintf(stderr,
+                    "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames; match %.1f LUFS %.1f dBTP -> "
+                    "%.1f LUFS %.1f dBTP (gain %+.1f dB)\n",
+                    out, t.first, t.end, t.frames, t.lufs_before, t.peak_before, t.lufs_after, t.peak_after,
+                    t.gain_db);
+        status = RS_EXIT_OK;
+    }
+    au_track_free(&t);
+    rp_free(&rp);
+    return status;
+}
+
+static int events(const char *path, uint64_t first, uint64_t end)
+{
+    rp_replay rp;
+    if (!read_for_sound(path, end, &rp))
+        return RS_EXIT_FAIL;
+    if (!end)
+        end = rp.ticks;
+    g_state st, prev;
+    g_init(&st, rp.stage, rp.seed);
+    size_t next = 0;
+    rs_err err = {0};
+    int status = RS_EXIT_OK;
+    for (uint64_t k = 0; k < end; k++) {
+        g_events ev;
+        prev = st;
+        g_step(&st, &rp.inputs[2 * k], &ev);
+        if (!rp_check_tick(&rp, &st, k + 1, &next, path, &err)) {
+            cli_error("replay", "%s", err.msg);
+            status = RS_EXIT_FAIL;
+            break;
+        }
+        if (k < first)
+            continue;
+        au_cue c[AU_MAX_CUES];
+        int n = au_game_cues(&prev, &st, &ev, c, AU_MAX_CUES);
+        char names[256] = "";
+        size_t at = 0;
+        for (int i = 0; i < ev.n && at < sizeof names; i++)
+            at += (size_t)snprintf(names + at, sizeof names - at, "%s%s", i ? " " : "", g_event_name(ev.ev[i].type));
+        for (int i = 0; i < n; i++)
+            printf("%" PRIu64 " %s %+.2f %.2f%s%s%s\n", k, au_bank_get(c[i].sound)->name, c[i].pan, c[i].gain,
+                   ev.n ? " [" : "", names, ev.n ? "]" : "");
+    }
+    if (fflush(stdout) != 0)
+        status = RS_EXIT_FAIL;
+    rp_free(&rp);
+    return status;
+}
+
 int cmd_replay(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
@@ -143,21 +269,26 @@ int cmd_replay(int argc, char **argv)
         return argc < 2 ? RS_EXIT_USAGE : RS_EXIT_OK;
     }
     const char *sub = argv[1];
-    if (strcmp(sub, "info") && strcmp(sub, "verify")) {
-        cli_error("replay", "unknown subcommand '%s' (expected info or verify)", sub);
+    if (strcmp(sub, "info") && strcmp(sub, "verify") && strcmp(sub, "sound") && strcmp(sub, "events")) {
+        cli_error("replay", "unknown subcommand '%s' (expected info, verify, sound or events)", sub);
         return RS_EXIT_USAGE;
     }
     static const struct option opts[] = {
         {"hashes", required_argument, 0, 'H'}, {"quiet", no_argument, 0, 'q'}, {"help", no_argument, 0, 'h'},
         {"overwrite", no_argument, 0, 'y'},   {"no-overwrite", no_argument, 0, 'n'},
-        {"progress", required_argument, 0, 'g'}, {0}};
+        {"progress", required_argument, 0, 'g'}, {"output", required_argument, 0, 'o'},
+        {"ticks", required_argument, 0, 'K'},     {"loudness", required_argument, 0, 'L'},
+        {"float", no_argument, 0, 'F'},          {0}};
     const char *hashes = NULL;
-    bool quiet = false, overwrite = false;
+    const char *out = NULL;
+    bool quiet = false, overwrite = false, float32 = false, any_sound_opt = false;
+    uint64_t first = 0, end = 0;
+    double lufs = 0;
     int progress = RS_PROGRESS_AUTO;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc - 1, argv + 1, "qhyn", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc - 1, argv + 1, "qhyno:", opts, NULL)) != -1) {
         switch (c) {
         case 'H': hashes = optarg; break;
         case 'q': quiet = true; break;
@@ -165,6 +296,19 @@ int cmd_replay(int argc, char **argv)
         case 'n': overwrite = false; break;
         case 'g': if (!cli_progress_mode("replay", optarg, &progress)) return RS_EXIT_USAGE; break;
         case 'h': help(); return RS_EXIT_OK;
+        case 'o': out = optarg; any_sound_opt = true; break;
+        case 'K': if (!ticks_arg(optarg, &first, &end)) return RS_EXIT_USAGE; break;
+        case 'L': {
+            char *e;
+            lufs = strcmp(optarg, "off") ? strtod(optarg, &e) : NAN;
+            if (!isnan(lufs) && (*e || e == optarg || !(lufs >= -70 && lufs <= 0))) {
+                cli_error("replay", "--loudness '%s': expected LUFS from -70 to 0, or off", optarg);
+                return RS_EXIT_USAGE;
+            }
+            any_sound_opt = true;
+            break;
+        }
+        case 'F': float32 = any_sound_opt = true; break;
         default: return cli_bad_option("replay", argv + 1);
         }
     }
@@ -173,6 +317,24 @@ int cmd_replay(int argc, char **argv)
         return cli_usage_error("replay");
     }
     const char *file = argv[optind + 1];
+    bool is_sound = !strcmp(sub, "sound"), is_events = !strcmp(sub, "events");
+    if (!is_sound && (any_sound_opt || (end && !is_events))) {
+        cli_error("replay", "-o, --ticks, --loudness and --float belong to 'replay sound' (--ticks also to 'replay events')");
+        return RS_EXIT_USAGE;
+    }
+    if ((is_sound || is_events) && hashes) {
+        cli_error("replay", "--hashes belongs to 'replay verify'");
+        return RS_EXIT_USAGE;
+    }
+    if (is_sound) {
+        if (!out) {
+            cli_error("replay", "sound needs -o OUT.wav");
+            return cli_usage_error("replay");
+        }
+        return sound(file, out, first, end, lufs, float32, overwrite);
+    }
+    if (is_events)
+        return events(file, first, end);
     if (!strcmp(sub, "info")) {
         if (hashes) {
             cli_error("replay", "--hashes belongs to 'replay verify'");

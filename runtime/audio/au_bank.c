@@ -1,5 +1,5 @@
 /* The sound bank: every effect synthesized here at AU_RATE, mono float,
- * plus the announcer's clips (au_voice.c).  Built once on first use
+ * plus the announcer's clips (au_voice.c), after them.  Built once on first use
  * (pthread_once), read-only afterwards, so any thread may read it.
  *
  * Determinism: each sound owns a fixed noise seed (xorshift32, au_local.h)
@@ -250,12 +250,17 @@ static void crowd(float *b, size_t n, au_rng *r, int voices, double f1, double f
             b[i] += (float)(g * env * (au_bq_run(&a, buzz) + 0.6 * au_bq_run(&c, buzz)));
         }
     }
-    au_biquad bed;
+    au_biquad bed, lp1, lp2;
     au_bq_bandpass(&bed, 900, 0.5);
     for (size_t i = 0; i < n; i++) {
         double t = tsec(i), env = (t < attack ? t / attack : 1) * exp(-t / (hold * 1.2));
         b[i] += (float)(0.8 * env * au_bq_run(&bed, au_rng_white(r)));
     }
+    /* a hall full of people, heard from the ring: no hiss above 4 kHz */
+    au_bq_lowpass(&lp1, 4000, 0.7);
+    au_bq_lowpass(&lp2, 4000, 0.7);
+    for (size_t i = 0; i < n; i++)
+        b[i] = (float)au_bq_run(&lp2, au_bq_run(&lp1, b[i]));
 }
 static void s_crowd_cheer(float *b, size_t n, au_rng *r)
 {
@@ -314,21 +319,27 @@ float *au_bank_synth(int id, size_t *frames)
     return b;
 }
 
-static au_sound bank[NSYNTH];
+static au_sound *bank;
 static int bank_n;
 static pthread_once_t bank_once = PTHREAD_ONCE_INIT;
 
-/* A sound that cannot be built (out of memory at start-up) stays in the
- * bank as silence of length 0: the game plays on without it. */
+/* The synthesized sounds, then the announcer's clips.  A sound that cannot
+ * be built (out of memory at start-up) stays in the bank as silence of
+ * length 0: the game plays on without it. */
 static void build(void)
 {
-    for (int i = 0; i < NSYNTH; i++) {
-        size_t n = 0;
-        bank[i].name = synths[i].name;
-        bank[i].samples = au_bank_synth(i, &n);
-        bank[i].frames = bank[i].samples ? n : 0;
+    int n = NSYNTH + au_voice_count();
+    bank = calloc((size_t)n, sizeof *bank);
+    if (!bank)
+        return;
+    for (int i = 0; i < n; i++) {
+        size_t frames = 0;
+        bool synth = i < NSYNTH;
+        bank[i].name = synth ? synths[i].name : au_voice_name(i - NSYNTH);
+        bank[i].samples = synth ? au_bank_synth(i, &frames) : au_voice_build(i - NSYNTH, &frames);
+        bank[i].frames = bank[i].samples ? frames : 0;
     }
-    bank_n = NSYNTH;
+    bank_n = n;
 }
 
 int au_bank_count(void)

@@ -61,4 +61,16 @@ const au_loop *au_music_loop(int stage); /* NULL for a stage outside 0..G_STAGES
  * bank is built with it; tests compare two builds. */
 float *au_bank_synth(int id, size_t *frames);
 
+/* au_wav_read on bytes in memory (name is for messages). */
+bool au_wav_parse(const uint8_t *d, size_t len, const char *name, float **pcm, size_t *frames, int *channels,
+                  int *rate, rs_err *err);
+
+/* The announcer's clips, embedded in the binary (au_voice.c): count, the
+ * bank name of clip i ("voice_round1", ...), and its samples decoded,
+ * trimmed of silence and resampled to AU_RATE (malloc'd; NULL when out of
+ * memory or not a WAV this build reads). */
+int au_voice_count(void);
+const char *au_voice_name(int i);
+float *au_voice_build(int i, size_t *frames);
+
 #endif

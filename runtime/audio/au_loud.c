@@ -11,9 +11,10 @@
  *   g[n] = mean(m'[n-L+1 .. n])        (a smooth attack over L frames)
  * Every m'[k] in g[n]'s window covers r[n], so g[n] <= r[n]: the estimate
  * never goes over the ceiling, and the ramps stay smooth.  The result is
- * measured again with libebur128, whose meter is the judge; a second pass
- * with the ceiling lowered by the excess (never needed on the bundled
- * demos) covers a disagreement between the two estimates.  The ceiling
+ * measured again with libebur128, whose meter is the judge: a pass with the
+ * ceiling lowered by the excess covers a disagreement between the two
+ * estimates, and when the limiter cost loudness, the gain is raised by the
+ * shortfall and the original limited again (up to 3 times).  The ceiling
  * aimed at is 0.2 dB under the one asked for. */
 #include <ebur128.h>
 #include <math.h>
@@ -188,21 +189,34 @@ bool au_loud_normalize(float *pcm, size_t frames, double target_lufs, double pea
         *before = b;
     a = b;
     if (isfinite(b.integrated)) {
-        float g = (float)pow(10.0, (target_lufs - b.integrated) / 20.0);
-        for (size_t i = 0; i < 2 * frames; i++)
-            pcm[i] *= g;
-        double ceiling_db = peak_dbtp - MARGIN_DB;
-        for (int pass = 0; pass < 3; pass++) {
+        float *orig = malloc(frames * 2 * sizeof *orig);
+        if (!orig)
+            return rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory for %zu frames", frames);
+        memcpy(orig, pcm, frames * 2 * sizeof *orig);
+        double gain_db = target_lufs - b.integrated, ceiling_db = peak_dbtp - MARGIN_DB;
+        for (int pass = 0; pass < 6; pass++) {
+            float g = (float)pow(10.0, gain_db / 20.0);
+            for (size_t i = 0; i < 2 * frames; i++)
+                pcm[i] = orig[i] * g;
             bool nomem = false;
             bool limited = limit(pcm, frames, pow(10.0, ceiling_db / 20.0), &nomem);
-            if (nomem)
-                return rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory for the limiter (%zu frames)", frames);
-            if (!au_loud_measure(pcm, frames, &a, err))
-                return false;
-            if (!limited || a.true_peak <= peak_dbtp)
+            if (nomem || !au_loud_measure(pcm, frames, &a, err)) {
+                free(orig);
+                return nomem ? rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory for the limiter (%zu frames)", frames)
+                             : false;
+            }
+            /* the limiter took loudness away: make it up (a few times at
+             * most: on programme that is all peaks it cannot be) */
+            bool peak_ok = a.true_peak <= peak_dbtp;
+            bool loud_ok = !limited || fabs(a.integrated - target_lufs) <= 0.2 || pass >= 3;
+            if (peak_ok && loud_ok)
                 break;
-            ceiling_db -= a.true_peak - peak_dbtp + 0.05;
+            if (!peak_ok)
+                ceiling_db -= a.true_peak - peak_dbtp + 0.05;
+            if (!loud_ok)
+                gain_db += target_lufs - a.integrated;
         }
+        free(orig);
     }
     if (after)
         *after = a;

@@ -18,7 +18,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "au.h"
+#include "au_local.h"
 #include "../util/rs_file.h"
 #include "../util/rs_out.h"
 
@@ -87,9 +87,11 @@ static size_t header(uint8_t *h, bool float32, uint32_t data_bytes)
     return n;
 }
 
+/* x 32768, clipped at 32767: the inverse of the reader's / 32768, so a
+ * 16-bit file read and written again keeps every sample */
 static int16_t to16(float v)
 {
-    double s = (double)v * 32767.0;
+    double s = (double)v * 32768.0;
     if (!(s > -32768.0)) /* NaN goes to the floor, then clipped like any sample */
         s = s != s ? 0.0 : -32768.0;
     if (s > 32767.0)
@@ -247,6 +249,15 @@ bool au_wav_read(const char *path, float **pcm, size_t *frames, int *channels, i
     uint8_t *d = (uint8_t *)rs_read_file(path, WAV_MAX_FILE, &len, &ferr);
     if (!d)
         return rs_fail(err, AU_ERR_WAV_OPEN, "%s", ferr.msg);
+    bool ok = au_wav_parse(d, len, path, pcm, frames, channels, rate, err);
+    free(d);
+    return ok;
+}
+
+bool au_wav_parse(const uint8_t *d, size_t len, const char *path, float **pcm, size_t *frames, int *channels,
+                  int *rate, rs_err *err)
+{
+    *pcm = NULL;
     bool ok = false;
     unsigned fmt = 0, ch = 0, bits = 0;
     uint32_t hz = 0;
@@ -347,6 +358,5 @@ bool au_wav_read(const char *path, float **pcm, size_t *frames, int *channels, i
     *rate = (int)hz;
     ok = true;
 done:
-    free(d);
     return ok;
 }
