@@ -144,28 +144,29 @@ t_sync_containers() {
     done
 }
 
-# a hit's sound starts at its frame: the first hit of `replay events`, the onset in the decoded MP4 near tick/60 s
+# a hit's sound starts at its frame: the hits of `replay events`, each onset in the decoded MP4 within 1 ms of
+# tick * 800 samples.  The music and the crowd play under the hits, so the onset is looked for above 3 kHz, where
+# a hit is a sharp step: the first 0.5 ms window with 5% of the peak energy of the 20 ms around the tick.
 t_hit_onset() {
     need_ffmpeg
     replay6 || return 1
-    "$RS_BIN" replay events r.rsr >ev.txt 2>/dev/null || t_skip_case "this build has no 'replay events' (part A)"
-    tick=$(awk '$2 ~ /^hit/ { print $1; exit }' ev.txt)
-    [ -n "$tick" ] || { echo "no hit in the replay's events:"; head ev.txt; return 1; }
-    "$RS_BIN" render r.rsr -o v.mp4 $SIZES --quiet --audio-bitrate 320k || return 1
-    pcm v.mp4 v.f32 || return 1
-    python3 - v.f32 "$tick" <<'EOF' || return 1
+    "$RS_BIN" replay events r.rsr >ev.txt || return 1
+    ticks=$(awk '$2 ~ /^hit_/ { print $1 }' ev.txt | head -3 | tr '\n' ' ')
+    [ -n "$ticks" ] || { echo "no hit in the replay's events:"; head ev.txt; return 1; }
+    "$RS_BIN" render r.rsr -o v.mp4 $SIZES --quiet || return 1
+    ffmpeg -v error -i v.mp4 -map 0:a:0 -ac 1 -af highpass=f=3000,highpass=f=3000 -f f32le v.f32 || return 1
+    python3 - v.f32 $ticks <<'EOF' || return 1
 import sys, array
 x = array.array('f'); x.frombytes(open(sys.argv[1], 'rb').read())
-tick = int(sys.argv[2]); at = tick * 800
-# the envelope in 0.25 ms windows; the onset: the first window 12 dB above the 20 ms before it
-w = 12
-def e(i): return sum(v * v for v in x[i:i + w]) / w
-lo = max(at - 960, 0)
-base = max(e(i) for i in range(lo, at - 960 + 960 - 480, w)) if at > 960 else 0.0
-onset = next((i for i in range(at - 480, at + 960, w) if e(i) > 16 * base + 1e-7), None)
-print("hit at tick", tick, "=", at, "; onset at", onset)
-if onset is None or abs(onset - at) > 48:
-    print("onset more than 1 ms from the hit's frame"); sys.exit(1)
+bad = 0
+for tick in map(int, sys.argv[2:]):
+    at, w = tick * 800, 24
+    e = {i: sum(v * v for v in x[i:i + w]) / w for i in range(at - 480, at + 480, w)}
+    peak = max(e.values())
+    onset = min(i for i in e if e[i] >= 0.05 * peak) - at
+    print("hit at tick %d: onset %+d samples (%+.2f ms) from its frame's time" % (tick, onset, onset / 48.0))
+    bad += abs(onset) > 48
+sys.exit(bad)
 EOF
 }
 
