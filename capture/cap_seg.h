@@ -45,7 +45,10 @@
  *   frames 600
  *   bytes 1234567
  *   crc32 89abcdef
- *   hashes 0123456789abcdef      ("hashes none" without a list) */
+ *   hashes 0123456789abcdef      ("hashes none" without a list)
+ *   replay 0123456789abcdef      optional: FNV-1a 64 of the replay file's
+ *                                bytes, so join --replay can tell the
+ *                                segments' replay from another */
 typedef struct cap_seg_info {
     char key[CAP_SEG_KEY_MAX + 1];
     char format[8];        /* mp4, mkv or webm: the segment file's extension */
@@ -56,6 +59,8 @@ typedef struct cap_seg_info {
     uint32_t crc;          /* CRC-32 of every packet's payload, in the order libavformat reads them */
     bool has_hashes;
     uint64_t hashes_fnv;   /* FNV-1a 64 of the hash list's text */
+    bool has_replay;       /* manifests before sound have no replay line */
+    uint64_t replay_fnv;   /* FNV-1a 64 of the replay file */
 } cap_seg_info;
 
 /* One segment as join sees it. */
@@ -78,9 +83,14 @@ const char *cap_seg_format_of(const char *path);
 /* After a segment's render, with the file (and its hash list) in place:
  * reads it back through libavformat, checks it is ticks first..end-1
  * (count, keyframe, pts), and writes SEG.seg atomically.  hashes: its
- * list, or NULL.  False (CAP_ERR_SEG_* or CAP_ERR_WRITE) leaves no
+ * list, or NULL; replay_fnv: the replay file's FNV-1a 64 (rs_fnv1a64 of
+ * its bytes), or NULL.  False (CAP_ERR_SEG_* or CAP_ERR_WRITE) leaves no
  * manifest; the caller removes the files. */
-bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes, rs_err *err);
+bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes,
+                  const uint64_t *replay_fnv, rs_err *err);
+
+/* The FNV-1a 64 of a replay file's bytes, as manifests record it. */
+bool cap_seg_replay_fnv(const char *replay, uint64_t *out, rs_err *err);
 
 /* What join wants of every segment. */
 typedef struct cap_seg_want {

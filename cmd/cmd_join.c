@@ -197,6 +197,19 @@ int cmd_join(int argc, char **argv)
     uint64_t total = 0;
     for (int i = 0; i < n; i++)
         total += segs[i].m.frames;
+    uint64_t replay_fnv = 0;
+    if (replay && !cap_seg_replay_fnv(replay, &replay_fnv, &err)) {
+        cap_join_close(j, false, NULL);
+        goto done;
+    }
+    for (int i = 0; replay && i < n; i++)
+        if (segs[i].m.has_replay && segs[i].m.replay_fnv != replay_fnv) {
+            cap_join_close(j, false, NULL);
+            cli_error("join", "--replay %s: not the replay segment %d (%s) was rendered from (FNV-1a %016" PRIx64
+                              ", the manifest says %016" PRIx64 ")", replay, i, segs[i].path, replay_fnv, segs[i].m.replay_fnv);
+            status = RS_EXIT_USAGE;
+            goto done;
+        }
     if (replay) {
         /* the whole job's sound, once: ticks first..end of the manifests */
         uint64_t t0 = segs[0].m.first, t1 = t0 + total;

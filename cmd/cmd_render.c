@@ -508,7 +508,9 @@ int cmd_render(int argc, char **argv)
     }
     if (!job_poster_commit(&poster, &err))
         goto done;
-    if (segment && !cap_seg_seal(out, segment, t_first, t_end, hashes, &err)) {
+    uint64_t replay_fnv = 0; /* the manifest names the replay: join --replay checks it is the segments' */
+    if (segment && (!cap_seg_replay_fnv(replay, &replay_fnv, &err) ||
+                    !cap_seg_seal(out, segment, t_first, t_end, hashes, &replay_fnv, &err))) {
         /* no manifest, no segment: the files go too */
         unlink(out);
         if (hashes)

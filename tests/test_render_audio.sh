@@ -188,10 +188,15 @@ t_join_audio() {
     set -- $(lag_corr w.f32 j.f32)
     echo "join vs whole render: lag $1, correlation $2"
     [ "$1" = 0 ] && awk -v c="$2" 'BEGIN { exit !(c >= 0.99) }' || return 1
-    # a replay that is not the segments' (too short for their ticks) is refused
-    "$RS_BIN" record --ai --quiet --seconds 2 --seed 3 -o short.rsr 2>/dev/null || return 1
-    expect_fail 2 "short.rsr: 120 ticks, but the segments run to tick 240" \
-        "$RS_BIN" join --segment k1 --replay short.rsr -o x.mp4 s1.mp4 s2.mp4 || return 1
+    # the manifests name their replay: another one is refused, naming the segment, and nothing is written
+    grep -q "^replay $(python3 -c 'import sys
+h = 0xcbf29ce484222325
+for b in open("r.rsr", "rb").read(): h = ((h ^ b) * 0x100000001b3) & (2**64 - 1)
+print("%016x" % h)')\$" s1.mp4.seg || { echo "s1.mp4.seg does not name r.rsr's FNV-1a:"; cat s1.mp4.seg; return 1; }
+    "$RS_BIN" record --ai --quiet --seconds 6 --seed 22 -o other.rsr 2>/dev/null || return 1
+    expect_fail 2 "--replay other.rsr: not the replay segment 0 \(s1.mp4\) was rendered from" \
+        "$RS_BIN" join --segment k1 --replay other.rsr -o x.mp4 s1.mp4 s2.mp4 || return 1
+    [ ! -e x.mp4 ] || { echo "x.mp4 written with another replay's sound"; return 1; }
 }
 
 t_bad_options() {
