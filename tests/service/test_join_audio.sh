@@ -45,5 +45,25 @@ t_whole_job_has_audio() {
     svc_stop
 }
 
-t_run ${T_ONLY:-joined_job_has_audio whole_job_has_audio}
+# audio=off (query or form field): no sound in the segments' join or a whole render; the job JSON says so
+t_audio_off() {
+    command -v ffprobe >/dev/null || t_skip_case "ffprobe not installed"
+    "$RS_BIN" record --ai --quiet --stage dojo --seconds 2 --seed 7 -o two.rsr || return 1
+    svc_start d $SVC_FAST --workers 2 --segment-seconds 1 || return 1
+    code=$(curl -s -o bad.json -w '%{http_code}' -X POST --data-binary @two.rsr "$SVC_URL/jobs?audio=maybe")
+    [ "$code" = 400 ] && grep -q "audio 'maybe': expected on or off" bad.json || { echo "audio=maybe: $code $(cat bad.json)"; return 1; }
+    id=$(svc_submit two.rsr "audio=off") || return 1
+    on=$(svc_submit two.rsr) || return 1
+    [ "$(svc_field "$id" audio)" = false ] && [ "$(svc_field "$on" audio)" = true ] ||
+        { echo "job JSON audio: $(svc_field "$id" audio) / $(svc_field "$on" audio)"; return 1; }
+    svc_wait_state "$id" done 120 && svc_wait_state "$on" done 120 || return 1
+    curl -sf -o off.mp4 "$SVC_URL/jobs/$id/video" && curl -sf -o on.mp4 "$SVC_URL/jobs/$on/video" || return 1
+    [ -z "$(ffprobe -v error -select_streams a -show_entries stream=codec_name -of csv=p=0 off.mp4)" ] ||
+        { echo "audio=off: the video has sound"; return 1; }
+    [ "$(ffprobe -v error -select_streams a -show_entries stream=codec_name -of csv=p=0 on.mp4)" = aac ] ||
+        { echo "the default job has no sound"; return 1; }
+    svc_stop
+}
+
+t_run ${T_ONLY:-joined_job_has_audio whole_job_has_audio audio_off}
 t_done
