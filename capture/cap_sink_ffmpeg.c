@@ -20,7 +20,11 @@
  * With x264's B-frames (delay D = 2 at veryfast) the dts of the k-th
  * packet is A + k - D: pts are consecutive, so x264's dts (the pts D
  * packets earlier in presentation order) run on across segment
- * boundaries without a gap or a repeat. */
+ * boundaries without a gap or a repeat.
+ *
+ * Sound (s->audio, cap_sink_audio): a second stream, AAC or Opus, encoded
+ * by cap_audio.c after each video frame up to that frame's end, and
+ * flushed before the trailer.  Segments never have one (join adds it). */
 #ifdef RS_HAVE_FFMPEG /* configure.sh found libavformat; otherwise this file is empty */
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
