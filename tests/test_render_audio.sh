@@ -132,10 +132,10 @@ t_ticks_cut() {
 t_sync_containers() {
     need_ffmpeg
     replay6 || return 1
-    "$RS_BIN" render r.rsr -o /dev/null --format y4m $SIZES --ticks 0:360 --quiet --wav t.wav || return 1
+    "$RS_BIN" render r.rsr -o /dev/null --format y4m $SIZES --ticks 0:240 --quiet --wav t.wav || return 1
     ffmpeg -v error -i t.wav -ac 1 -f f32le t.f32 || return 1
     for c in mp4 mkv webm; do
-        "$RS_BIN" render r.rsr -o "v.$c" $SIZES --quiet || return 1
+        "$RS_BIN" render r.rsr -o "v.$c" $SIZES --ticks 0:240 --quiet || return 1
         pcm "v.$c" "v.$c.f32" || return 1
         set -- $(lag_corr t.f32 "v.$c.f32")
         echo "$c: lag $1 samples, correlation $2"
@@ -151,9 +151,9 @@ t_hit_onset() {
     need_ffmpeg
     replay6 || return 1
     "$RS_BIN" replay events r.rsr >ev.txt || return 1
-    ticks=$(awk '$2 ~ /^hit_/ { print $1 }' ev.txt | head -3 | tr '\n' ' ')
+    ticks=$(awk '$2 ~ /^hit_/ && $1 < 240 { print $1 }' ev.txt | head -3 | tr '\n' ' ')
     [ -n "$ticks" ] || { echo "no hit in the replay's events:"; head ev.txt; return 1; }
-    "$RS_BIN" render r.rsr -o v.mp4 $SIZES --quiet || return 1
+    "$RS_BIN" render r.rsr -o v.mp4 $SIZES --ticks 0:240 --quiet || return 1
     ffmpeg -v error -i v.mp4 -map 0:a:0 -ac 1 -af highpass=f=3000,highpass=f=3000 -f f32le v.f32 || return 1
     python3 - v.f32 $ticks <<'EOF' || return 1
 import sys, array
