@@ -89,7 +89,10 @@ bool job_audio_plan(job_audio *a, cap_sink *s, const rp_replay *rp, const char *
 {
     if (a->mode != JOB_AUDIO_ON && !a->wav)
         return true;
-    au_replay_opts o = {.target_lufs = a->lufs ? a->lufs : JOB_AUDIO_LUFS_DEFAULT};
+    /* no_check: the render's own loop checks the checkpoints of the ticks it
+     * draws and reports a desync its way ("desync TICK" on --progress-fd,
+     * which the service reads); join's segments were checked as rendered */
+    au_replay_opts o = {.target_lufs = a->lufs ? a->lufs : JOB_AUDIO_LUFS_DEFAULT, .no_check = true};
     if (!au_replay_track(rp, name, first, end, &o, &a->track, err))
         return false;
     if (a->mode == JOB_AUDIO_ON) {
