@@ -526,12 +526,12 @@ int cmd_render(int argc, char **argv)
     if (!quiet)
         fprintf(stderr,
                 "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d) in %.1f s, %.1f fps; %s capture, "
-                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n",
+                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n", /* the encoder last */
                 out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, secs, secs > 0 ? st.frames / secs : 0.0,
                 cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
-                st.high_water, st.fence_waits, sink.enc_name[0] ? "; encoder " : "", sink.enc_name, said);
+                st.high_water, st.fence_waits, said, sink.enc_name[0] ? "; encoder " : "", sink.enc_name);
     if (!quiet && poster.due)
         fprintf(stderr, "ringside render: poster %s: frame %" PRIu64 " (%s)\n", poster.path, poster.tick,
                 job_poster_why_name(poster.why));
