@@ -120,6 +120,23 @@ static void t_wav_reads_other_formats(void)
     T_EQ(rate, 32000);
     T_ASSERT(x[0] == 0 && x[1] == 127.0f / 128 && x[2] == -1 && x[3] == 0.5f);
     free(x);
+    /* WAVE_FORMAT_EXTENSIBLE: 5.1 float at 44.1 kHz, one frame, after an odd-sized chunk */
+    uint8_t ext[12 + 8 + 40 + 10 + 8 + 24] = "RIFF\0\0\0\0WAVEfmt \x28\0\0\0\xfe\xff\x06\0\x44\xac\0\0";
+    size_t at = 12 + 8;
+    ext[at + 14] = 32;                              /* bits */
+    ext[at + 16] = 22;                              /* cbSize */
+    ext[at + 24] = 3;                               /* sub-format: IEEE float */
+    memcpy(ext + at + 40, "odd \x01\0\0\0\x7f\0", 10); /* 1 byte + its pad byte */
+    memcpy(ext + at + 50, "data\x18\0\0\0", 8);
+    for (int c = 0; c < 6; c++) {
+        float v = (float)(c + 1) / 8;
+        memcpy(ext + at + 58 + 4 * c, &v, 4);
+    }
+    path_in_tmp(a, sizeof a, "ext.wav");
+    write_bytes(a, ext, sizeof ext);
+    T_ASSERTF(au_wav_read(a, &x, &n, &ch, &rate, &err), "%s", err.msg);
+    T_ASSERT(n == 1 && ch == 6 && rate == 44100 && x[0] == 0.125f && x[5] == 0.75f);
+    free(x);
 }
 
 static void expect_bad(const char *name, const void *data, size_t n, const char *words)

@@ -9,6 +9,7 @@
  * the picture sounds on the left.  Announcer lines, the bell, thunder and
  * the crowd are centred. */
 #include <pthread.h>
+#include <string.h>
 
 #include "au_local.h"
 
@@ -72,9 +73,12 @@ static bool attacking(int move)
     }
 }
 
+/* the stages whose ring stands in water: a ring-out splashes */
 static bool water_stage(int stage)
 {
-    return stage == 1 || stage == 3; /* harbor, shallows */
+    if (stage < 0 || stage >= G_STAGES)
+        return false;
+    return !strcmp(g_stages[stage].name, "harbor") || !strcmp(g_stages[stage].name, "shallows");
 }
 
 static void from_events(const g_state *cur, const g_events *ev, cues *c, bool *struck)

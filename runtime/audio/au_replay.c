@@ -11,10 +11,10 @@
  * the whole match's), so every call mixes the whole match, whatever range
  * it returns; that is what makes the audio of ticks A..B exactly those
  * samples of the full track, and joined segments equal one render.  The
- * cost is mixing and measuring the whole match per call: about 1/400 of
- * real time for mixing (docs/audio.md has the figures).  Without
- * normalization only ticks 0..end-1 are simulated and only the range is
- * kept. */
+ * cost is the whole match per call: the mixing takes about 1/4000 of real
+ * time, the loudness measurements most of the rest, about 1/100 in all
+ * (docs/audio.md has the figures).  Without normalization only ticks
+ * 0..end-1 are simulated and only the range is kept. */
 #include <inttypes.h>
 #include <math.h>
 #include <stdlib.h>

@@ -1,0 +1,84 @@
+#!/bin/sh
+# End-to-end: `replay sound` and `replay events` through the real binary:
+# the WAV's format and length, a range equal to that slice of the whole,
+# loudness as ffmpeg measures it, stdout, the cue listing, and the errors.
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/lib.sh"
+SRC=$(cd "$here/.." && pwd)
+DEMO=$SRC/demos/temple.rsr
+
+short_replay() { # 1200 ticks on the dojo, CPU against CPU
+    "$RS_BIN" record --ai --quiet --seconds 20 --seed 21 -o short.rsr 2>/dev/null
+}
+
+probe() { # FILE -> "codec rate channels samples"
+    ffprobe -v error -select_streams a:0 -count_packets -show_entries stream=codec_name,sample_rate,channels,duration_ts \
+        -of csv=p=0 "$1" | tr ',' ' '
+}
+
+t_sound_wav_and_its_slices() {
+    short_replay || return 1
+    "$RS_BIN" replay sound short.rsr -o all.wav 2>all.txt || { cat all.txt; return 1; }
+    "$RS_BIN" replay sound short.rsr -o part.wav --ticks 600:660 2>part.txt || { cat part.txt; return 1; }
+    set -- $(probe part.wav)
+    [ "$1 $2 $3 $4" = "pcm_s16le 48000 2 48000" ] || { echo "part.wav: $*"; return 1; }
+    set -- $(probe all.wav)
+    [ "$4" = $((1200 * 800)) ] || { echo "all.wav: $* (want 1200 ticks x 800 frames)"; return 1; }
+    # ticks 600..659 are bytes 600*800*4.. of the whole track's samples
+    tail -c +$((44 + 600 * 800 * 4 + 1)) all.wav | head -c $((60 * 800 * 4)) >slice.raw
+    tail -c +45 part.wav >part.raw
+    cmp slice.raw part.raw || { echo "ticks 600:660 differ from that slice of the whole"; return 1; }
+    # float, and standard output, give the same samples as the file
+    "$RS_BIN" replay sound short.rsr -o f.wav --ticks 600:660 --float 2>/dev/null || return 1
+    set -- $(probe f.wav)
+    [ "$1" = pcm_f32le ] || { echo "f.wav: $*"; return 1; }
+    "$RS_BIN" replay sound short.rsr -o - --ticks 600:660 >stdout.wav 2>/dev/null || return 1
+    cmp stdout.wav part.wav || { echo "-o - differs from the file"; return 1; }
+    grep -q "ticks 600:660, 48000 frames; match .* -> -16.0 LUFS" part.txt || { cat part.txt; return 1; }
+}
+
+t_sound_loudness_measured_by_ffmpeg() {
+    "$RS_BIN" replay sound "$DEMO" -o a.wav 2>/dev/null || return 1
+    "$RS_BIN" replay sound "$DEMO" -o b.wav --loudness -23 2>/dev/null || return 1
+    for f in a:-16 b:-23; do
+        ffmpeg -hide_banner -nostats -i "${f%%:*}.wav" -af ebur128=peak=true -f null - 2>m.txt
+        awk -v want="${f#*:}" '/I:/ { i = $2 } /Peak:/ { p = $2 }
+            END { d = i - want; if (d < 0) d = -d; if (d > 1 || p > -1.0) { print "I " i " (want " want "), peak " p; exit 1 } }' m.txt ||
+            return 1
+    done
+    "$RS_BIN" replay sound "$DEMO" -o c.wav --loudness off --ticks 0:60 2>c.txt || return 1
+    grep -q "not normalized" c.txt || { cat c.txt; return 1; }
+}
+
+t_events_list_the_cues() {
+    "$RS_BIN" replay events "$DEMO" --ticks 0:900 >e.txt 2>err.txt || { cat err.txt; return 1; }
+    grep -q '^0 voice_round1 +0.00 1.00 \[round\]$' e.txt || { head -3 e.txt; return 1; }
+    grep -q '^59 bell ' e.txt && grep -q '^59 voice_fight ' e.txt || { grep '^59 ' e.txt; return 1; }
+    # every hit sound is on a tick with a hit event; none past the range
+    awk '$2 ~ /^hit_/ && !/\[.*hit.*\]/ { print; bad = 1 } $1 >= 900 { print; bad = 1 } END { exit bad }' e.txt ||
+        return 1
+    grep -q ' hit_' e.txt || { echo "no hit in ticks 0..899"; return 1; }
+    "$RS_BIN" replay events "$DEMO" --ticks 600:660 >f.txt || return 1
+    awk '$1 < 600 || $1 >= 660 { exit 1 }' f.txt || { cat f.txt; return 1; }
+}
+
+t_errors() {
+    expect_fail 2 "sound needs -o OUT.wav" "$RS_BIN" replay sound "$DEMO" || return 1
+    : >exists.wav
+    expect_fail 1 "exists.wav: exists \(use -y to overwrite\)" "$RS_BIN" replay sound "$DEMO" -o exists.wav || return 1
+    expect_fail 1 "folder nowhere does not exist" "$RS_BIN" replay sound "$DEMO" -o nowhere/x.wav || return 1
+    expect_fail 2 "--loudness 'loud': expected LUFS from -70 to 0, or off" \
+        "$RS_BIN" replay sound "$DEMO" -o a.wav --loudness loud || return 1
+    expect_fail 2 "--loudness '3'" "$RS_BIN" replay sound "$DEMO" -o a.wav --loudness 3 || return 1
+    expect_fail 2 "--ticks '9:3': the end must be after the start" "$RS_BIN" replay sound "$DEMO" -o a.wav --ticks 9:3 ||
+        return 1
+    expect_fail 1 "past the replay's end \(2537 ticks\)" "$RS_BIN" replay sound "$DEMO" -o a.wav --ticks 0:3000 || return 1
+    expect_fail 2 "belong to 'replay sound'" "$RS_BIN" replay info "$DEMO" --float || return 1
+    expect_fail 2 "belong to 'replay sound'" "$RS_BIN" replay verify "$DEMO" -o a.wav || return 1
+    printf 'RSRP broken' >bad.rsr
+    expect_fail 1 "bad.rsr" "$RS_BIN" replay sound bad.rsr -o a.wav || return 1
+    [ ! -e a.wav ] && [ ! -e a.wav.part ] || { echo "a refused run left a file"; return 1; }
+}
+
+t_run sound_wav_and_its_slices sound_loudness_measured_by_ffmpeg events_list_the_cues errors
+t_done
