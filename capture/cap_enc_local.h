@@ -6,6 +6,7 @@
 #define CAP_ENC_LOCAL_H
 
 #include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
 
 #include "cap_sink.h"
 
@@ -23,5 +24,27 @@ bool cap_encoder_open(cap_encoder *x, const cap_sink *s, bool global_header, rs_
 /* One capture frame (s->fmt: I420, or RGBA for 4:4:4) with timestamp pts. */
 bool cap_encoder_send(cap_encoder *x, const cap_sink *s, const uint8_t *frame, int64_t pts, rs_err *err);
 void cap_encoder_close(cap_encoder *x);
+
+/* The audio encoder beside it (cap_audio.c): the sink's borrowed track
+ * (s->audio), encoded in the encoder's frame size as the video goes. */
+typedef struct cap_aenc {
+    AVCodecContext *ctx;
+    AVStream *st;
+    AVFrame *frame;
+    AVPacket *pkt;
+    const float *pcm;   /* the track, stereo interleaved */
+    size_t frames;      /* its length in sample frames */
+    size_t sent;        /* frames handed to the encoder: the FIFO's read position */
+    size_t chunk;       /* the encoder's frame size */
+    size_t skip;        /* frames of the track's start that stand in for the priming (AAC in MKV, NUT) */
+} cap_aenc;
+
+/* Adds the audio stream to fmt (before its header is written). */
+bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *err);
+/* Encodes the track up to sample frame upto (whole encoder frames only). */
+bool cap_aenc_feed(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, size_t upto, rs_err *err);
+/* The rest, the last short frame, and the encoder's delayed packets. */
+bool cap_aenc_finish(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *err);
+void cap_aenc_close(cap_aenc *a);
 
 #endif

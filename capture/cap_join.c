@@ -6,7 +6,12 @@
  * the hash list first, so a video in place always has its list.  The
  * .part files are created before any segment is read: a missing or
  * read-only output directory is the output's failure (exit 1 in join,
- * the service retries later), never blamed on a segment. */
+ * the service retries later), never blamed on a segment.
+ *
+ * Audio (cap_join_audio): segments carry none; the job's track, mixed
+ * once for the joined ticks, is encoded here beside the copied video,
+ * up to the end of each packet's tick as it is written (cap_audio.c), so
+ * the sound has no seam where the segments meet. */
 #include "cap_seg.h"
 
 #include <errno.h>
@@ -23,6 +28,8 @@
 #ifdef RS_HAVE_FFMPEG
 #include <libavformat/avformat.h>
 
+#include "cap_enc_local.h"
+
 struct cap_join {
     cap_join_desc d;
     AVFormatContext *fmt;
@@ -31,6 +38,8 @@ struct cap_join {
     FILE *hf;
     char part[1100], hpart[1100];
     bool header;
+    cap_sink audio; /* audio.audio NULL: no sound */
+    cap_aenc a;
 };
 
 static int fail_av(rs_err *err, int id, const char *path, const char *what, int code)
@@ -99,6 +108,8 @@ static bool write_header(cap_join *j, const AVFormatContext *ic, const AVStream 
     }
     j->st->time_base = (AVRational){1, 60};
     j->st->avg_frame_rate = j->st->r_frame_rate = (AVRational){60, 1};
+    if (j->audio.audio && !cap_aenc_open(&j->a, &j->audio, j->fmt, err))
+        return false;
     AVDictionary *opts = NULL;
     if (mp4) /* the index before the frames: plays while it downloads; every metadata key kept */
         av_dict_set(&opts, "movflags", "+faststart+use_metadata_tags", 0);
@@ -181,6 +192,11 @@ static bool copy_one(cap_join *j, const cap_seg *s, int64_t origin, int reorder,
         }
         k++;
         (*done)++;
+        /* the sound up to the end of this packet's tick */
+        if (j->a.ctx && !cap_aenc_feed(&j->a, &j->audio, j->fmt, (size_t)(s->m.first + k - (uint64_t)origin) * 800, err)) {
+            *seg_fault = false;
+            goto done;
+        }
         if (j->d.progress)
             j->d.progress(j->d.ctx, *done, total);
     }
@@ -239,6 +255,8 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
     int r;
     if (ok && !j->header)
         rs_fail(err, CAP_ERR_ARG, "%s: closed before any segment was copied", j->d.out);
+    if (good && j->a.ctx)
+        good = cap_aenc_finish(&j->a, &j->audio, j->fmt, err);
     if (good && (r = av_write_trailer(j->fmt)) < 0) /* MP4: moves the index to the front, rewriting the file */
         good = fail_av(err, CAP_ERR_WRITE, j->d.out, "write failed", r);
     if (j->fmt && j->fmt->pb) {
@@ -278,9 +296,15 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
             unlink(j->hpart);
     }
     av_packet_free(&j->pkt);
+    cap_aenc_close(&j->a);
     avformat_free_context(j->fmt);
     free(j);
     return good;
+}
+
+void cap_join_audio(cap_join *j, const cap_sink *audio)
+{
+    j->audio = *audio;
 }
 
 #else /* no FFmpeg: nothing to join with */
@@ -305,5 +329,10 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
 {
     (void)j, (void)err;
     return !ok;
+}
+
+void cap_join_audio(cap_join *j, const cap_sink *audio)
+{
+    (void)j, (void)audio;
 }
 #endif

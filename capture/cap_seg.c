@@ -112,14 +112,16 @@ static bool hashes_check(const char *path, uint64_t first, uint64_t end, uint64_
 
 static bool manifest_write(const char *seg, const cap_seg_info *m, rs_err *err)
 {
-    char path[1100], text[MANIFEST_MAX], hashes[24] = "none";
+    char path[1100], text[MANIFEST_MAX], hashes[24] = "none", replay[32] = "";
     cap_seg_manifest_path(seg, path, sizeof path);
     if (m->has_hashes)
         snprintf(hashes, sizeof hashes, "%016" PRIx64, m->hashes_fnv);
+    if (m->has_replay)
+        snprintf(replay, sizeof replay, "replay %016" PRIx64 "\n", m->replay_fnv);
     int n = snprintf(text, sizeof text,
                      MANIFEST_MAGIC "\nkey %s\nformat %s\nsize %dx%d\nticks %" PRIu64 " %" PRIu64 "\nframes %" PRIu64
-                                    "\nbytes %" PRIu64 "\ncrc32 %08" PRIx32 "\nhashes %s\n",
-                     m->key, m->format, m->w, m->h, m->first, m->end, m->frames, m->bytes, m->crc, hashes);
+                                    "\nbytes %" PRIu64 "\ncrc32 %08" PRIx32 "\nhashes %s\n%s",
+                     m->key, m->format, m->w, m->h, m->first, m->end, m->frames, m->bytes, m->crc, hashes, replay);
     rs_err e = {0};
     if (!rs_write_part(path, text, (size_t)n, &e) || !rs_commit_file(path, &e))
         return rs_fail(err, CAP_ERR_WRITE, "%s", e.msg); /* rs_file's failure, as one of ours */
@@ -180,8 +182,11 @@ static bool manifest_read(const char *seg, cap_seg_info *out, rs_err *err)
     else if (!manifest_line(&p, "hashes", v[0], sizeof v[0]) ||
              (strcmp(v[0], "none") && (strlen(v[0]) != 16 || sscanf(v[0], "%" SCNx64 "%c", &m->hashes_fnv, &tail) != 1)))
         bad = "no valid 'hashes' line";
+    else if (*p && !(m->has_replay = manifest_line(&p, "replay", v[1], sizeof v[1]) && strlen(v[1]) == 16 &&
+                                     sscanf(v[1], "%" SCNx64 "%c", &m->replay_fnv, &tail) == 1))
+        bad = "no valid 'replay' line after the 'hashes' line";
     else if (*p)
-        bad = "has text after the 'hashes' line";
+        bad = "has text after the 'replay' line";
     m->has_hashes = !bad && strcmp(v[0], "none") != 0;
     free(text);
     if (bad)
@@ -291,9 +296,12 @@ static bool probe(const char *seg, cap_seg_info *m, uint32_t *crc, cap_seg *out,
 }
 #endif
 
-bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes, rs_err *err)
+bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes,
+                  const uint64_t *replay_fnv, rs_err *err)
 {
     cap_seg_info m = {.first = first, .end = end, .frames = end - first};
+    if (replay_fnv)
+        m.has_replay = true, m.replay_fnv = *replay_fnv;
     cap_seg s = {.path = seg};
     const char *fmt = cap_seg_format_of(seg);
     struct stat st;
@@ -315,6 +323,17 @@ bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end
             return false;
     }
     return manifest_write(seg, &m, err);
+}
+
+bool cap_seg_replay_fnv(const char *replay, uint64_t *out, rs_err *err)
+{
+    size_t len;
+    char *bytes = rs_read_file(replay, (size_t)1 << 30, &len, err);
+    if (!bytes)
+        return false;
+    *out = rs_fnv1a64(bytes, len);
+    free(bytes);
+    return true;
 }
 
 /* --- verification ------------------------------------------------------- */

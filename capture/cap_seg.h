@@ -17,6 +17,7 @@
  *   render: cap_seg_seal(seg, key, A, B, hashes)       after the files are in place
  *   join:   j = cap_join_open(&desc)                    output directory writable?
  *           cap_seg_verify(segs, n, &want, bad, ctx)    every segment, and all together
+ *           cap_join_audio(j, sink)                     optional: the whole job's track
  *           cap_join_copy(j, segs, n, &bad)             stream copy
  *           cap_join_close(j, ok)                       faststart, rename into place
  *
@@ -44,7 +45,10 @@
  *   frames 600
  *   bytes 1234567
  *   crc32 89abcdef
- *   hashes 0123456789abcdef      ("hashes none" without a list) */
+ *   hashes 0123456789abcdef      ("hashes none" without a list)
+ *   replay 0123456789abcdef      optional: FNV-1a 64 of the replay file's
+ *                                bytes, so join --replay can tell the
+ *                                segments' replay from another */
 typedef struct cap_seg_info {
     char key[CAP_SEG_KEY_MAX + 1];
     char format[8];        /* mp4, mkv or webm: the segment file's extension */
@@ -55,6 +59,8 @@ typedef struct cap_seg_info {
     uint32_t crc;          /* CRC-32 of every packet's payload, in the order libavformat reads them */
     bool has_hashes;
     uint64_t hashes_fnv;   /* FNV-1a 64 of the hash list's text */
+    bool has_replay;       /* manifests before sound have no replay line */
+    uint64_t replay_fnv;   /* FNV-1a 64 of the replay file */
 } cap_seg_info;
 
 /* One segment as join sees it. */
@@ -77,9 +83,14 @@ const char *cap_seg_format_of(const char *path);
 /* After a segment's render, with the file (and its hash list) in place:
  * reads it back through libavformat, checks it is ticks first..end-1
  * (count, keyframe, pts), and writes SEG.seg atomically.  hashes: its
- * list, or NULL.  False (CAP_ERR_SEG_* or CAP_ERR_WRITE) leaves no
+ * list, or NULL; replay_fnv: the replay file's FNV-1a 64 (rs_fnv1a64 of
+ * its bytes), or NULL.  False (CAP_ERR_SEG_* or CAP_ERR_WRITE) leaves no
  * manifest; the caller removes the files. */
-bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes, rs_err *err);
+bool cap_seg_seal(const char *seg, const char *key, uint64_t first, uint64_t end, const char *hashes,
+                  const uint64_t *replay_fnv, rs_err *err);
+
+/* The FNV-1a 64 of a replay file's bytes, as manifests record it. */
+bool cap_seg_replay_fnv(const char *replay, uint64_t *out, rs_err *err);
 
 /* What join wants of every segment. */
 typedef struct cap_seg_want {
@@ -110,6 +121,11 @@ typedef struct cap_join_desc {
 /* Creates OUT.part (and HASHES.part): fails with CAP_ERR_CREATE when the
  * output directory is gone or not writable, before any segment is read. */
 cap_join *cap_join_open(const cap_join_desc *d, rs_err *err);
+/* Optional, before cap_join_copy: an audio stream, the track, codec and
+ * bitrate of `audio` (a sink of the output given them by cap_sink_audio:
+ * the track covers the joined ticks, 800 sample frames each), encoded as
+ * the video is copied, so the sound is one piece across segment joins. */
+void cap_join_audio(cap_join *j, const cap_sink *audio);
 /* Stream-copies the verified segments in order: pts continue from one
  * segment to the next (the video starts at pts 0, as any render does),
  * dts = position - the largest B-frame delay, so they rise by one a

@@ -107,6 +107,12 @@ struct cap_sink {
     char enc_note[256];
     cap_meta meta[CAP_META_MAX];
     int n_meta;
+    /* FFmpeg sinks: the soundtrack (cap_audio.c), set by cap_sink_audio
+     * before open; audio NULL: no audio stream */
+    const float *audio;    /* 48 kHz stereo float, interleaved, borrowed */
+    size_t audio_frames;   /* sample frames: 800 a video frame */
+    int64_t audio_bitrate; /* bits/s, filled with the default when 0 */
+    char audio_codec[8];   /* "aac" or "opus" */
 };
 
 /* Adds one metadata entry (key from cap_meta_keys; empty values are skipped). */
@@ -122,6 +128,17 @@ bool cap_sink_for(const char *path, int w, int h, cap_sink *s, rs_err *err);
  * Y4M unless format says otherwise; MP4 is refused there (its index is
  * written last, by seeking back). */
 bool cap_sink_for_format(const char *path, const char *format, int w, int h, cap_sink *s, rs_err *err);
+
+/* The audio codec the sink's container carries: "aac" (.mp4, .mkv,
+ * .nut), "opus" (.webm), or NULL: no audio there (Y4M, images, null:,
+ * segments, or a build without FFmpeg). */
+const char *cap_sink_audio_codec(const cap_sink *s);
+/* Gives the sink its soundtrack: frames stereo 48 kHz float frames (800
+ * for every video frame, the first at video frame 0), encoded at bitrate
+ * bits/s (0: 192k AAC, 128k Opus) and interleaved with the video as it is
+ * written.  CAP_ERR_ENC_SETTING when the container takes no audio or the
+ * bitrate is outside the encoder's range (the message names both). */
+bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrate, rs_err *err);
 
 /* Human-readable list of what this build can write. */
 const char *cap_sink_formats(void);

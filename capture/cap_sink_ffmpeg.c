@@ -20,7 +20,11 @@
  * With x264's B-frames (delay D = 2 at veryfast) the dts of the k-th
  * packet is A + k - D: pts are consecutive, so x264's dts (the pts D
  * packets earlier in presentation order) run on across segment
- * boundaries without a gap or a repeat. */
+ * boundaries without a gap or a repeat.
+ *
+ * Sound (s->audio, cap_sink_audio): a second stream, AAC or Opus, encoded
+ * by cap_audio.c after each video frame up to that frame's end, and
+ * flushed before the trailer.  Segments never have one (join adds it). */
 #ifdef RS_HAVE_FFMPEG /* configure.sh found libavformat; otherwise this file is empty */
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
@@ -38,6 +42,7 @@ typedef struct ff_impl {
     cap_encoder x;
     AVStream *st;
     AVPacket *pkt;
+    cap_aenc a; /* a.ctx NULL: no audio */
     char part[1100];
     bool stream; /* "-" (fd 1), a device or a pipe: written in place, no .part, no rename */
 } ff_impl;
@@ -120,6 +125,8 @@ static bool ff_open(cap_sink *s, rs_err *err)
         f->st->codecpar->codec_tag = MKTAG('h', 'v', 'c', '1'); /* not hev1: Safari and QuickTime play only hvc1 */
     f->st->time_base = e->time_base;
     f->st->avg_frame_rate = e->framerate;
+    if (s->audio && !cap_aenc_open(&f->a, s, f->fmt, err))
+        goto fail;
     for (int i = 0; i < s->n_meta; i++)
         av_dict_set(&f->fmt->metadata, s->meta[i].key, s->meta[i].value, 0);
     if ((r = avio_open(&f->fmt->pb, f->part, AVIO_FLAG_WRITE)) < 0) {
@@ -150,7 +157,9 @@ static bool ff_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err *
 {
     ff_impl *f = s->impl;
     int64_t pts = (int64_t)index + (s->segment ? (int64_t)s->index_base : 0);
-    return cap_encoder_send(&f->x, s, frame, pts, err) && drain(s, f, err);
+    /* then the sound up to the end of this frame: 800 sample frames a tick */
+    return cap_encoder_send(&f->x, s, frame, pts, err) && drain(s, f, err) &&
+           (!f->a.ctx || cap_aenc_feed(&f->a, s, f->fmt, (size_t)(index + 1) * 800, err));
 }
 
 static bool ff_close(cap_sink *s, bool ok, rs_err *err)
@@ -165,6 +174,8 @@ static bool ff_close(cap_sink *s, bool ok, rs_err *err)
             good = fail_av(err, CAP_ERR_ENCODER, s->path, "flushing the encoder", r);
         else
             good = drain(s, f, err);
+        if (good && f->a.ctx)
+            good = cap_aenc_finish(&f->a, s, f->fmt, err);
         if (good && (r = av_write_trailer(f->fmt)) < 0)
             good = fail_av(err, CAP_ERR_WRITE, s->path, "write failed", r);
     }
@@ -180,6 +191,7 @@ static bool ff_close(cap_sink *s, bool ok, rs_err *err)
         unlink(f->part);
     av_packet_free(&f->pkt);
     cap_encoder_close(&f->x);
+    cap_aenc_close(&f->a);
     avformat_free_context(f->fmt);
     free(f);
     s->impl = NULL;

@@ -9,13 +9,16 @@
 #include <string.h>
 
 #include "../capture/cap_seg.h"
+#include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_progress.h"
 #include "cli.h"
+#include "job_audio.h"
 
 static void help(void)
 {
     printf("usage: ringside join --segment KEY -o OUT [-y|-n] [--hashes FILE] [--first T]\n"
-           "                     [--progress-fd N] [--progress tty|plain|off] [--quiet] SEG...\n\n"
+           "                     [--progress-fd N] [--progress tty|plain|off] [--quiet]\n"
+           "                     [--replay R [--audio-bitrate RATE] [--loudness LUFS]] SEG...\n\n"
            "Joins segments written by 'ringside render --ticks A:B --segment KEY' into one\n"
            "video by stream copy (no re-encoding): .mp4 (index at the front), .mkv or .webm,\n"
            "as OUT's extension says, with the segments' own format.  SEG... in tick order.\n\n"
@@ -32,6 +35,11 @@ static void help(void)
            "                    (one line per frame, as 'render --hashes' of the whole video;\n"
            "                    '-' for standard output)\n"
            "  --first T         the first segment starts at tick T (default 0)\n"
+           "  --replay R        the segments' replay: its soundtrack for the joined ticks is\n"
+           "                    mixed once and encoded beside the copied video (AAC in .mp4\n"
+           "                    and .mkv, Opus in .webm); without it the video is silent\n"
+           "  --audio-bitrate R, --loudness LUFS\n"
+           "                    as in 'ringside render' (defaults 192k AAC, 128k Opus; -16)\n"
            "  --progress-fd N   report on file descriptor N, for programs (ringside serve):\n"
            "                    'bad INDEX REASON MESSAGE' for each bad segment (INDEX: its\n"
            "                    position in SEG..., from 0), then 'frames DONE TOTAL' lines\n"
@@ -90,8 +98,11 @@ int cmd_join(int argc, char **argv)
         {"progress-fd", required_argument, 0, 'G'}, {"quiet", no_argument, 0, 'q'},
         {"help", no_argument, 0, 'h'},
         {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
-        {"progress", required_argument, 0, 'g'},   {0}};
-    const char *out = NULL, *key = NULL, *hashes = NULL;
+        {"progress", required_argument, 0, 'g'},   {"replay", required_argument, 0, 'R'},
+        {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
+        {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {0}};
+    const char *out = NULL, *key = NULL, *hashes = NULL, *replay = NULL;
+    job_audio audio = {0};
     uint64_t first = 0;
     long progress_fd = -1;
     bool quiet = false, overwrite = false;
@@ -111,6 +122,11 @@ int cmd_join(int argc, char **argv)
         case 'y': overwrite = true; break;
         case 'n': overwrite = false; break;
         case 'g': if (!cli_progress_mode("join", optarg, &progress)) return RS_EXIT_USAGE; break;
+        case 'R': replay = optarg; break;
+        case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS:
+            if (!job_audio_option(&audio, "join", c, optarg))
+                return RS_EXIT_USAGE;
+            break;
         default: return cli_bad_option("join", argv);
         }
     }
@@ -130,6 +146,24 @@ int cmd_join(int argc, char **argv)
     }
     if (!cli_out_ok("join", out, overwrite) || (hashes && strcmp(hashes, "-") && !cli_out_ok("join", hashes, overwrite)))
         return RS_EXIT_FAIL;
+    if (!replay && (audio.bitrate || audio.lufs)) {
+        cli_error("join", "--audio-bitrate and --loudness need --replay R (the sound comes from the replay)");
+        return RS_EXIT_USAGE;
+    }
+    rs_err err = {0};
+    cap_sink asink = {0}; /* the output as a render's sink: which codec, which bitrate */
+    bool usage;
+    audio.mode = replay ? JOB_AUDIO_ON : JOB_AUDIO_OFF;
+    if (replay && (!cap_sink_for(out, 16, 16, &asink, &err) || !job_audio_check(&audio, "join", &asink, &usage, &err))) {
+        if (err.msg[0])
+            cli_error("join", "%s", err.msg);
+        return RS_EXIT_USAGE;
+    }
+    rp_replay rp = {0};
+    if (replay && !rp_read(replay, &rp, &err)) {
+        cli_error("join", "%s", err.msg);
+        return RS_EXIT_USAGE;
+    }
     int n = argc - optind;
     char *const *paths = argv + optind;
     join_report rep = {.fd = (int)progress_fd};
@@ -147,7 +181,6 @@ int cmd_join(int argc, char **argv)
     sigaction(SIGINT, &sa, &old_int);
     sigaction(SIGTERM, &sa, &old_term);
     int status = RS_EXIT_FAIL;
-    rs_err err = {0};
     /* the output first: a directory that is gone is the output's failure, not the segments' */
     cap_join *j = cap_join_open(&(cap_join_desc){.out = out, .hashes = hashes, .progress = report_frames, .ctx = &rep,
                                                  .stop = &stop_requested},
@@ -164,6 +197,35 @@ int cmd_join(int argc, char **argv)
     uint64_t total = 0;
     for (int i = 0; i < n; i++)
         total += segs[i].m.frames;
+    uint64_t replay_fnv = 0;
+    if (replay && !cap_seg_replay_fnv(replay, &replay_fnv, &err)) {
+        cap_join_close(j, false, NULL);
+        goto done;
+    }
+    for (int i = 0; replay && i < n; i++)
+        if (segs[i].m.has_replay && segs[i].m.replay_fnv != replay_fnv) {
+            cap_join_close(j, false, NULL);
+            cli_error("join", "--replay %s: not the replay segment %d (%s) was rendered from (FNV-1a %016" PRIx64
+                              ", the manifest says %016" PRIx64 ")", replay, i, segs[i].path, replay_fnv, segs[i].m.replay_fnv);
+            status = RS_EXIT_USAGE;
+            goto done;
+        }
+    if (replay) {
+        /* the whole job's sound, once: ticks first..end of the manifests */
+        uint64_t t0 = segs[0].m.first, t1 = t0 + total;
+        if (t1 > rp.ticks) {
+            cap_join_close(j, false, NULL);
+            cli_error("join", "--replay %s: %" PRIu64 " ticks, but the segments run to tick %" PRIu64 "; not their replay", replay,
+                      rp.ticks, t1);
+            status = RS_EXIT_USAGE;
+            goto done;
+        }
+        if (!job_audio_plan(&audio, &asink, &rp, replay, t0, t1, &err)) {
+            cap_join_close(j, false, NULL);
+            goto done;
+        }
+        cap_join_audio(j, &asink);
+    }
     rs_progress_start(&rep.prog, "join", "frames", total, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
     cli_progress_fd(rep.fd, 0, total, &rep.last);
     int bad = -1;
@@ -178,9 +240,11 @@ int cmd_join(int argc, char **argv)
     }
     if (!cap_join_close(j, ok, &err))
         goto done;
+    char said[300];
+    job_audio_describe(&audio, &asink, said, sizeof said);
     if (!quiet)
-        fprintf(stderr, "ringside join: wrote %s: %" PRIu64 " frames (ticks %" PRIu64 "..%" PRIu64 ") from %d segments in %.2f s\n",
-                out, total, segs[0].m.first, segs[0].m.first + total - 1, n, secs);
+        fprintf(stderr, "ringside join: wrote %s: %" PRIu64 " frames (ticks %" PRIu64 "..%" PRIu64 ") from %d segments in %.2f s%s\n",
+                out, total, segs[0].m.first, segs[0].m.first + total - 1, n, secs, said);
     status = RS_EXIT_OK;
 done:
     sigaction(SIGINT, &old_int, NULL);
@@ -188,5 +252,7 @@ done:
     if (status == RS_EXIT_FAIL)
         cli_error("join", "%s", err.msg);
     free(segs);
+    job_audio_free(&audio);
+    rp_free(&rp);
     return status;
 }

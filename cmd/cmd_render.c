@@ -12,6 +12,7 @@
 #include "../capture/cap.h"
 #include "../capture/cap_seg.h"
 #include "cli.h"
+#include "job_audio.h"
 #include "job_poster.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
@@ -34,7 +35,8 @@ static void help(void)
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
            "                       [--ticks A:B] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
            "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
-           "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n\n"
+           "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n"
+           "                       [--audio on|off] [--audio-bitrate RATE] [--loudness LUFS] [--wav FILE]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension (any\n"
            "case) or --format: %s.\n"
@@ -99,6 +101,15 @@ static void help(void)
            "  --hw H             auto (default): NVENC or VAAPI when a device exists and the\n"
            "                     encoder opens, else software, with a note; off: software;\n"
            "                     nvenc, vaapi: that one or fail (docs/capture.md, Encoders)\n"
+           "  --audio on|off     the replay's soundtrack as an audio stream: AAC in .mp4, .mkv\n"
+           "                     and .nut, Opus in .webm (default on for those, off for Y4M,\n"
+           "                     image sequences and segments, which carry none)\n"
+           "  --audio-bitrate R  AAC 32k..512k (default 192k), Opus 16k..510k (default 128k)\n"
+           "  --loudness LUFS    the whole match's integrated loudness, EBU R128, %.0f..%.0f\n"
+           "                     (default %.0f; true peak at most -1 dBTP); --ticks A:B gets\n"
+           "                     exactly those samples of the whole match's track\n"
+           "  --wav FILE         also write the track of the rendered ticks as a 16-bit WAV,\n"
+           "                     beside any output (Y4M, images); obeys -y/-n\n"
            "  --progress MODE    tty: one line redrawn in place; plain: a line every 5 s and\n"
            "                     the last, for logs; off.  Default: tty when stderr is a\n"
            "                     terminal, else plain\n"
@@ -106,7 +117,8 @@ static void help(void)
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
-           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO);
+           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO, JOB_AUDIO_LUFS_MIN,
+           JOB_AUDIO_LUFS_MAX, JOB_AUDIO_LUFS_DEFAULT);
 }
 
 /* long-only options (no letter): the encoder's */
@@ -164,8 +176,11 @@ int cmd_render(int argc, char **argv)
         {"bitrate", required_argument, 0, OPT_BITRATE}, {"preset", required_argument, 0, OPT_PRESET},
         {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
         {"poster", required_argument, 0, 'O'},
+        {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
+        {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
         {0}};
     cap_enc enc = {0};
+    job_audio audio = {0};
     const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL, *poster_path = NULL;
     bool overwrite = false;
     int progress = RS_PROGRESS_AUTO;
@@ -292,6 +307,10 @@ int cmd_render(int argc, char **argv)
             }
             break;
         case 'O': poster_path = optarg; break;
+        case JOB_AUDIO_OPT_AUDIO: case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS: case JOB_AUDIO_OPT_WAV:
+            if (!job_audio_option(&audio, "render", c, optarg))
+                return RS_EXIT_USAGE;
+            break;
         default: return cli_bad_option("render", argv);
         }
     }
@@ -383,6 +402,12 @@ int cmd_render(int argc, char **argv)
     }
     sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
     sink.segment = segment != NULL;
+    audio.overwrite = overwrite;
+    bool usage;
+    if (!job_audio_check(&audio, "render", &sink, &usage, &err)) {
+        status = usage ? RS_EXIT_USAGE : RS_EXIT_FAIL;
+        goto done;
+    }
     render_meta(&sink, replay, &rp);
     if (!cap_sink_encoder(&sink, &enc, &err)) {
         status = err.code == CAP_ERR_ENC_SETTING ? RS_EXIT_USAGE : RS_EXIT_FAIL;
@@ -405,6 +430,8 @@ int cmd_render(int argc, char **argv)
         }
         cd.hashes = hf;
     }
+    if (!job_audio_plan(&audio, &sink, &rp, replay, t_first, t_end, &err))
+        goto done;
     p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err);
     if (!p) {
         status = cli_plat_status(&err);
@@ -472,26 +499,39 @@ int cmd_render(int argc, char **argv)
         }
         hpart[0] = 0;
     }
+    if (!job_audio_commit(&audio, &err)) {
+        /* the video and its WAV go together, as with the hash list */
+        struct stat vst;
+        if (stat(out, &vst) == 0 && S_ISREG(vst.st_mode))
+            unlink(out);
+        goto done;
+    }
     if (!job_poster_commit(&poster, &err))
         goto done;
-    if (segment && !cap_seg_seal(out, segment, t_first, t_end, hashes, &err)) {
+    uint64_t replay_fnv = 0; /* the manifest names the replay: join --replay checks it is the segments' */
+    if (segment && (!cap_seg_replay_fnv(replay, &replay_fnv, &err) ||
+                    !cap_seg_seal(out, segment, t_first, t_end, hashes, &replay_fnv, &err))) {
         /* no manifest, no segment: the files go too */
         unlink(out);
         if (hashes)
             unlink(hashes);
         if (poster.due)
             unlink(poster.path);
+        if (audio.wav)
+            unlink(audio.wav);
         goto done;
     }
+    char said[300];
+    job_audio_describe(&audio, &sink, said, sizeof said);
     if (!quiet)
         fprintf(stderr,
                 "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d) in %.1f s, %.1f fps; %s capture, "
-                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s\n",
+                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n", /* the encoder last */
                 out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, secs, secs > 0 ? st.frames / secs : 0.0,
                 cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
-                st.high_water, st.fence_waits, sink.enc_name[0] ? "; encoder " : "", sink.enc_name);
+                st.high_water, st.fence_waits, said, sink.enc_name[0] ? "; encoder " : "", sink.enc_name);
     if (!quiet && poster.due)
         fprintf(stderr, "ringside render: poster %s: frame %" PRIu64 " (%s)\n", poster.path, poster.tick,
                 job_poster_why_name(poster.why));
@@ -511,6 +551,7 @@ done:
     if (hpart[0])
         unlink(hpart);
     job_poster_abandon(&poster);
+    job_audio_free(&audio);
     if (p) {
         r_target_destroy(&t);
         r_game_destroy(r);

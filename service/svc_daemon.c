@@ -216,8 +216,10 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
         w->nunits = d->store->ops->units(d->store, j->id, w->units, j->segments + 1, err);
         if (w->nunits < 0)
             return false;
-    } else if (!rs_mkdirs_for(w->f.replay, err) || !rs_write_part(w->f.replay, j->replay, j->replay_len, err) ||
-               !rs_commit_file(w->f.replay, err))
+    }
+    /* every unit gets the replay: renders draw it, the join mixes its sound */
+    if (!rs_mkdirs_for(w->f.replay, err) || !rs_write_part(w->f.replay, j->replay, j->replay_len, err) ||
+        !rs_commit_file(w->f.replay, err))
         return false;
     if (j->unit.kind == SVC_UNIT_SEGMENT && !rs_mkdirs_for(w->f.out, err))
         return false;

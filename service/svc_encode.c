@@ -117,6 +117,12 @@ bool svc_encode_check(const svc_config *cfg, const svc_encode_req *q, const char
             return rs_fail(err, SVC_ERR_BAD_PARAM, "pix_fmt '%s': expected yuv420p or yuv444p", q->pix_fmt);
         put(out, n, "pix_fmt", q->pix_fmt);
     }
+    if (q->audio && q->audio[0]) {
+        if (strcmp(q->audio, "on") && strcmp(q->audio, "off"))
+            return rs_fail(err, SVC_ERR_BAD_PARAM, "audio '%s': expected on or off", q->audio);
+        if (!strcmp(q->audio, "off"))
+            put(out, n, "audio", "off"); /* render --audio off; the join gets no --replay */
+    }
     if (!out[0])
         return true;
     /* the encoder's own word on the rest (container, preset names, CRF range) */

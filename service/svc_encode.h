@@ -1,4 +1,4 @@
-/* A job's encoder options (codec, crf, bitrate, preset, pix_fmt): checked
+/* A job's encoder options (codec, crf, bitrate, preset, pix_fmt, audio): checked
  * at upload, stored as one string, given to the job's renders. */
 #ifndef SVC_ENCODE_H
 #define SVC_ENCODE_H
@@ -13,6 +13,7 @@
 /* What an upload asked for; NULL or "": not asked. */
 typedef struct svc_encode_req {
     const char *codec, *crf, *bitrate, *preset, *pix_fmt;
+    const char *audio; /* "on" (the default: not stored) or "off" */
 } svc_encode_req;
 
 /* Checks q against the settings and the encoder for a video of format

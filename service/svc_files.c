@@ -143,6 +143,13 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
                                     "--progress-fd", "3", "--quiet"};
         for (size_t i = 0; i < sizeof head / sizeof *head; i++)
             add(&a, head[i]);
+        /* the job's sound, mixed once for the whole video (segments are silent), unless it asked for none */
+        char audio[8];
+        svc_encode_get(j->encode, "audio", audio, sizeof audio);
+        if (strcmp(audio, "off")) {
+            add(&a, "--replay");
+            add(&a, f->replay);
+        }
         int k = 0;
         for (int i = 0; i < n; i++) {
             if (units[i].kind != SVC_UNIT_SEGMENT)

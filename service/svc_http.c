@@ -384,7 +384,7 @@ typedef struct req {
     const char *bad; /* a malformed body: answered 400 once it is read */
     char name[SVC_NAME_MAX];
     char size[32], format[16];
-    char codec[16], crf[8], bitrate[16], preset[CAP_ENC_PRESET_MAX], pix_fmt[16]; /* svc_encode.c */
+    char codec[16], crf[8], bitrate[16], preset[CAP_ENC_PRESET_MAX], pix_fmt[16], audio[8]; /* svc_encode.c */
     /* who asks (authorize): tok.id 0 without a token; all: sees every job
      * (an operator token, or loopback with no tokens at all) */
     svc_token tok;
@@ -522,7 +522,7 @@ static enum MHD_Result post_field(void *cls, enum MHD_ValueKind kind, const char
     } const fields[] = {{"size", q->size, sizeof q->size},       {"format", q->format, sizeof q->format},
                         {"codec", q->codec, sizeof q->codec},    {"crf", q->crf, sizeof q->crf},
                         {"bitrate", q->bitrate, sizeof q->bitrate}, {"preset", q->preset, sizeof q->preset},
-                        {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}};
+                        {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}, {"audio", q->audio, sizeof q->audio}};
     char *dst = NULL;
     size_t room = 0;
     for (size_t i = 0; i < sizeof fields / sizeof *fields; i++)
@@ -634,7 +634,8 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
                           {"crf", q->crf, sizeof q->crf},
                           {"bitrate", q->bitrate, sizeof q->bitrate},
                           {"preset", q->preset, sizeof q->preset},
-                          {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}};
+                          {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt},
+                          {"audio", q->audio, sizeof q->audio}};
     for (size_t i = 0; i < sizeof enc_args / sizeof *enc_args; i++)
         if (!enc_args[i].dst[0] && (v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, enc_args[i].key))) {
             if (strlen(v) >= enc_args[i].room)
@@ -672,7 +673,7 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         snprintf(j.format, sizeof j.format, "%s", q->format);
     }
     rs_err err = {0};
-    svc_encode_req eq = {q->codec, q->crf, q->bitrate, q->preset, q->pix_fmt};
+    svc_encode_req eq = {q->codec, q->crf, q->bitrate, q->preset, q->pix_fmt, q->audio};
     if (!svc_encode_check(&d->cfg, &eq, j.format, j.width, j.height, j.encode, sizeof j.encode, &err))
         return reject(d, c, err.code, "%s", err.msg);
     if (!svc_check_upload(&d->cfg, q->body, q->len, j.name, &j, &err))
@@ -1427,7 +1428,7 @@ static bool state_changing(const char *method)
 static const struct {
     const char *method, *path, *params;
 } query_params[] = {
-    {"POST", "/jobs", "size,format,name,codec,crf,bitrate,preset,pix_fmt"},
+    {"POST", "/jobs", "size,format,name,codec,crf,bitrate,preset,pix_fmt,audio"},
     {"GET", "/jobs", "limit,before"},
     {"HEAD", "/jobs", "limit,before"},
 };

@@ -188,7 +188,10 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
     json_replay(b, j);
     char codec[16];
     codec_of(j, codec, sizeof codec);
-    svc_buf_printf(b, ",\"length_s\":%.2f,\"codec\":\"%s\",\"encode\":", j->frames_total / 60.0, codec);
+    char audio[8];
+    svc_encode_get(j->encode, "audio", audio, sizeof audio); /* stored only when off */
+    svc_buf_printf(b, ",\"length_s\":%.2f,\"codec\":\"%s\",\"audio\":%s,\"encode\":", j->frames_total / 60.0, codec,
+                   strcmp(audio, "off") ? "true" : "false");
     svc_json_str(b, j->encode);
     if (v && v->bytes >= 0)
         svc_buf_printf(b, ",\"bytes\":%lld", (long long)v->bytes);

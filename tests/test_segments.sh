@@ -156,7 +156,7 @@ t_bad_segments_exit_3() {
     cp keep.hashes s70.hashes
     # a manifest that is not one
     echo "hello" >>s0.mp4.seg
-    bad_join 0 manifest "s0.mp4.seg: has text after the 'hashes' line" s0.mp4 s70.mp4 s160.mp4 || return 1
+    bad_join 0 manifest "s0.mp4.seg: has text after the 'replay' line" s0.mp4 s70.mp4 s160.mp4 || return 1
     # two bad at once: both named, in order
     cp "$FIX/mp4/s0.mp4.seg" .
     rm s160.mp4

@@ -595,7 +595,7 @@ static void t_json_job(void)
     svc_job j = job(SVC_QUEUED);
     job_is(&j, JOB_HEAD "\"queued\"," JOB_NAME "\"frames_done\":0,\"frames_total\":200,\"progress\":0.0000,"
                         "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
                         "\"finished\":null,\"url\":\"/jobs/42\",\"log\":\"/jobs/42/log\"}", true);
@@ -603,13 +603,17 @@ static void t_json_job(void)
     j.frames_done = 50, j.fps = 25, j.started = 1700000060;
     job_is(&j, JOB_HEAD "\"running\"," JOB_NAME "\"frames_done\":50,\"frames_total\":200,\"progress\":0.2500,"
                         "\"fps\":25.00,\"eta_s\":6.0," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"worker\":\"box:123\",\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":null,\"url\":\"/jobs/42\","
                         "\"log\":\"/jobs/42/log\"}", true);
     j.fps = 0; /* no speed yet: no guess */
     job_is(&j, "\"fps\":0.00,\"eta_s\":null,", false);
+    /* a job uploaded with audio=off says so (its renders get --audio off) */
+    snprintf(j.encode, sizeof j.encode, "codec=vp9 audio=off");
+    job_is(&j, "\"codec\":\"vp9\",\"audio\":false,\"encode\":\"codec=vp9 audio=off\",", false);
+    j.encode[0] = 0;
     /* the replay's header, and what the HTTP side adds */
     svc_job k = job(SVC_DONE);
     k.stage = 4, k.kind[0] = RP_HUMAN, k.kind[1] = RP_CPU, k.winner = 2, k.rounds[0] = 1, k.rounds[1] = 2;
@@ -618,7 +622,7 @@ static void t_json_job(void)
     svc_buf b = {0};
     svc_json_job(&b, &k, 3, NULL, 0, &v);
     T_CONTAINS(b.p, "\"eta_s\":null,\"queue_position\":null,\"stage\":\"snowfield\",\"players\":[\"human\",\"cpu\"],"
-                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":123456,\"render_s\":12,");
+                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":123456,\"render_s\":12,");
     T_CONTAINS(b.p, "\"poster\":\"/jobs/42/poster\",\"log\":\"/jobs/42/log\"}");
     svc_buf_free(&b);
     k = job(SVC_QUEUED);
@@ -634,7 +638,7 @@ static void t_json_job(void)
     j.started = 1700000060, j.finished = 1700000100;
     job_is(&j, JOB_HEAD "\"done\"," JOB_NAME "\"frames_done\":200,\"frames_total\":200,\"progress\":1.0000,"
                         "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,\"render_s\":40,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,\"render_s\":40,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":\"2023-11-14T22:15:00Z\","
@@ -646,7 +650,7 @@ static void t_json_job(void)
     snprintf(j.error, sizeof j.error, "desync at tick 0:\n\"want\" \x01 \xff");
     job_is(&j, JOB_HEAD "\"failed\"," JOB_NAME "\"frames_done\":120,\"frames_total\":200,\"progress\":0.6000,"
                         "\"fps\":0.00,\"eta_s\":null,\"queue_position\":null,\"stage\":null,\"players\":null,"
-                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"encode\":\"\",\"bytes\":null,"
+                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,"
                         "\"render_s\":null,\"attempts\":3,\"max_attempts\":3,"
                         "\"error\":\"desync at tick 0:\\n\\\"want\\\" \\u0001 \\ufffd\",\"desync_tick\":0,"
                         "\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
