@@ -60,7 +60,7 @@ static void help(void)
            "  --hdr-format F   the HDR buffer: rgba16f (default) or r11g11b10f\n"
            "  --audio-out F    write the sound to F (.wav, 16-bit) instead of the audio device;\n"
            "                   headless, without it, the game is silent\n"
-           "  --mute           no sound at all (the mixer does not run)\n"
+           "  --mute           no sound (the mixer does not run; --audio-out gets silence)\n"
            "  --volume V       output volume, 0..1 (linear; default 1; 0 is --mute)\n"
            "  --audio-device D  the OpenAL device to play on (default: the system's)\n");
 }
@@ -125,6 +125,8 @@ static void on_step(void *user, const g_input in[2])
         s->failed = true;
     if (s->mix)
         play_sound(s, &ev);
+    else if (s->out && !au_out_write(s->out, s->pcm, AU_TICK_FRAMES, &s->err)) /* muted: s->pcm stays zero */
+        s->failed = true;
 }
 
 static void on_render(void *user, float alpha)
@@ -197,12 +199,13 @@ static bool parse_volume(const char *arg, float *v)
 static bool audio_open(play *s, const char *wav, bool mute, float volume, const char *device, bool headless,
                        int stage)
 {
-    if (mute || volume == 0 || (headless && !wav))
+    bool silent = mute || volume == 0;
+    if ((silent && !wav) || (headless && !wav))
         return true;
     if (wav && !rs_out_check(wav, true, &s->err))
         return false;
     rs_err err = {0};
-    s->out = au_out_open(&(au_out_opts){.wav_path = wav, .device = device, .volume = volume}, &err);
+    s->out = au_out_open(&(au_out_opts){.wav_path = wav, .device = device, .volume = silent ? 1 : volume}, &err);
     if (!s->out) {
         if (wav || err.code != AU_ERR_DEVICE) {
             s->err = err;
@@ -211,6 +214,8 @@ static bool audio_open(play *s, const char *wav, bool mute, float volume, const 
         fprintf(stderr, "ringside play: warning: %s; the game runs silent\n", err.msg);
         return true;
     }
+    if (silent) /* --audio-out records what was played: silence, tick for tick */
+        return true;
     s->mix = au_mixer_new(NULL, &s->err);
     if (!s->mix)
         return false;
@@ -353,10 +358,6 @@ int cmd_play(int argc, char **argv)
         const char *dot = strrchr(audio_out, '.');
         if (!dot || strcmp(dot, ".wav")) {
             cli_error("play", "--audio-out %s: expected a .wav file", audio_out);
-            goto done;
-        }
-        if (mute || volume == 0) {
-            cli_error("play", "--audio-out with %s: nothing would be written", mute ? "--mute" : "--volume 0");
             goto done;
         }
     }
