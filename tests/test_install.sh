@@ -122,10 +122,12 @@ t_bash_completion() {
     complete_words ringside render f >got.txt && want "render REPLAY" fight.rsr || return 1
     complete_words ringside render x --size "" >got.txt && want "render --size" || return 1
     # subcommands and their own options
-    complete_words ringside bench "" >got.txt && want "bench" platform sim capture accuracy upload encode || return 1
+    complete_words ringside bench "" >got.txt && want "bench" platform sim capture accuracy upload encode audio || return 1
     complete_words ringside bench capture --si >got.txt && want "bench capture --si" --sink --size || return 1
     complete_words ringside bench capture --sink "" >got.txt && want "bench capture --sink" mp4 y4m null || return 1
     complete_words ringside replay v >got.txt && want "replay" verify || return 1
+    complete_words ringside replay "" >got.txt && want "replay" info verify sound events || return 1
+    complete_words ringside play --mu >got.txt && want "play --mu" --mute || return 1
     # serve: its settings are options; token's own
     complete_words ringside serve --ret >got.txt && want "serve --ret" --retention || return 1
     complete_words ringside serve token add bob --op >got.txt && want "serve token --op" --operator || return 1
