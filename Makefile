@@ -202,6 +202,7 @@ bench: $(BUILD)/ringside
 	$(BUILD)/ringside bench sim -y --csv out/bench-sim.csv
 	$(BUILD)/ringside bench capture -y --csv out/bench-capture.csv --chart out/bench-capture.png
 	$(BUILD)/ringside bench upload -y --csv out/bench-upload.csv
+	$(BUILD)/ringside bench audio -y --csv out/bench-audio.csv
 
 # The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
 # same commands must reproduce them byte for byte (tests/test_replay.sh).
