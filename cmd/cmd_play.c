@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "snd_out.h"
 #include "../runtime/audio/au_out.h"
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
@@ -178,19 +179,6 @@ static bool screenshot(play *s, const char *path, rs_err *err)
     return ok;
 }
 
-/* --volume: a number in 0..1. */
-static bool parse_volume(const char *arg, float *v)
-{
-    char *end;
-    double d = strtod(arg, &end);
-    if (end == arg || *end || !(d >= 0 && d <= 1)) {
-        cli_error("play", "--volume '%s': expected a number in 0..1 (linear; 0 is --mute)", arg);
-        return false;
-    }
-    *v = (float)d;
-    return true;
-}
-
 /* The output the options ask for.  --audio-out is opened before anything
  * else, so a bad path stops the run at once; the device after the window,
  * so a run that cannot open a window says only that.  A device that
@@ -326,7 +314,13 @@ int cmd_play(int argc, char **argv)
         case 'q': quiet = true; break;
         case 'A': audio_out = optarg; break;
         case 'M': mute = true; break;
-        case 'V': if (!parse_volume(optarg, &volume)) goto done; break;
+        case 'V': {
+            snd_opts so = {0}; /* the parsing movie and attract use */
+            if (!snd_volume_arg("play", optarg, &so))
+                goto done;
+            volume = so.volume;
+            break;
+        }
         case 'D': audio_device = optarg; break;
         case 'h': help(); status = RS_EXIT_OK; goto done;
         default:

@@ -58,8 +58,8 @@ t_mute_and_headless_are_silent() {
 }
 
 t_usage() {
-    expect_fail 2 "--volume '2': expected a number in 0\.\.1" "$RS_BIN" play --headless --seconds 1 --volume 2 || return 1
-    expect_fail 2 "--volume 'loud': expected a number in 0\.\.1" "$RS_BIN" play --headless --seconds 1 --volume loud ||
+    expect_fail 2 "--volume '2': expected a number from 0 \(silent\) to 1 \(full\)" "$RS_BIN" play --headless --seconds 1 --volume 2 || return 1
+    expect_fail 2 "--volume 'loud': expected a number from 0 \(silent\) to 1 \(full\)" "$RS_BIN" play --headless --seconds 1 --volume loud ||
         return 1
     expect_fail 2 "--volume '-0.1'" "$RS_BIN" play --headless --seconds 1 --volume -0.1 || return 1
     expect_fail 2 "--audio-out x.mp3: expected a \.wav file" "$RS_BIN" play --headless --seconds 1 --audio-out x.mp3 ||
