@@ -190,18 +190,27 @@ static void t_no_audio_is_silence_not_error(void)
     T_CONTAINS(err.msg, "nothing.mkv");
 }
 
+/* A click train: one 0.9 impulse at the start of each second of a 44.1
+ * kHz track, `seconds` long, as FLAC in dir; its name in path. */
+static void click_track(const char *dir, int seconds, char *path, size_t size)
+{
+    char one[1024];
+    snprintf(one, sizeof one, "%s/click.wav", dir);
+    snprintf(path, size, "%s/clicks.mka", dir);
+    sh("ffmpeg -nostdin -hide_banner -loglevel error -y -f lavfi -i 'aevalsrc=if(eq(n\\,0)\\,0.9\\,0):s=44100:d=1' "
+       "-c:a pcm_s16le '%s'", one);
+    sh("ffmpeg -nostdin -hide_banner -loglevel error -y -stream_loop -1 -i '%s' -t %d -c:a flac '%s'", one, seconds,
+       path);
+}
+
 /* A click train: one impulse each second of a 44.1 kHz track, looped for
  * ten minutes; read as 36000 ticks, each click must sit on its second. */
 static void t_no_drift_over_36000_ticks(void)
 {
     need_ffmpeg();
     const char *dir = t_tmpdir();
-    char one[1024], path[1024];
-    snprintf(one, sizeof one, "%s/click.wav", dir);
-    snprintf(path, sizeof path, "%s/clicks.mka", dir);
-    sh("ffmpeg -nostdin -hide_banner -loglevel error -y -f lavfi -i 'aevalsrc=if(eq(n\\,0)\\,0.9\\,0):s=44100:d=1' "
-       "-c:a pcm_s16le '%s'", one);
-    sh("ffmpeg -nostdin -hide_banner -loglevel error -y -stream_loop -1 -i '%s' -t 600 -c:a flac '%s'", one, path);
+    char path[1024];
+    click_track(dir, 600, path, sizeof path);
     const int64_t ticks = 36000;
     mv_audio_stats st;
     clock_t c0 = clock();
@@ -231,12 +240,8 @@ static void t_late_read_is_silent_and_moves_on(void)
 {
     need_ffmpeg();
     const char *dir = t_tmpdir();
-    char one[1024], path[1024];
-    snprintf(one, sizeof one, "%s/click.wav", dir);
-    snprintf(path, sizeof path, "%s/clicks.mka", dir);
-    sh("ffmpeg -nostdin -hide_banner -loglevel error -y -f lavfi -i 'aevalsrc=if(eq(n\\,0)\\,0.9\\,0):s=44100:d=1' "
-       "-c:a pcm_s16le '%s'", one);
-    sh("ffmpeg -nostdin -hide_banner -loglevel error -y -stream_loop -1 -i '%s' -t 300 -c:a flac '%s'", one, path);
+    char path[1024];
+    click_track(dir, 300, path, sizeof path);
     rs_err err = {0};
     mv_audio *a = mv_audio_open(path, &err);
     T_ASSERTF(a, "%s", err.msg);

@@ -32,26 +32,22 @@ probe postgres libpq RS_HAVE_PQ
 probe microhttpd libmicrohttpd RS_HAVE_MHD
 # live sound (play, movie, attract): OpenAL Soft; without it they run silent
 probe openal openal RS_HAVE_OPENAL
-# libpng writes every PNG (runtime/util/rs_img.c): every build needs it,
-# whatever RS_ONLY says
-if pkg-config --exists libpng 2>/dev/null; then
-    cflags="$cflags $(pkg-config --cflags libpng)"
-    libs="$libs $(pkg-config --libs libpng)"
-    have="$have png"
-else
-    echo "configure: libpng not found by pkg-config; run tools/deps.sh build" >&2
-    exit 1
-fi
-# libebur128 measures loudness (runtime/audio/au_loud.c): every build's
-# soundtracks are normalized with it, whatever RS_ONLY says
-if pkg-config --exists libebur128 2>/dev/null; then
-    cflags="$cflags $(pkg-config --cflags libebur128)"
-    libs="$libs $(pkg-config --libs libebur128)"
-    have="$have ebur128"
-else
-    echo "configure: libebur128 not found by pkg-config; run tools/deps.sh build" >&2
-    exit 1
-fi
+# Libraries every build needs, whatever RS_ONLY says: name, pkg-config module
+require() {
+    if pkg-config --exists "$2" 2>/dev/null; then
+        cflags="$cflags $(pkg-config --cflags "$2")"
+        libs="$libs $(pkg-config --libs "$2")"
+        have="$have $1"
+    else
+        echo "configure: $2 not found by pkg-config; run tools/deps.sh build" >&2
+        exit 1
+    fi
+}
+# libpng writes every PNG (runtime/util/rs_img.c)
+require png libpng
+# libebur128 measures loudness (runtime/audio/au_loud.c): every soundtrack is
+# normalized with it
+require ebur128 libebur128
 case "$have" in
 *egl*|*osmesa*) ;;
 *) echo "configure: neither EGL nor OSMesa found by pkg-config; run tools/deps.sh build" >&2; exit 1 ;;
