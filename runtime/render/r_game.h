@@ -33,6 +33,23 @@ static inline r_game_hdr r_game_hdr_of(int fmt)
     return fmt == R_HDR_R11G11B10F ? R_GAME_HDR_R11G11B10F : R_GAME_HDR_RGBA16F;
 }
 
+/* The renderer's cost/accuracy knobs (docs/accuracy.md, "Quality"): zero
+ * in every field is the full-quality default.  The render scale (how many
+ * pixels are drawn per output pixel) is not here: it is the caller's
+ * choice of the size passed to r_game_draw.  Presets are rs_quality's
+ * (runtime/render/r_quality.h); each field is read at r_game_create_opts. */
+typedef enum r_aa { R_AA_OFF, R_AA_FXAA } r_aa;
+typedef struct r_quality {
+    int shadow_size;  /* SSFSM light depth map, texels a side, 128..4096: 0 = 1024 */
+    int sil_size;     /* projection-shadow silhouette, level 0, 64..2048: 0 = 512 */
+    bool mask_half;   /* SSFSM's shadow mask and its filter at half the render size */
+    int bloom_levels; /* bloom pyramid levels added, 1..2: 0 = 2 (1/4 and 1/8 of 720 rows) */
+    r_aa aa;          /* post-process anti-aliasing on the tone-mapped image */
+    int lspsm_size;   /* LSPSM shadow map, texels a side, 256..4096: 0 = the module's default */
+    int fog_size;     /* the mist's top-down density map, 64..1024: 0 = the module's default */
+    int water_grid;   /* water surface quads a side, 16..256: 0 = the module's default */
+} r_quality;
+
 /* Zero is the default for every field. */
 typedef struct r_game_opts {
     const char *stage_file; /* NULL: <data>/stages/<game stage>.stage */
@@ -42,6 +59,7 @@ typedef struct r_game_opts {
     const char *cache_dir;  /* NULL: r_ibl_cache_dir(); "" = no cache */
     int lut_size;           /* 0: R_TONE_LUT_DEFAULT */
     bool quiet;             /* no note when prefiltering takes a while */
+    r_quality q;            /* zero: full quality */
 } r_game_opts;
 
 /* Needs a current GL context. */
