@@ -10,6 +10,7 @@
 
 #include "../runtime/game/g_game.h"
 #include "../runtime/platform/plat.h"
+#include "../runtime/render/r_quality.h"
 #include "../runtime/render/r_stage.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_out.h"
@@ -92,6 +93,37 @@ bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
     *w = (int)a;
     *h = (int)b;
     return true;
+}
+
+bool cli_out_size(const char *opt, const char *arg, int *w, int *h)
+{
+    if (!cli_size(opt, arg, R_RENDER_MAX, w, h))
+        return false;
+    if (*w < CLI_SIZE_MIN || *h < CLI_SIZE_MIN) {
+        fprintf(stderr, "ringside: %s '%s': the smallest output is %dx%d\n", opt, arg, CLI_SIZE_MIN, CLI_SIZE_MIN);
+        return false;
+    }
+    return true;
+}
+
+const struct r_preset *cli_quality(const char *cmd, const char *arg)
+{
+    const r_preset *p = r_preset_named(arg);
+    if (!p)
+        cli_error(cmd, "--quality '%s': expected %s", arg, r_preset_list());
+    return p;
+}
+
+const char *cli_quality_help(void)
+{
+    static char text[1024];
+    if (!text[0]) {
+        size_t n = 0;
+        for (int i = 0; i < R_PRESETS && n < sizeof text; i++)
+            n += (size_t)snprintf(text + n, sizeof text - n, "                       %-10s %s\n", r_presets[i].name,
+                                  r_presets[i].what);
+    }
+    return text;
 }
 
 bool cli_stage(const char *arg, int *stage)

@@ -21,6 +21,14 @@ typedef struct cli_cmd {
 void cli_progress_fd(int fd, uint64_t done, uint64_t total, double *last);
 /* Parses "WxH" with 1 <= W,H <= max; prints a usage error naming opt. */
 bool cli_size(const char *opt, const char *arg, int max, int *w, int *h);
+/* An output size: "WxH" with CLI_SIZE_MIN <= W,H <= R_RENDER_MAX (r_quality.h). */
+#define CLI_SIZE_MIN 16
+bool cli_out_size(const char *opt, const char *arg, int *w, int *h);
+/* --quality NAME: the preset, or NULL after a usage error naming cmd. */
+struct r_preset;
+const struct r_preset *cli_quality(const char *cmd, const char *arg);
+/* The presets for --help: one indented line each, "draft ... \n". */
+const char *cli_quality_help(void);
 /* Parses a non-negative 64-bit number (decimal or 0x hex). */
 bool cli_u64(const char *opt, const char *arg, uint64_t *out);
 /* Parses an integer in [lo, hi]; prints a usage error naming opt. */
@@ -49,6 +57,7 @@ int cmd_attract(int argc, char **argv);
 int bench_upload(int argc, char **argv);
 int bench_encode(int argc, char **argv);
 int bench_audio(int argc, char **argv);
+int bench_quality(int argc, char **argv);
 int cmd_serve(int argc, char **argv);
 int cmd_join(int argc, char **argv);
 

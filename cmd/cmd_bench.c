@@ -27,7 +27,8 @@ static void help(void)
            "       ringside bench accuracy [--frames N] ... (see bench accuracy --help)\n"
            "       ringside bench upload [--frames N] [--modes LIST] ... (see bench upload --help)\n"
            "       ringside bench encode [--frames N] [--codecs LIST] ... (see bench encode --help)\n"
-           "       ringside bench audio [--replay FILE] [--csv FILE] ... (see bench audio --help)\n\n"
+           "       ringside bench audio [--replay FILE] [--csv FILE] ... (see bench audio --help)\n"
+           "       ringside bench quality [--size WxH] [--frames N] ... (see bench quality --help)\n\n"
            "bench platform times every headless backend built in (egl, osmesa) in one run\n"
            "on the smoke scene: context start-up, draw (glFinish), and draw + full-frame\n"
            "glReadPixels.  Each figure is the median over the runs; the ratio line compares\n"
@@ -264,8 +265,10 @@ int cmd_bench(int argc, char **argv)
         return bench_encode(argc - 1, argv + 1);
     if (!strcmp(argv[1], "audio"))
         return bench_audio(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "quality"))
+        return bench_quality(argc - 1, argv + 1);
     if (strcmp(argv[1], "platform") != 0) {
-        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim, capture, accuracy, upload, encode, audio)",
+        cli_error("bench", "unknown benchmark '%s' (expected: platform, sim, capture, accuracy, upload, encode, audio, quality)",
                   argv[1]);
         return RS_EXIT_USAGE;
     }

@@ -18,6 +18,7 @@
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
+#include "../runtime/render/r_quality.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
@@ -26,7 +27,7 @@
 
 static void help(void)
 {
-    printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
+    printf("usage: ringside render REPLAY -o OUT [--size WxH] [--quality Q] [--render-size WxH]\n"
            "                       [--capture async|sequential] [--downscale gpu|cpu]\n"
            "                       [--filter box|bilinear|nearest|lanczos3] [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
@@ -52,8 +53,14 @@ static void help(void)
            "                     never replace them: an existing output is refused, naming it,\n"
            "                     and nothing is written.  The default: ringside never asks,\n"
            "                     on a terminal or off it.  The output's folder must exist\n"
-           "  --size WxH         output size, even numbers (default 640x360)\n"
-           "  --render-size WxH  size the game is drawn at (default 1280x720)\n"
+           "  --size WxH         output size, %d..%d a side, even numbers for video\n"
+           "                     (default 640x360)\n"
+           "  --quality Q        draft, standard (default), high or reference: how many\n"
+           "                     pixels are drawn per output pixel and the renderer's\n"
+           "                     knobs, chosen by measured error (docs/accuracy.md):\n"
+           "%s"
+           "  --render-size WxH  draw at this size instead of the quality's (at least the\n"
+           "                     output size, at most %d times it)\n"
            "  --capture MODE     async (default): GPU downscale, PBO ring, writer thread;\n"
            "                     sequential: the original, everything on the game thread\n"
            "  --downscale WHERE  gpu (async default) or cpu (sequential default)\n"
@@ -117,7 +124,7 @@ static void help(void)
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
-           cap_sink_formats(), CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO, JOB_AUDIO_LUFS_MIN,
+           cap_sink_formats(), CLI_SIZE_MIN, R_RENDER_MAX, cli_quality_help(), CAP_MAX_SCALE, CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO, JOB_AUDIO_LUFS_MIN,
            JOB_AUDIO_LUFS_MAX, JOB_AUDIO_LUFS_DEFAULT);
 }
 
@@ -175,7 +182,7 @@ int cmd_render(int argc, char **argv)
         {"codec", required_argument, 0, OPT_CODEC}, {"crf", required_argument, 0, OPT_CRF},
         {"bitrate", required_argument, 0, OPT_BITRATE}, {"preset", required_argument, 0, OPT_PRESET},
         {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
-        {"poster", required_argument, 0, 'O'},
+        {"poster", required_argument, 0, 'O'},     {"quality", required_argument, 0, 'L'},
         {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
         {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
         {0}};
@@ -184,7 +191,8 @@ int cmd_render(int argc, char **argv)
     const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL, *poster_path = NULL;
     bool overwrite = false;
     int progress = RS_PROGRESS_AUTO;
-    cap_desc cd = {.w = 640, .h = 360, .src_w = 1280, .src_h = 720};
+    cap_desc cd = {.w = 640, .h = 360};
+    const r_preset *quality = &r_presets[R_PRESET_DEFAULT];
     bool quiet = false;
     r_game_opts go = {0};
     int passes = 0; /* 1 summary, 2 per frame */
@@ -197,8 +205,9 @@ int cmd_render(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
         switch (c) {
         case 'o': out = optarg; break;
-        case 's': if (!cli_size("--size", optarg, 8192, &cd.w, &cd.h)) return RS_EXIT_USAGE; break;
-        case 'r': if (!cli_size("--render-size", optarg, 8192, &cd.src_w, &cd.src_h)) return RS_EXIT_USAGE; break;
+        case 's': if (!cli_out_size("--size", optarg, &cd.w, &cd.h)) return RS_EXIT_USAGE; break;
+        case 'r': if (!cli_size("--render-size", optarg, R_RENDER_MAX, &cd.src_w, &cd.src_h)) return RS_EXIT_USAGE; break;
+        case 'L': if (!(quality = cli_quality("render", optarg))) return RS_EXIT_USAGE; break;
         case 'c':
             if (!strcmp(optarg, "async"))
                 cd.mode = CAP_ASYNC;
@@ -353,6 +362,9 @@ int cmd_render(int argc, char **argv)
         }
     }
     go.quiet = quiet;
+    go.q = quality->q;
+    if (!cd.src_w) /* the quality's scale, unless --render-size said */
+        r_preset_render_size(quality, cd.w, cd.h, R_RENDER_MAX, &cd.src_w, &cd.src_h);
     if (!cap_check_sizes_for(fmt, cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
         cli_error("render", "%s", err.msg);
         return RS_EXIT_USAGE;
@@ -525,9 +537,9 @@ int cmd_render(int argc, char **argv)
     job_audio_describe(&audio, &sink, said, sizeof said);
     if (!quiet)
         fprintf(stderr,
-                "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d) in %.1f s, %.1f fps; %s capture, "
+                "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d, quality %s) in %.1f s, %.1f fps; %s capture, "
                 "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n", /* the encoder last */
-                out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, secs, secs > 0 ? st.frames / secs : 0.0,
+                out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, quality->name, secs, secs > 0 ? st.frames / secs : 0.0,
                 cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
                 (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
                 cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,

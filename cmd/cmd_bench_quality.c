@@ -1,0 +1,515 @@
+/* ringside bench quality: what each of the renderer's knobs costs and how
+ * far it moves the picture, per stage, against a reference drawn at 4x4
+ * pixels per output pixel with every knob at full; and from that the
+ * quality presets (r_quality.h): for each error budget, the fastest
+ * measured combination that stays inside it on every stage.
+ *
+ * Each configuration draws the same frames of each shipped demo (from the
+ * same tick, effects warmed up as a full render would have them), brings
+ * them to the output size with the capture's box filter, reads them back
+ * and compares them with the reference's: PSNR over RGB (MSE pooled over
+ * the frames) and SSIM on luma (Wang et al. 2004: 11x11 Gaussian window,
+ * sigma 1.5).  The time is the draw and the downscale of a frame, finished
+ * (glFinish), median over the frames. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../capture/cap.h"
+#include "../capture/cap_scale.h"
+#include "bench_chart.h"
+#include "cli.h"
+#include "job_render.h"
+#include "../runtime/gl/rgl.h"
+#include "../runtime/platform/plat.h"
+#include "../runtime/render/r_game.h"
+#include "../runtime/render/r_quality.h"
+#include "../runtime/render/r_target.h"
+#include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_progress.h"
+
+/* The demos and the tick each one's frames start at: where its stage
+ * shows what it has (the golden images' ticks, tests/test_render.c). */
+static const struct {
+    const char *name;
+    uint64_t tick;
+} demos[] = {{"dojo", 1200},     {"harbor", 900},   {"mistvale", 700}, {"plaza", 1500},
+             {"quarry", 3000},   {"shallows", 380}, {"snowfield", 900}, {"temple", 900}};
+#define NDEMOS (int)(sizeof demos / sizeof *demos)
+#define FRAME_STEP 15 /* ticks between the frames measured */
+
+typedef struct config {
+    const char *name;
+    double scale;
+    r_quality q;
+    int kind; /* 0 a knob on its own, 1 a candidate combination for the presets, 2 the reference,
+                 3 a shipped preset that is none of the others */
+} config;
+
+/* Cheap settings for the light-space maps and the effects' grids, as one
+ * knob set: each on its own is a row too. */
+#define CHEAP_Q .shadow_size = 512, .sil_size = 256, .mask_half = true, .bloom_levels = 1, .lspsm_size = 1024, \
+                .fog_size = 128, .water_grid = 32
+
+static const config fixed_configs[] = {
+    {"reference 4x", 4, {0}, 2},
+    /* the render scale alone, then each knob on its own at 1x */
+    {"1x", 1, {0}, 1},
+    {"1.5x", 1.5, {0}, 1},
+    {"2x (the old default)", 2, {0}, 1},
+    {"1x fxaa", 1, {.aa = R_AA_FXAA}, 1},
+    {"1x shadow 512", 1, {.shadow_size = 512}, 0},
+    {"1x shadow 2048", 1, {.shadow_size = 2048}, 0},
+    {"1x silhouette 256", 1, {.sil_size = 256}, 0},
+    {"1x mask half", 1, {.mask_half = true}, 0},
+    {"1x bloom 1 level", 1, {.bloom_levels = 1}, 0},
+    {"1x lspsm 1024", 1, {.lspsm_size = 1024}, 0},
+    {"1x fog 128", 1, {.fog_size = 128}, 0},
+    {"1x water 32", 1, {.water_grid = 32}, 0},
+    /* combinations the presets choose among */
+    {"1x cheap", 1, {CHEAP_Q}, 1},
+    {"1x cheap fxaa", 1, {CHEAP_Q, .aa = R_AA_FXAA}, 1},
+    {"1.5x fxaa", 1.5, {.aa = R_AA_FXAA}, 1},
+    {"1.5x cheap", 1.5, {CHEAP_Q}, 1},
+    {"2x cheap", 2, {CHEAP_Q}, 1},
+    {"3x", 3, {0}, 1},
+};
+#define NFIXED (int)(sizeof fixed_configs / sizeof *fixed_configs)
+#define MAXCONFIGS (NFIXED + R_PRESETS)
+
+/* the fixed ones, then each shipped preset that is not among them */
+static config configs[MAXCONFIGS];
+static int NCONFIGS;
+
+typedef struct result {
+    bool done;
+    double ms, psnr, ssim;
+} result;
+
+static void help(void)
+{
+    printf("usage: ringside bench quality [--size WxH] [--frames N] [--stages LIST] [--csv FILE]\n"
+           "                              [--chart FILE.png] [-y|-n] [--quiet]\n\n"
+           "Draws the same frames of every shipped demo under each knob of the renderer\n"
+           "(render scale, FXAA, shadow and silhouette map sizes, the shadow mask at half\n"
+           "size, bloom levels, LSPSM and fog map sizes, the water grid) and under\n"
+           "combinations of them, brings each to the output size with the box filter, and\n"
+           "compares it with a reference drawn at 4x4 pixels per output pixel with every\n"
+           "knob at full: PSNR (RGB) and SSIM (luma), and the milliseconds a frame takes\n"
+           "(draw and downscale, finished; median over the frames).  Then, for each quality\n"
+           "preset's error budget, the fastest combination whose PSNR is inside it on every\n"
+           "stage, beside the table the program ships (r_quality.c); and each preset's\n"
+           "frame rate per stage as a ratio to the old default (2x).  docs/accuracy.md has\n"
+           "the numbers.\n\n"
+           "  --size WxH      output size (default 640x360, the service's default job)\n"
+           "  --frames N      frames per stage, %d ticks apart, 1..30 (default 4)\n"
+           "  --stages LIST   comma-separated demos (default all: dojo,harbor,mistvale,plaza,\n"
+           "                  quarry,shallows,snowfield,temple)\n"
+           "  --csv FILE      one row per stage and configuration (default\n"
+           "                  out/bench-quality.csv; '-' standard output)\n"
+           "  --chart FILE    frames per second of each configuration, labelled with its\n"
+           "                  worst PSNR, as PNG and SVG beside it (default\n"
+           "                  out/bench-quality.png; '' none)\n"
+           "  -y, -n          replace a --csv or --chart FILE given here, or refuse it\n"
+           "  --quiet         no progress lines\n",
+           FRAME_STEP);
+}
+
+/* SSIM of two 8-bit luma images (w x h), mean over the valid windows. */
+static double ssim_luma(const float *a, const float *b, int w, int h)
+{
+    enum { R = 5 };
+    double g[2 * R + 1], gs = 0;
+    for (int i = -R; i <= R; i++)
+        gs += g[i + R] = exp(-(double)(i * i) / (2 * 1.5 * 1.5));
+    for (int i = 0; i <= 2 * R; i++)
+        g[i] /= gs;
+    if (w <= 2 * R || h <= 2 * R)
+        return 1.0;
+    size_t n = (size_t)w * h;
+    /* five moments, blurred horizontally then vertically */
+    double *m = calloc(n * 5, sizeof *m), *t = calloc(n * 5, sizeof *t);
+    if (!m || !t) {
+        free(m);
+        free(t);
+        return NAN;
+    }
+    for (size_t i = 0; i < n; i++) {
+        m[i] = a[i], m[n + i] = b[i], m[2 * n + i] = (double)a[i] * a[i], m[3 * n + i] = (double)b[i] * b[i];
+        m[4 * n + i] = (double)a[i] * b[i];
+    }
+    for (int k = 0; k < 5; k++)
+        for (int y = 0; y < h; y++)
+            for (int x = R; x < w - R; x++) {
+                double s = 0;
+                for (int i = -R; i <= R; i++)
+                    s += g[i + R] * m[k * n + (size_t)y * w + x + i];
+                t[k * n + (size_t)y * w + x] = s;
+            }
+    const double c1 = (0.01 * 255) * (0.01 * 255), c2 = (0.03 * 255) * (0.03 * 255);
+    double sum = 0;
+    long cnt = 0;
+    for (int y = R; y < h - R; y++)
+        for (int x = R; x < w - R; x++) {
+            double v[5];
+            for (int k = 0; k < 5; k++) {
+                double s = 0;
+                for (int i = -R; i <= R; i++)
+                    s += g[i + R] * t[k * n + (size_t)(y + i) * w + x];
+                v[k] = s;
+            }
+            double ma = v[0], mb = v[1], va = v[2] - ma * ma, vb = v[3] - mb * mb, cov = v[4] - ma * mb;
+            sum += ((2 * ma * mb + c1) * (2 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+            cnt++;
+        }
+    free(m);
+    free(t);
+    return sum / (double)cnt;
+}
+
+static void luma(const uint8_t *rgba, int npx, float *y)
+{
+    for (int i = 0; i < npx; i++)
+        y[i] = (float)(0.2126 * rgba[4 * i] + 0.7152 * rgba[4 * i + 1] + 0.0722 * rgba[4 * i + 2]);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Draws demo d's frames under config c: their pixels (frames x w x h x 4,
+ * top row first) into px, and the median ms a frame into *ms. */
+static bool draw_frames(const char *data, int d, const config *c, int frames, int w, int h, uint8_t *px, double *ms,
+                        rs_err *err)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/demos/%s.rsr", data, demos[d].name);
+    rp_replay rp = {0};
+    r_game *r = NULL;
+    r_target src = {0};
+    cap_scaler *sc = NULL;
+    GLuint dtex = 0, dfbo = 0;
+    bool ok = false;
+    double t[31];
+    int rw, rh;
+    r_preset_render_size(&(r_preset){.scale = c->scale}, w, h, R_RENDER_MAX, &rw, &rh);
+    if (!rp_read(path, &rp, err))
+        goto done;
+    /* one frame more, before the measured ones and neither timed nor kept:
+     * llvmpipe compiles a program's code at its first draw */
+    uint64_t first = demos[d].tick - FRAME_STEP, end = demos[d].tick + (uint64_t)FRAME_STEP * (uint64_t)(frames - 1) + 1;
+    if (end > rp.ticks) {
+        rs_fail(err, 1, "%s: too short for %d frames from tick %" PRIu64, path, frames, demos[d].tick);
+        goto done;
+    }
+    if (!(r = r_game_create_opts(&(r_game_opts){.q = c->q, .quiet = true}, err)) || !r_game_prepare(r, rp.stage, err) ||
+        !r_target_create(&src, rw, rh, err) || !(sc = cap_scaler_create(CAP_FILTER_BOX, rw, rh, w, h, err)))
+        goto done;
+    gl.GenTextures(1, &dtex);
+    gl.BindTexture(GL_TEXTURE_2D, dtex);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.GenFramebuffers(1, &dfbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, dfbo);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, dtex, 0);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    job_render j;
+    if (!job_render_begin(&j, &(job_render_desc){.rp = &rp, .game = r, .target = &src, .name = path,
+                                                 .first = first, .end = end, .every = FRAME_STEP,
+                                                 .no_check = true},
+                          err))
+        goto done;
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    for (int f = -1; f < frames; f++) {
+        gl.Finish();
+        double t0 = rs_now();
+        if (job_render_next(&j, err) <= 0)
+            goto done;
+        cap_scaler_run(sc, src.tex, dfbo);
+        gl.Finish();
+        if (f < 0)
+            continue;
+        t[f] = (rs_now() - t0) * 1e3;
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, dfbo);
+        gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px + (size_t)f * w * h * 4); /* row 0 is the top */
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    }
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    qsort(t, (size_t)frames, sizeof *t, cmp_double);
+    *ms = frames % 2 ? t[frames / 2] : (t[frames / 2 - 1] + t[frames / 2]) / 2;
+    ok = true;
+done:
+    if (dfbo)
+        gl.DeleteFramebuffers(1, &dfbo);
+    if (dtex)
+        gl.DeleteTextures(1, &dtex);
+    cap_scaler_destroy(sc);
+    if (src.fbo)
+        r_target_destroy(&src);
+    r_game_destroy(r);
+    rp_free(&rp);
+    return ok;
+}
+
+static void compare(const uint8_t *a, const uint8_t *ref, int frames, int w, int h, float *ya, float *yb, double *psnr,
+                    double *ssim)
+{
+    size_t npx = (size_t)w * h;
+    double se = 0, ss = 0;
+    for (int f = 0; f < frames; f++) {
+        const uint8_t *pa = a + (size_t)f * npx * 4, *pr = ref + (size_t)f * npx * 4;
+        for (size_t i = 0; i < npx; i++)
+            for (int k = 0; k < 3; k++) {
+                double dd = (double)pa[4 * i + (size_t)k] - pr[4 * i + (size_t)k];
+                se += dd * dd;
+            }
+        luma(pa, (int)npx, ya);
+        luma(pr, (int)npx, yb);
+        ss += ssim_luma(ya, yb, w, h);
+    }
+    *psnr = se == 0 ? 99.0 : 10 * log10(255.0 * 255.0 * (double)npx * 3 * frames / se);
+    *ssim = ss / frames;
+}
+
+static bool q_equal(const r_quality *a, const r_quality *b)
+{
+    return a->shadow_size == b->shadow_size && a->sil_size == b->sil_size && a->mask_half == b->mask_half &&
+           a->bloom_levels == b->bloom_levels && a->aa == b->aa && a->lspsm_size == b->lspsm_size &&
+           a->fog_size == b->fog_size && a->water_grid == b->water_grid;
+}
+
+/* The config whose scale and knobs are these, or -1. */
+static int config_like(double scale, const r_quality *q)
+{
+    for (int c = 0; c < NCONFIGS; c++)
+        if (configs[c].scale == scale && q_equal(&configs[c].q, q))
+            return c;
+    return -1;
+}
+
+int bench_quality(int argc, char **argv)
+{
+    static const struct option opts[] = {{"size", required_argument, 0, 's'},   {"frames", required_argument, 0, 'f'},
+                                         {"stages", required_argument, 0, 'S'}, {"csv", required_argument, 0, 'c'},
+                                         {"chart", required_argument, 0, 'C'},  {"quiet", no_argument, 0, 'q'},
+                                         {"help", no_argument, 0, 'h'},         {"overwrite", no_argument, 0, 'y'},
+                                         {"no-overwrite", no_argument, 0, 'n'}, {0}};
+    int w = 640, h = 360, frames = 4, c;
+    long v;
+    bool use[NDEMOS], quiet = false, overwrite = false, user_csv = false, user_chart = false;
+    const char *csv = "out/bench-quality.csv", *chart = "out/bench-quality.png";
+    for (int d = 0; d < NDEMOS; d++)
+        use[d] = true;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "hynq", opts, NULL)) != -1) {
+        switch (c) {
+        case 's': if (!cli_out_size("--size", optarg, &w, &h)) return RS_EXIT_USAGE; break;
+        case 'f': if (!cli_int("--frames", optarg, 1, 30, &v)) return RS_EXIT_USAGE; frames = (int)v; break;
+        case 'S': {
+            for (int d = 0; d < NDEMOS; d++)
+                use[d] = false;
+            for (const char *p = optarg; *p;) {
+                size_t k = strcspn(p, ",");
+                int found = -1;
+                for (int d = 0; d < NDEMOS; d++)
+                    if (strlen(demos[d].name) == k && !strncmp(p, demos[d].name, k))
+                        found = d;
+                if (found < 0) {
+                    cli_error("bench", "--stages '%s': '%.*s' is not a shipped demo (dojo, harbor, mistvale, plaza, "
+                              "quarry, shallows, snowfield, temple)", optarg, (int)k, p);
+                    return RS_EXIT_USAGE;
+                }
+                use[found] = true;
+                p += k + (p[k] == ',');
+            }
+            break;
+        }
+        case 'c': csv = optarg; user_csv = true; break;
+        case 'C': chart = optarg; user_chart = true; break;
+        case 'q': quiet = true; break;
+        case 'y': overwrite = true; break;
+        case 'n': overwrite = false; break;
+        case 'h': help(); return RS_EXIT_OK;
+        default: return cli_bad_option("bench", argv);
+        }
+    }
+    if (optind != argc) {
+        cli_error("bench", "unexpected argument '%s'", argv[optind]);
+        return RS_EXIT_USAGE;
+    }
+    NCONFIGS = 0;
+    for (int i = 0; i < NFIXED; i++)
+        configs[NCONFIGS++] = fixed_configs[i];
+    for (int i = 0; i < R_PRESETS; i++)
+        if (config_like(r_presets[i].scale, &r_presets[i].q) < 0)
+            configs[NCONFIGS++] = (config){r_presets[i].name, r_presets[i].scale, r_presets[i].q, 3};
+    rs_err err = {0};
+    if (chart && *chart && !bench_chart_check(chart, &err)) {
+        cli_error("bench", "--chart %s", err.msg);
+        return RS_EXIT_USAGE;
+    }
+    if ((user_csv && *csv && strcmp(csv, "-") && !cli_out_ok("bench", csv, overwrite)) ||
+        (user_chart && *chart && !cli_out_ok("bench", chart, overwrite)))
+        return RS_EXIT_USAGE;
+
+    int status = RS_EXIT_FAIL;
+    plat *p = NULL;
+    size_t fbytes = (size_t)w * h * 4 * (size_t)frames;
+    uint8_t *ref = malloc(fbytes), *px = malloc(fbytes);
+    float *ya = malloc((size_t)w * h * sizeof *ya), *yb = malloc((size_t)w * h * sizeof *yb);
+    result(*res)[MAXCONFIGS] = calloc(NDEMOS, sizeof *res);
+    const char *data = rs_data_dir(&err);
+    if (!ref || !px || !ya || !yb || !res) {
+        rs_fail(&err, 1, "out of memory");
+        goto done;
+    }
+    if (!data || !(p = plat_create(&(plat_desc){.hidden = true}, &err)))
+        goto done;
+    int nuse = 0;
+    for (int d = 0; d < NDEMOS; d++)
+        nuse += use[d];
+    double t_start = rs_now();
+    for (int d = 0, k = 0; d < NDEMOS; d++) {
+        if (!use[d])
+            continue;
+        k++;
+        for (int ci = 0; ci < NCONFIGS; ci++) {
+            result *rr = &res[d][ci];
+            if (!draw_frames(data, d, &configs[ci], frames, w, h, ci == 0 ? ref : px, &rr->ms, &err))
+                goto done;
+            if (ci == 0)
+                rr->psnr = 99, rr->ssim = 1;
+            else
+                compare(px, ref, frames, w, h, ya, yb, &rr->psnr, &rr->ssim);
+            rr->done = true;
+            if (!quiet)
+                fprintf(stderr, "bench quality: %s (%d/%d) %-22s %8.2f ms %7.2f dB  SSIM %.4f  [%.0f s]\n",
+                        demos[d].name, k, nuse, configs[ci].name, rr->ms, rr->psnr, rr->ssim, rs_now() - t_start);
+        }
+    }
+
+    /* the table: per configuration, mean ms and the worst stage */
+    printf("bench quality: %dx%d output, %d frames a stage (%d ticks apart), reference: 4x4 pixels per output\n"
+           "pixel, every knob at full; ms: draw + box downscale, finished, median a frame, mean over stages\n",
+           w, h, frames, FRAME_STEP);
+    printf("%-22s %9s %7s %9s %9s", "configuration", "ms/frame", "fps", "min dB", "min SSIM");
+    for (int d = 0; d < NDEMOS; d++)
+        if (use[d])
+            printf(" %9.9s", demos[d].name);
+    printf("\n");
+    double mean_ms[MAXCONFIGS], min_db[MAXCONFIGS], min_ssim[MAXCONFIGS];
+    for (int ci = 0; ci < NCONFIGS; ci++) {
+        double s = 0;
+        min_db[ci] = 99, min_ssim[ci] = 1;
+        for (int d = 0; d < NDEMOS; d++) {
+            if (!use[d])
+                continue;
+            s += res[d][ci].ms;
+            min_db[ci] = fmin(min_db[ci], res[d][ci].psnr);
+            min_ssim[ci] = fmin(min_ssim[ci], res[d][ci].ssim);
+        }
+        mean_ms[ci] = s / nuse;
+        printf("%-22s %9.2f %7.1f %9.2f %9.4f", configs[ci].name, mean_ms[ci], 1000 / mean_ms[ci], min_db[ci],
+               min_ssim[ci]);
+        for (int d = 0; d < NDEMOS; d++)
+            if (use[d])
+                printf(" %9.2f", res[d][ci].psnr);
+        printf("\n");
+    }
+
+    /* the presets: the fastest candidate inside each budget */
+    printf("\npresets (the fastest combination whose PSNR is inside the budget on every stage measured):\n");
+    printf("%-10s %8s  %-22s %9s %9s  %s\n", "preset", "budget", "chosen", "ms/frame", "min dB", "shipped (r_quality.c)");
+    int shipped[R_PRESETS];
+    for (int i = 0; i < R_PRESETS; i++) {
+        const r_preset *pr = &r_presets[i];
+        int best = -1;
+        if (pr->budget_db <= 0) {
+            best = 0;
+        } else {
+            for (int ci = 1; ci < NCONFIGS; ci++)
+                if (configs[ci].kind & 1 && min_db[ci] >= pr->budget_db && (best < 0 || mean_ms[ci] < mean_ms[best]))
+                    best = ci;
+        }
+        shipped[i] = config_like(pr->scale, &pr->q);
+        char budget[16];
+        snprintf(budget, sizeof budget, pr->budget_db > 0 ? ">= %.0f dB" : "itself", pr->budget_db);
+        printf("%-10s %8s  %-22s %9.2f %9.2f  %s\n", pr->name, budget, best >= 0 ? configs[best].name : "(none)",
+               best >= 0 ? mean_ms[best] : 0.0, best >= 0 ? min_db[best] : 0.0,
+               shipped[i] == best ? "the same" : configs[shipped[i]].name);
+    }
+
+    /* each shipped preset's frame rate per stage, against the old default (2x, every knob at full) */
+    int old = config_like(2, &(r_quality){0});
+    if (old >= 0) {
+        printf("\nfps per stage and preset, and the ratio to the old default (2x):\n%-10s", "stage");
+        for (int i = 0; i < R_PRESETS; i++)
+            printf(" %17s", r_presets[i].name);
+        printf(" %9s\n", "old (2x)");
+        for (int d = 0; d < NDEMOS; d++) {
+            if (!use[d])
+                continue;
+            printf("%-10s", demos[d].name);
+            for (int i = 0; i < R_PRESETS; i++) {
+                printf(" %8.1f (%5.2fx)", 1000 / res[d][shipped[i]].ms, res[d][old].ms / res[d][shipped[i]].ms);
+            }
+            printf(" %9.1f\n", 1000 / res[d][old].ms);
+        }
+    }
+
+    if (csv && *csv) {
+        FILE *f = cli_bench_open("bench", csv, user_csv, overwrite);
+        if (!f) {
+            rs_fail(&err, 1, "%s: not written", csv);
+            goto done;
+        }
+        fprintf(f, "stage,configuration,scale,aa,shadow_size,sil_size,mask_half,bloom_levels,lspsm_size,fog_size,water_grid,"
+                   "ms_per_frame,psnr_db,ssim,frames,w,h\n");
+        for (int d = 0; d < NDEMOS; d++)
+            for (int ci = 0; use[d] && ci < NCONFIGS; ci++) {
+                const config *cf = &configs[ci];
+                fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
+                        cf->q.aa == R_AA_FXAA ? "fxaa" : "off", cf->q.shadow_size, cf->q.sil_size, cf->q.mask_half,
+                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, res[d][ci].ms,
+                        res[d][ci].psnr, res[d][ci].ssim, frames, w, h);
+            }
+        if (cli_fclose(f) != 0) {
+            rs_fail(&err, 1, "%s: cannot write", csv);
+            goto done;
+        }
+    }
+    if (chart && *chart) {
+        bench_bar bars[MAXCONFIGS];
+        char labels[MAXCONFIGS][64];
+        for (int ci = 0; ci < NCONFIGS; ci++) {
+            if (ci == 0)
+                snprintf(labels[ci], sizeof labels[ci], "%s", configs[ci].name);
+            else
+                snprintf(labels[ci], sizeof labels[ci], "%s, %.1f dB", configs[ci].name, min_db[ci]);
+            bars[ci] = (bench_bar){labels[ci], 1000 / mean_ms[ci], configs[ci].kind & 1};
+        }
+        char title[160];
+        snprintf(title, sizeof title, "bench quality: frames per second at %dx%d and the worst stage's PSNR", w, h);
+        bench_chart bc = {title, "frames per second (fps), draw and downscale, higher is better", "fps", bars, NCONFIGS};
+        if (!bench_chart_write(chart, &bc, &err))
+            goto done;
+    }
+    status = RS_EXIT_OK;
+done:
+    if (status != RS_EXIT_OK)
+        cli_error("bench", "%s", err.msg);
+    plat_destroy(p);
+    free(ref);
+    free(px);
+    free(ya);
+    free(yb);
+    free(res);
+    return status;
+}
