@@ -50,8 +50,11 @@ static const c_row rows[] = {
     {"size", C_SIZE, OFF(width), OFF(height), 16, 8192, "640x360", NULL, "a job's video size unless it asks"},
     {"max_size", C_SIZE, OFF(max_width), OFF(max_height), 16, 8192, "1920x1080", NULL,
      "the largest video size a job may ask for"},
-    {"render_size", C_SIZE, OFF(render_width), OFF(render_height), 16, 8192, "1280x720", NULL,
-     "the size the game is drawn at before the GPU downscale"},
+    {"render_size", C_SIZE, OFF(render_width), OFF(render_height), 16, 8192, "auto", NULL,
+     "the size the game is drawn at before the GPU downscale; auto: the job's quality preset decides it from the "
+     "job's size (as render --quality does)"},
+    {"quality", C_CHOICE, OFF(quality), 0, 0, 0, "standard", "draft|standard|high|reference",
+     "a job's quality preset unless it asks (docs/accuracy.md)"},
     {"format", C_CHOICE, OFF(format), 0, 0, 0, "mp4", "mp4|webm|mkv", "a job's video format unless it asks"},
     {"backend", C_CHOICE, OFF(backend), 0, 0, 0, "egl", "egl|osmesa", "GL backend of the render processes"},
     {"log_level", C_CHOICE, OFF(log_level), 0, 0, 0, "info", "debug|info|warn|error", "least important log line shown"},
@@ -154,6 +157,10 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
         return true;
     case C_SIZE: {
         long w, h;
+        if (r->off == OFF(render_width) && !strcmp(v, "auto")) {
+            *(int *)(base + r->off) = *(int *)(base + r->off2) = 0;
+            return true;
+        }
         if (!parse_long(v, &w, &rest) || (*rest != 'x' && *rest != 'X') || !parse_long(rest + 1, &h, &rest) || *rest)
             return rs_fail(err, 1, "%s: '%s' is not a size (expected WxH, such as 640x360)", r->name, v);
         if (w < r->lo || h < r->lo || w > r->hi || h > r->hi || (w | h) & 1)
@@ -318,7 +325,7 @@ bool svc_config_finish(svc_config *c, rs_err *err)
         return rs_fail(err, 1, "size %dx%d is larger than max_size %dx%d", c->width, c->height, c->max_width,
                        c->max_height);
     rs_err serr = {0};
-    if (!cap_check_sizes_for(CAP_I420, c->render_width, c->render_height, c->width, c->height, &serr))
+    if (c->render_width && !cap_check_sizes_for(CAP_I420, c->render_width, c->render_height, c->width, c->height, &serr))
         return rs_fail(err, 1, "size %dx%d with render_size %dx%d: %s", c->width, c->height, c->render_width,
                        c->render_height, serr.msg);
     return true;
@@ -351,7 +358,10 @@ void svc_config_dump(const svc_config *c, FILE *f)
             fprintf(f, "%ld\n", *(const long *)(base + r->off));
             break;
         case C_SIZE:
-            fprintf(f, "%dx%d\n", *(const int *)(base + r->off), *(const int *)(base + r->off2));
+            if (!*(const int *)(base + r->off))
+                fprintf(f, "auto\n");
+            else
+                fprintf(f, "%dx%d\n", *(const int *)(base + r->off), *(const int *)(base + r->off2));
             break;
         case C_CHOICE:
             if (r->off == OFF(log_level))

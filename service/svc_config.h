@@ -28,7 +28,9 @@ typedef struct svc_config {
     int segment_seconds;  /* split a job into segments of this much game time (0: never) */
     int width, height;    /* a job's output size unless it asks for one */
     int max_width, max_height; /* the largest output a job may ask for */
-    int render_width, render_height; /* the size the game is drawn at */
+    int render_width, render_height; /* the size the game is drawn at; 0x0 ("auto"): the job's quality
+                                        preset decides it from the job's size */
+    char quality[16];     /* a job's quality preset unless it asks (r_quality.h) */
     char format[8];       /* mp4, webm or mkv */
     char backend[16];     /* egl or osmesa */
     int log_level;

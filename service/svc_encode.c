@@ -15,6 +15,7 @@
 #include "../capture/cap.h"
 #include "../capture/cap_enc.h"
 #include "../capture/cap_sink.h"
+#include "../runtime/render/r_quality.h"
 #include "svc_local.h"
 
 /* A whole decimal number, sign allowed ("-3", "12"). */
@@ -123,8 +124,13 @@ bool svc_encode_check(const svc_config *cfg, const svc_encode_req *q, const char
         if (!strcmp(q->audio, "off"))
             put(out, n, "audio", "off"); /* render --audio off; the join gets no --replay */
     }
-    if (!out[0])
-        return true;
+    const char *quality = q->quality && q->quality[0] ? q->quality : cfg->quality;
+    if (!r_preset_named(quality))
+        return rs_fail(err, SVC_ERR_BAD_PARAM, "quality '%s': expected %s", quality, r_preset_list());
+    if (!out[0]) {
+        put(out, n, "quality", quality);
+        return strlen(out) + 1 < n || rs_fail(err, SVC_ERR_BAD_PARAM, "the options are too long together");
+    }
     /* the encoder's own word on the rest (container, preset names, CRF range) */
     char path[32];
     snprintf(path, sizeof path, "job.%s", format);
@@ -133,7 +139,8 @@ bool svc_encode_check(const svc_config *cfg, const svc_encode_req *q, const char
         const char *msg = err ? strstr(err->msg, ": ") : NULL;
         return rs_fail(err, SVC_ERR_BAD_PARAM, "%s", msg ? msg + 2 : "the encoder refuses these options");
     }
-    return true;
+    put(out, n, "quality", quality);
+    return strlen(out) + 1 < n || rs_fail(err, SVC_ERR_BAD_PARAM, "the options are too long together");
 }
 
 int svc_encode_argv(const char *encode, char opt[][24], char val[][CAP_ENC_PRESET_MAX], int max)

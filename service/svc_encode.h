@@ -1,4 +1,5 @@
-/* A job's encoder options (codec, crf, bitrate, preset, pix_fmt, audio): checked
+/* A job's encoder options (codec, crf, bitrate, preset, pix_fmt, audio) and its
+ * quality preset: checked
  * at upload, stored as one string, given to the job's renders. */
 #ifndef SVC_ENCODE_H
 #define SVC_ENCODE_H
@@ -14,6 +15,8 @@
 typedef struct svc_encode_req {
     const char *codec, *crf, *bitrate, *preset, *pix_fmt;
     const char *audio; /* "on" (the default: not stored) or "off" */
+    const char *quality; /* a preset name (r_quality.h); "": the setting quality.  Always stored,
+                            so every segment of a job is drawn alike whatever the daemon's default */
 } svc_encode_req;
 
 /* Checks q against the settings and the encoder for a video of format

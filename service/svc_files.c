@@ -180,11 +180,15 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
             add(&a, "--segment");
             add(&a, j->key);
         }
-        const char *const tail[] = {"-y", "-o", f->out, "--size", size, "--render-size", rsize, "--hashes", f->hashes,
+        const char *const tail[] = {"-y", "-o", f->out, "--size", size, "--hashes", f->hashes,
                                     "--poster", f->poster, "--progress-fd", "3", "--progress", "off", "--backend", cfg->backend};
         for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
             add(&a, tail[i]);
-        char opt[8][24], val[8][CAP_ENC_PRESET_MAX]; /* the job's encoder options (svc_encode.c) */
+        if (cfg->render_width) { /* the operator's fixed size; else the job's quality decides */
+            add(&a, "--render-size");
+            add(&a, rsize);
+        }
+        char opt[8][24], val[8][CAP_ENC_PRESET_MAX]; /* the job's encoder options and quality (svc_encode.c) */
         int nenc = svc_encode_argv(j->encode, opt, val, 8);
         for (int i = 0; i < nenc; i++) {
             add(&a, opt[i]);

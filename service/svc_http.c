@@ -384,7 +384,7 @@ typedef struct req {
     const char *bad; /* a malformed body: answered 400 once it is read */
     char name[SVC_NAME_MAX];
     char size[32], format[16];
-    char codec[16], crf[8], bitrate[16], preset[CAP_ENC_PRESET_MAX], pix_fmt[16], audio[8]; /* svc_encode.c */
+    char codec[16], crf[8], bitrate[16], preset[CAP_ENC_PRESET_MAX], pix_fmt[16], audio[8], quality[16]; /* svc_encode.c */
     /* who asks (authorize): tok.id 0 without a token; all: sees every job
      * (an operator token, or loopback with no tokens at all) */
     svc_token tok;
@@ -522,7 +522,8 @@ static enum MHD_Result post_field(void *cls, enum MHD_ValueKind kind, const char
     } const fields[] = {{"size", q->size, sizeof q->size},       {"format", q->format, sizeof q->format},
                         {"codec", q->codec, sizeof q->codec},    {"crf", q->crf, sizeof q->crf},
                         {"bitrate", q->bitrate, sizeof q->bitrate}, {"preset", q->preset, sizeof q->preset},
-                        {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}, {"audio", q->audio, sizeof q->audio}};
+                        {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt}, {"audio", q->audio, sizeof q->audio},
+                        {"quality", q->quality, sizeof q->quality}};
     char *dst = NULL;
     size_t room = 0;
     for (size_t i = 0; i < sizeof fields / sizeof *fields; i++)
@@ -635,7 +636,8 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
                           {"bitrate", q->bitrate, sizeof q->bitrate},
                           {"preset", q->preset, sizeof q->preset},
                           {"pix_fmt", q->pix_fmt, sizeof q->pix_fmt},
-                          {"audio", q->audio, sizeof q->audio}};
+                          {"audio", q->audio, sizeof q->audio},
+                          {"quality", q->quality, sizeof q->quality}};
     for (size_t i = 0; i < sizeof enc_args / sizeof *enc_args; i++)
         if (!enc_args[i].dst[0] && (v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, enc_args[i].key))) {
             if (strlen(v) >= enc_args[i].room)
@@ -664,7 +666,8 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
                                d->cfg.max_width, d->cfg.max_height);
         j.width = (int)w, j.height = (int)h;
         rs_err serr = {0};
-        if (!cap_check_sizes_for(CAP_I420, d->cfg.render_width, d->cfg.render_height, j.width, j.height, &serr))
+        if (d->cfg.render_width &&
+            !cap_check_sizes_for(CAP_I420, d->cfg.render_width, d->cfg.render_height, j.width, j.height, &serr))
             return reject(d, c, SVC_ERR_BAD_PARAM, "size %s: %s", q->size, serr.msg);
     }
     if (q->format[0]) {
@@ -673,7 +676,7 @@ static enum MHD_Result do_submit(svc_daemon *d, struct MHD_Connection *c, req *q
         snprintf(j.format, sizeof j.format, "%s", q->format);
     }
     rs_err err = {0};
-    svc_encode_req eq = {q->codec, q->crf, q->bitrate, q->preset, q->pix_fmt, q->audio};
+    svc_encode_req eq = {q->codec, q->crf, q->bitrate, q->preset, q->pix_fmt, q->audio, q->quality};
     if (!svc_encode_check(&d->cfg, &eq, j.format, j.width, j.height, j.encode, sizeof j.encode, &err))
         return reject(d, c, err.code, "%s", err.msg);
     if (!svc_check_upload(&d->cfg, q->body, q->len, j.name, &j, &err))
@@ -1144,9 +1147,13 @@ static enum MHD_Result do_health(svc_daemon *d, struct MHD_Connection *c)
     svc_buf_printf(&b, "{\"ok\":%s,\"queue\":\"%s\",\"workers\":%d,\"busy\":%d,\"draining\":%s,\"version\":\"%s\"",
                    ok ? "true" : "false", d->http_store->ops->name, d->cfg.workers, busy, draining ? "true" : "false",
                    RS_VERSION);
-    /* what the dashboard's upload form offers: the default and the bounds */
-    svc_buf_printf(&b, ",\"default_size\":\"%dx%d\",\"max_size\":\"%dx%d\",\"default_format\":\"%s\"", d->cfg.width,
-                   d->cfg.height, d->cfg.max_width, d->cfg.max_height, d->cfg.format);
+    /* what the dashboard's upload form offers: the default and the bounds (a fixed
+     * render_size bounds the sizes too: downscale only) */
+    int mw = d->cfg.max_width, mh = d->cfg.max_height;
+    if (d->cfg.render_width && (d->cfg.render_width < mw || d->cfg.render_height < mh))
+        mw = d->cfg.render_width < mw ? d->cfg.render_width : mw, mh = d->cfg.render_height < mh ? d->cfg.render_height : mh;
+    svc_buf_printf(&b, ",\"default_size\":\"%dx%d\",\"max_size\":\"%dx%d\",\"default_format\":\"%s\",\"default_quality\":\"%s\"",
+                   d->cfg.width, d->cfg.height, mw, mh, d->cfg.format, d->cfg.quality);
     if (ok)
         svc_buf_printf(&b, ",\"queued\":%" PRId64 ",\"running\":%" PRId64 "}\n", counts[SVC_QUEUED], counts[SVC_RUNNING]);
     else {
@@ -1428,7 +1435,7 @@ static bool state_changing(const char *method)
 static const struct {
     const char *method, *path, *params;
 } query_params[] = {
-    {"POST", "/jobs", "size,format,name,codec,crf,bitrate,preset,pix_fmt,audio"},
+    {"POST", "/jobs", "size,format,name,codec,crf,bitrate,preset,pix_fmt,audio,quality"},
     {"GET", "/jobs", "limit,before"},
     {"HEAD", "/jobs", "limit,before"},
 };

@@ -188,11 +188,17 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
     json_replay(b, j);
     char codec[16];
     codec_of(j, codec, sizeof codec);
-    char audio[8];
+    char audio[8], quality[16];
     svc_encode_get(j->encode, "audio", audio, sizeof audio); /* stored only when off */
+    svc_encode_get(j->encode, "quality", quality, sizeof quality); /* "" for a job queued before presets */
     svc_buf_printf(b, ",\"length_s\":%.2f,\"codec\":\"%s\",\"audio\":%s,\"encode\":", j->frames_total / 60.0, codec,
                    strcmp(audio, "off") ? "true" : "false");
     svc_json_str(b, j->encode);
+    svc_buf_add(b, ",\"quality\":", 11);
+    if (quality[0])
+        svc_json_str(b, quality);
+    else
+        svc_buf_add(b, "null", 4);
     if (v && v->bytes >= 0)
         svc_buf_printf(b, ",\"bytes\":%lld", (long long)v->bytes);
     else

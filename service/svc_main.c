@@ -206,15 +206,17 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
     int64_t counts[SVC_NSTATES] = {0};
     rs_err cerr = {0};
     d.store->ops->counts(d.store, counts, &cerr);
-    char shown[160];
+    char shown[160], rsize[48] = "drawn at the size the quality sets";
+    if (d.cfg.render_width)
+        snprintf(rsize, sizeof rsize, "drawn at %dx%d", d.cfg.render_width, d.cfg.render_height);
     snprintf(shown, sizeof shown, "%s", d.cfg.listen);
     char *colon = strrchr(shown, ':');
     if (colon)
         snprintf(colon + 1, sizeof shown - (size_t)(colon + 1 - shown), "%u", d.port);
     svc_log(SVC_LOG_INFO, -1,
-            "listening on http://%s/ (queue %s: %lld queued, %lld running; %d worker%s; videos in %s; drawn at %dx%d)",
+            "listening on http://%s/ (queue %s: %lld queued, %lld running; %d worker%s; videos in %s; quality %s, %s)",
             shown, d.store->ops->name, (long long)counts[SVC_QUEUED], (long long)counts[SVC_RUNNING], d.cfg.workers,
-            d.cfg.workers == 1 ? "" : "s", d.cfg.output, d.cfg.render_width, d.cfg.render_height);
+            d.cfg.workers == 1 ? "" : "s", d.cfg.output, d.cfg.quality, rsize);
     ok = svc_run(&d) == 0;
     if (!ok)
         rs_fail(err, 1, "the supervisor stopped on an error (see the log above)");

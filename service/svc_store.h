@@ -162,7 +162,7 @@ typedef struct svc_job {
     /* encoder options the job asked for, checked at upload against the
      * operator's bounds: "codec=hevc crf=24 preset=fast pix_fmt=yuv444p"
      * (any of them; "" = the render's defaults) */
-    char encode[96];
+    char encode[160];
     svc_unit unit;               /* claim: the unit handed out (the rest leave it zero) */
     /* the replay: submit reads it, claim fills it (malloc'd; svc_job_free) */
     uint8_t *replay;

@@ -86,7 +86,8 @@ static void t_config_defaults(void)
     T_ASSERT(c.lease == 30 && c.watchdog == 120 && c.grace == 30);
     T_ASSERT(c.width == 640 && c.height == 360 && c.max_width == 1920 && c.max_height == 1080);
     T_EQ(c.segment_seconds, 30);
-    T_ASSERT(c.render_width == 1280 && c.render_height == 720);
+    T_ASSERT(c.render_width == 0 && c.render_height == 0); /* auto: the job's quality decides */
+    T_ASSERT(!strcmp(c.quality, "standard"));
     T_EQ(c.log_level, SVC_LOG_INFO);
 }
 
@@ -148,7 +149,7 @@ static const set_case set_cases[] = {
     {"listen", "host:", 0, "the port must be 0..65535"}, {"listen", "host:-1", 0, "the port must be 0..65535"},
     {"listen", "host:80x", 0, "the port must be 0..65535"}, {"listen", "[::1]", 0, "an IPv6 address goes in brackets"},
     {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
-                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, format, backend, log_level, allowed_hosts, cors_origins, "
+                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, quality, format, backend, log_level, allowed_hosts, cors_origins, "
                         "max_connections, max_connections_per_ip, header_timeout, min_body_rate, upload_memory, "
                         "token_max_queued, token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)"},
     {"", "1", 0, "unknown setting ''"},
@@ -277,7 +278,7 @@ static void t_config_load_errors(void)
     LOAD_BAD("# c\n\nworkers = 0\n", ":3: workers: 0 is out of range (expected 1..64)");
     LOAD_BAD("workers = 2\ngarbage here\n", ":2: expected 'name = value', got 'garbage here'");
     LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, "
-                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, "
+                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, quality, "
                                    "format, backend, log_level, allowed_hosts, cors_origins, max_connections, "
                                    "max_connections_per_ip, header_timeout, min_body_rate, upload_memory, token_max_queued, "
                                    "token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)");
@@ -313,6 +314,9 @@ static void t_config_finish(void)
     SET_OK(&c, "output", "/mnt/v");
     T_ASSERT(svc_config_finish(&c, &e));
     T_ASSERT(!strcmp(c.queue, "postgres://db/ring") && !strcmp(c.output, "/mnt/v"));
+    SET_OK(&c, "size", "1920x1080"); /* render_size auto: any size up to max_size */
+    T_ASSERTF(svc_config_finish(&c, &e), "%s", e.msg);
+    SET_OK(&c, "render_size", "1280x720"); /* an operator's fixed size bounds the job sizes */
     SET_OK(&c, "size", "1280x720"); /* equal to the render size: allowed */
     T_ASSERT(svc_config_finish(&c, &e));
     SET_OK(&c, "size", "1920x1080"); /* within max_size, but larger than what is drawn */
@@ -367,7 +371,7 @@ static void t_config_dump_roundtrip(void)
                            {"max_upload", "3M"}, {"max_attempts", "5"}, {"lease", "60"}, {"watchdog", "300"},
                            {"grace", "0"}, {"segment_seconds", "0"}, {"size", "1280x720"}, {"max_size", "3840x2160"},
                            {"render_size", "2560x1440"}, {"format", "mkv"}, {"backend", "osmesa"},
-                           {"log_level", "debug"}};
+                           {"log_level", "debug"}, {"quality", "high"}};
     for (size_t i = 0; i < sizeof kv / sizeof *kv; i++)
         SET_OK(&c, kv[i][0], kv[i][1]);
     dump_reload(&c, &back);
@@ -595,7 +599,7 @@ static void t_json_job(void)
     svc_job j = job(SVC_QUEUED);
     job_is(&j, JOB_HEAD "\"queued\"," JOB_NAME "\"frames_done\":0,\"frames_total\":200,\"progress\":0.0000,"
                         "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"quality\":null,\"bytes\":null,\"render_s\":null,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
                         "\"finished\":null,\"url\":\"/jobs/42\",\"log\":\"/jobs/42/log\"}", true);
@@ -603,7 +607,7 @@ static void t_json_job(void)
     j.frames_done = 50, j.fps = 25, j.started = 1700000060;
     job_is(&j, JOB_HEAD "\"running\"," JOB_NAME "\"frames_done\":50,\"frames_total\":200,\"progress\":0.2500,"
                         "\"fps\":25.00,\"eta_s\":6.0," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,\"render_s\":null,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"quality\":null,\"bytes\":null,\"render_s\":null,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"worker\":\"box:123\",\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":null,\"url\":\"/jobs/42\","
@@ -613,6 +617,9 @@ static void t_json_job(void)
     /* a job uploaded with audio=off says so (its renders get --audio off) */
     snprintf(j.encode, sizeof j.encode, "codec=vp9 audio=off");
     job_is(&j, "\"codec\":\"vp9\",\"audio\":false,\"encode\":\"codec=vp9 audio=off\",", false);
+    /* and its quality preset */
+    snprintf(j.encode, sizeof j.encode, "codec=vp9 quality=high");
+    job_is(&j, "\"encode\":\"codec=vp9 quality=high\",\"quality\":\"high\",", false);
     j.encode[0] = 0;
     /* the replay's header, and what the HTTP side adds */
     svc_job k = job(SVC_DONE);
@@ -622,7 +629,7 @@ static void t_json_job(void)
     svc_buf b = {0};
     svc_json_job(&b, &k, 3, NULL, 0, &v);
     T_CONTAINS(b.p, "\"eta_s\":null,\"queue_position\":null,\"stage\":\"snowfield\",\"players\":[\"human\",\"cpu\"],"
-                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":123456,\"render_s\":12,");
+                    "\"winner\":2,\"rounds\":[1,2],\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"quality\":null,\"bytes\":123456,\"render_s\":12,");
     T_CONTAINS(b.p, "\"poster\":\"/jobs/42/poster\",\"log\":\"/jobs/42/log\"}");
     svc_buf_free(&b);
     k = job(SVC_QUEUED);
@@ -638,7 +645,7 @@ static void t_json_job(void)
     j.started = 1700000060, j.finished = 1700000100;
     job_is(&j, JOB_HEAD "\"done\"," JOB_NAME "\"frames_done\":200,\"frames_total\":200,\"progress\":1.0000,"
                         "\"fps\":0.00,\"eta_s\":null," "\"queue_position\":null,\"stage\":null,\"players\":null,\"winner\":null,\"rounds\":null,"
-                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,\"render_s\":40,"
+                        "\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"quality\":null,\"bytes\":null,\"render_s\":40,"
                         "\"attempts\":1,\"max_attempts\":3,\"error\":null,"
                         "\"desync_tick\":null,\"created\":\"2023-11-14T22:13:20Z\","
                         "\"started\":\"2023-11-14T22:14:20Z\",\"finished\":\"2023-11-14T22:15:00Z\","
@@ -650,7 +657,7 @@ static void t_json_job(void)
     snprintf(j.error, sizeof j.error, "desync at tick 0:\n\"want\" \x01 \xff");
     job_is(&j, JOB_HEAD "\"failed\"," JOB_NAME "\"frames_done\":120,\"frames_total\":200,\"progress\":0.6000,"
                         "\"fps\":0.00,\"eta_s\":null,\"queue_position\":null,\"stage\":null,\"players\":null,"
-                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"bytes\":null,"
+                        "\"winner\":null,\"rounds\":null,\"length_s\":3.33,\"codec\":\"vp9\",\"audio\":true,\"encode\":\"\",\"quality\":null,\"bytes\":null,"
                         "\"render_s\":null,\"attempts\":3,\"max_attempts\":3,"
                         "\"error\":\"desync at tick 0:\\n\\\"want\\\" \\u0001 \\ufffd\",\"desync_tick\":0,"
                         "\"created\":\"2023-11-14T22:13:20Z\",\"started\":null,"
@@ -990,20 +997,32 @@ static void t_encode_options(void)
 {
     svc_config c;
     svc_config_defaults(&c);
-    char out[96];
+    char out[160];
     rs_err err = {0};
     svc_encode_req q = {.codec = "hevc", .crf = "24", .preset = "fast", .pix_fmt = "yuv444p"};
     T_ASSERTF(svc_encode_check(&c, &q, "mp4", 640, 360, out, sizeof out, &err), "%s", err.msg);
-    T_ASSERTF(!strcmp(out, "codec=hevc crf=24 preset=fast pix_fmt=yuv444p"), "got %s", out);
+    /* the quality is always stored (the setting's when the job does not ask), so
+     * every segment of a job is drawn alike whatever daemon renders it */
+    T_ASSERTF(!strcmp(out, "codec=hevc crf=24 preset=fast pix_fmt=yuv444p quality=standard"), "got %s", out);
     char opt[8][24], val[8][CAP_ENC_PRESET_MAX];
-    T_ASSERT(svc_encode_argv(out, opt, val, 8) == 4);
+    T_ASSERT(svc_encode_argv(out, opt, val, 8) == 5);
+    T_ASSERTF(!strcmp(opt[4], "--quality") && !strcmp(val[4], "standard"), "got %s %s", opt[4], val[4]);
     T_ASSERTF(!strcmp(opt[3], "--pix-fmt"), "got %s", opt[3]);
     T_ASSERTF(!strcmp(val[3], "yuv444p"), "got %s", val[3]);
     char codec[16];
     svc_encode_get(out, "codec", codec, sizeof codec);
     T_ASSERTF(!strcmp(codec, "hevc"), "got %s", codec);
     svc_encode_req none = {0};
-    T_ASSERT(svc_encode_check(&c, &none, "webm", 640, 360, out, sizeof out, &err) && !out[0]);
+    T_ASSERT(svc_encode_check(&c, &none, "webm", 640, 360, out, sizeof out, &err));
+    T_ASSERTF(!strcmp(out, "quality=standard"), "got %s", out);
+    strcpy(c.quality, "draft"); /* the operator's default */
+    T_ASSERT(svc_encode_check(&c, &none, "webm", 640, 360, out, sizeof out, &err) && !strcmp(out, "quality=draft"));
+    svc_encode_req hi = {.quality = "high"}, bad_q = {.quality = "ultra"};
+    T_ASSERT(svc_encode_check(&c, &hi, "webm", 640, 360, out, sizeof out, &err) && !strcmp(out, "quality=high"));
+    T_ASSERT(!svc_encode_check(&c, &bad_q, "webm", 640, 360, out, sizeof out, &err));
+    T_ASSERTF(err.code == SVC_ERR_BAD_PARAM && strstr(err.msg, "quality 'ultra': expected draft, standard, high or reference"),
+              "got %s", err.msg);
+    strcpy(c.quality, "standard");
     /* numbered presets by range: 4..13 takes 8 and 13, not 3 or 14 */
     const char *ok[] = {"8", "13", "4"}, *bad[] = {"3", "14", "-1", "slow", "placebo"};
     for (size_t i = 0; i < sizeof ok / sizeof *ok; i++) {

@@ -191,7 +191,7 @@ async function main() {
       fail(`cannot open ${opt.url}/: ${e.message.split('\n')[0]}`);
     }
     if (!resp || !resp.ok()) fail(`GET ${opt.url}/ answered ${resp ? resp.status() : 'nothing'}`);
-    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-button', '#upload-status', '#jobs', '#player',
+    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-quality', '#upload-button', '#upload-status', '#jobs', '#player',
       '#token-section', '#token-input', '#token-save', '#token-error', '#token-forget']) {
       if (await page.locator(sel).count() !== 1) fail(`page has no single ${sel}`);
     }
@@ -207,8 +207,11 @@ async function main() {
       const [w, h] = v.split('x').map(Number);
       if (w > mw || h > mh) fail(`the size menu offers ${v}, over max_size ${health.max_size}`);
     }
+    // the quality menu: the server's default selected
+    await waitFor(page, 'the quality menu set from /healthz', () => page.$eval('#upload-quality',
+      (s, def) => s.value === def, health.default_quality), ctx);
     await page.setInputFiles('#upload-file', opt.replay);
-    for (const [sel, val] of [['#upload-size', opt.size], ['#upload-format', opt.format]]) {
+    for (const [sel, val] of [['#upload-size', opt.size], ['#upload-format', opt.format], ['#upload-quality', 'draft']]) {
       const vals = await page.$$eval(`${sel} option`, (os) => os.map((o) => o.value));
       if (!vals.includes(val)) fail(`${sel} has no option '${val}' (has ${vals.join(', ')})`);
       await page.selectOption(sel, val);
@@ -237,6 +240,8 @@ async function main() {
       if (st.error) fail(`upload refused: ${st.text}`);
       await sleep(100);
     }
+    const job = await (await page.request.get(`${opt.url}/jobs/${id}`, opt.token ? { headers: { Authorization: `Bearer ${opt.token}` } } : {})).json();
+    if (job.quality !== 'draft') fail(`the job was queued with quality ${job.quality}, not the 'draft' the form asked for`);
 
     // 4. wait for the row to be done, watching its progress bar
     const rowSel = `#jobs tr[data-job-id="${id}"]`;

@@ -152,8 +152,14 @@ t_encoder_options() {
     [ "$(ffprobe -v error -select_streams v -show_entries stream=codec_name -of csv=p=0 d/videos/$id.mp4)" = hevc ] ||
         { echo "job $id is not HEVC"; cat d.log; return 1; }
     curl -sf "$SVC_URL/jobs/$id" >j.json || return 1
-    [ "$(json_get codec <j.json)" = hevc ] && [ "$(json_get encode <j.json)" = "codec=hevc crf=30 preset=fast" ] ||
-        { cat j.json; return 1; }
+    [ "$(json_get codec <j.json)" = hevc ] && [ "$(json_get encode <j.json)" = "codec=hevc crf=30 preset=fast quality=standard" ] &&
+        [ "$(json_get quality <j.json)" = standard ] || { cat j.json; return 1; }
+    # the quality preset: stored with the job, given to its renders, drawn at the size it sets
+    id3=$(svc_submit a.rsr "quality=draft") || return 1
+    svc_wait_state "$id3" done 60 || return 1
+    curl -sf "$SVC_URL/jobs/$id3" >j3.json && [ "$(json_get quality <j3.json)" = draft ] || { cat j3.json; return 1; }
+    curl -sf "$SVC_URL/jobs/$id3/log" | grep -q "(drawn at 160x90, quality draft)" ||
+        { echo "job $id3 was not rendered with quality draft"; curl -s "$SVC_URL/jobs/$id3/log"; return 1; }
     # a form field works like the query parameter
     id2=$(curl -s -F replay=@a.rsr -F format=webm -F codec=vp9 -F preset=8 "$SVC_URL/jobs" | json_get id) || return 1
     svc_wait_state "$id2" done 60 || return 1
@@ -161,7 +167,8 @@ t_encoder_options() {
         { echo "job $id2 is not VP9"; return 1; }
     for q in "codec=av1:setting codecs" "crf=10:setting min_crf" "preset=placebo:setting presets" \
         "codec=vp9&format=mp4:MP4 does not hold vp9" "codec=h265:codec 'h265'" "pix_fmt=rgb24:pix_fmt 'rgb24'" \
-        "bitrate=900M:setting max_bitrate" "crf=25&bitrate=1M:exclude each other" "preset=x%3Bid:preset 'x;id'"; do
+        "bitrate=900M:setting max_bitrate" "crf=25&bitrate=1M:exclude each other" "preset=x%3Bid:preset 'x;id'" \
+        "quality=ultra:quality 'ultra': expected draft, standard, high or reference"; do
         [ "$(code POST "/jobs?${q%%:*}" --data-binary @a.rsr)" = 400 ] && grep -q "${q#*:}" body.txt ||
             { echo "'${q%%:*}': want 400 naming '${q#*:}'"; cat body.txt; return 1; }
     done
