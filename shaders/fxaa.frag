@@ -6,7 +6,7 @@
 //   2. the corners: a sub-pixel blend from how far the pixel is off its
 //      3x3 neighbourhood (single-pixel features, thin lines)
 //   3. the edge's direction (the larger second difference), the side it
-//      lies on, and a short walk both ways along it (4 steps, 2 taps each)
+//      lies on, and a short walk both ways along it (3 steps, 2 taps each)
 //      to find where it ends: pixels near an end of a long stair step are
 //      blended across the edge more than pixels near its middle
 //   4. one bilinear tap offset across the edge by the larger of 2 and 3
@@ -24,14 +24,16 @@ float luma(vec4 c)
     return dot(c.rgb, vec3(0.299, 0.587, 0.114));
 }
 
-// offsets must be constant expressions: a macro, not a function
-#define LUMA_AT(x, y) luma(textureLodOffset(u_src, uv, 0.0, ivec2(x, y)))
+// the 3x3 by texelFetch (no filtering: a third of a bilinear tap's cost on
+// llvmpipe, which runs both sides of a branch, so the early out saves little)
+#define LUMA_AT(x, y) luma(texelFetch(u_src, clamp(ip + ivec2(x, y), ivec2(0), last), 0))
 
 void main()
 {
     vec2 px = 1.0 / vec2(textureSize(u_src, 0));
-    vec2 uv = gl_FragCoord.xy * px; // texel centres: exact values despite the linear filter
-    vec4 c = textureLod(u_src, uv, 0.0);
+    vec2 uv = gl_FragCoord.xy * px;
+    ivec2 ip = ivec2(gl_FragCoord.xy), last = textureSize(u_src, 0) - 1;
+    vec4 c = texelFetch(u_src, ip, 0);
     float lc = luma(c);
     float ln = LUMA_AT(0, 1), ls = LUMA_AT(0, -1);
     float le = LUMA_AT(1, 0), lw = LUMA_AT(-1, 0);
@@ -66,10 +68,10 @@ void main()
     vec2 mid = uv + (horz ? vec2(0.0, 0.5 * step_len) : vec2(0.5 * step_len, 0.0));
 
     // the walk: bilinear taps on the edge line read both sides' mean
-    const float STEPS[4] = float[4](1.0, 2.0, 4.0, 8.0);
-    float d1 = STEPS[3] + 4.0, d2 = STEPS[3] + 4.0, e1 = 0.0, e2 = 0.0;
+    const float STEPS[3] = float[3](1.0, 3.0, 7.0);
+    float d1 = STEPS[2] + 3.0, d2 = STEPS[2] + 3.0, e1 = 0.0, e2 = 0.0;
     bool done1 = false, done2 = false;
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < 3; i++) {
         if (!done1) {
             e1 = luma(textureLod(u_src, mid - along * STEPS[i], 0.0)) - l_edge;
             if (abs(e1) >= grad)
