@@ -33,7 +33,8 @@ extern const r_fx_module fx_water_module;
 
 enum { W_SIM, W_SPLAT, W_NORMAL, W_MIRROR, W_UNDER, W_SURFACE, W_PROGS };
 
-#define MESH_N 64        /* surface quads per side: 12.5 cm; the normal map carries the finer detail */
+#define MESH_N 64        /* surface quads per side: 12.5 cm; the normal map carries the finer detail;
+                            r_quality.water_grid overrides it */
 #define COLOR_SIZE 128   /* the turbidity textures */
 #define MAX_SPLATS (2 * G_BONES)
 /* the look (not the automaton: fx_water_sim_params) */
@@ -58,6 +59,7 @@ typedef struct fx_water_state {
     int nsplat;
     GLuint mesh_vao, mesh_vbo, mesh_ibo;
     GLsizei mesh_count;
+    int mesh_n; /* quads a side: r_quality.water_grid or MESH_N */
     GLuint shallow_tex, deep_tex;
     /* screen-sized, made for the frame's size */
     int sw, sh;
@@ -119,7 +121,7 @@ static GLuint color_tex(uint8_t *px, bool deep)
  * surface (u, v, 2) down to the ring floor (u, v, 1). */
 static bool build_mesh(fx_water_state *w)
 {
-    const int n = MESH_N, row = n + 1, ngrid = row * row, nv = ngrid + 4 * 2 * row;
+    const int n = w->mesh_n, row = n + 1, ngrid = row * row, nv = ngrid + 4 * 2 * row;
     float *v = malloc((size_t)nv * 3 * sizeof *v);
     unsigned *idx = malloc(((size_t)n * n + 4 * (size_t)n) * 6 * sizeof *idx);
     if (!v || !idx) {
@@ -269,6 +271,7 @@ static bool create(r_game *r, rs_err *err)
         return rs_fail(err, 1, "out of memory");
     r_fx_set_state(r, &fx_water_module, w);
     fx_water_sim_params_fix(&w->prm);
+    w->mesh_n = r->opts.q.water_grid > 0 ? r->opts.q.water_grid : MESH_N; /* range checked by r_game_create_opts */
     return true;
 }
 

@@ -126,9 +126,9 @@ const r_stage *r_game_stage(const r_game *r)
 static void free_targets(r_game *r)
 {
     GLuint tex[] = {r->hdr_tex, r->depth_tex, r->mask_tex[0], r->mask_tex[1], r->b2_tex, r->b4_tex[0],
-                    r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex};
+                    r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex};
     GLuint fbo[] = {r->hdr_fbo, r->depth_fbo, r->mask_fbo[0], r->mask_fbo[1], r->b2_fbo, r->b4_fbo[0],
-                    r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo};
+                    r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo};
     for (size_t i = 0; i < sizeof tex / sizeof tex[0]; i++)
         if (tex[i])
             gl.DeleteTextures(1, &tex[i]);
@@ -137,6 +137,7 @@ static void free_targets(r_game *r)
             gl.DeleteFramebuffers(1, &fbo[i]);
     r->hdr_tex = r->depth_tex = r->b2_tex = r->sunvis_tex = r->fl_tex = 0;
     r->hdr_fbo = r->depth_fbo = r->b2_fbo = r->sunvis_fbo = r->fl_fbo = 0;
+    r->ldr_tex = r->ldr_fbo = 0;
     memset(r->mask_tex, 0, sizeof r->mask_tex), memset(r->mask_fbo, 0, sizeof r->mask_fbo);
     memset(r->b4_tex, 0, sizeof r->b4_tex), memset(r->b4_fbo, 0, sizeof r->b4_fbo);
     memset(r->b8_tex, 0, sizeof r->b8_tex), memset(r->b8_fbo, 0, sizeof r->b8_fbo);
@@ -170,6 +171,10 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
     r->sunvis_fbo = r_fbo_for(r->sunvis_tex, 0, 0);
     r->fl_tex = r_tex2d(GL_RGBA16F, r_half(w, 2), r_half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     r->fl_fbo = r_fbo_for(r->fl_tex, 0, 0);
+    if (r->opts.q.aa) { /* the tone map's image for the AA pass: linear, its walk taps between texels */
+        r->ldr_tex = r_tex2d(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->ldr_fbo = r_fbo_for(r->ldr_tex, 0, 0);
+    }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
@@ -202,6 +207,7 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_SUNVIS, "cap_fullscreen.vert", "sun_vis.frag", NULL},
         {P_FLARE, "cap_fullscreen.vert", "flare.frag", NULL},
         {P_HUD, "hud.vert", "hud.frag", NULL},
+        {P_FXAA, "cap_fullscreen.vert", "fxaa.frag", NULL},
         {P_TONE, "cap_fullscreen.vert", "tonemap.frag", NULL},
         {P_TONE + 1, "cap_fullscreen.vert", "tonemap.frag", "#define BLOOM 1\n"},
         {P_TONE + 2, "cap_fullscreen.vert", "tonemap.frag", "#define FLARE 1\n"},
@@ -243,7 +249,8 @@ static bool build_graph(r_game *r, rs_err *err)
     const r_pass *const order[] = {
         &r_shadow_passes[0], &r_shadow_passes[1], &r_shadow_passes[2], &r_shadow_passes[3],
         &r_shadow_passes[4], &r_shadow_passes[5], NULL, &r_scene_pass, NULL, &r_sky_pass, NULL, &r_lens_pass,
-        &r_post_passes[0], &r_post_passes[1], &r_post_passes[2], &r_post_passes[3], &r_post_passes[4], &r_hud_pass,
+        &r_post_passes[0], &r_post_passes[1], &r_post_passes[2], &r_post_passes[3], &r_post_passes[4], &r_aa_pass,
+        &r_hud_pass,
     };
     /* The core's passes that only shade the picture: a frame drawn for the
      * effects' history (LSPSM's focus reads the depth buffer) leaves them
@@ -252,7 +259,7 @@ static bool build_graph(r_game *r, rs_err *err)
     const r_pass *const shade_only[] = {
         &r_shadow_passes[0], &r_shadow_passes[1], &r_shadow_passes[2], &r_shadow_passes[4], &r_shadow_passes[5],
         &r_sky_pass, &r_lens_pass, &r_post_passes[0], &r_post_passes[1], &r_post_passes[2], &r_post_passes[3],
-        &r_post_passes[4], &r_hud_pass,
+        &r_post_passes[4], &r_aa_pass, &r_hud_pass,
     };
     r->history_skip = 0;
     int phase = R_FX_PRE;
@@ -277,6 +284,27 @@ static bool build_graph(r_game *r, rs_err *err)
     return true;
 }
 
+/* The knobs this file honours, each 0 (the default) or in its range. */
+static bool check_quality(const r_quality *q, rs_err *err)
+{
+    static const struct {
+        const char *name, *what;
+        int lo, hi;
+    } k[] = {
+        {"shadow_size", "the SSFSM light depth map's side", 128, 4096},
+        {"sil_size", "the silhouette's side", 64, 2048},
+        {"water_grid", "the water surface's quads a side", 16, 256},
+    };
+    const int v[] = {q->shadow_size, q->sil_size, q->water_grid};
+    for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
+        if (v[i] != 0 && (v[i] < k[i].lo || v[i] > k[i].hi))
+            return rs_fail(err, 1, "quality: %s %d out of range: %s is %d..%d texels (0 = default)", k[i].name, v[i],
+                           k[i].what, k[i].lo, k[i].hi);
+    if (q->aa != R_AA_OFF && q->aa != R_AA_FXAA)
+        return rs_fail(err, 1, "quality: aa %d unknown (0 off, 1 fxaa)", (int)q->aa);
+    return true;
+}
+
 r_game *r_game_create(rs_err *err)
 {
     return r_game_create_opts(NULL, err);
@@ -296,6 +324,13 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         snprintf(r->stage_file, sizeof r->stage_file, "%s", r->opts.stage_file);
         r->opts.stage_file = r->stage_file;
     }
+    if (!check_quality(&r->opts.q, err)) {
+        free(r->hud);
+        free(r);
+        return NULL;
+    }
+    r->shadow_size = r->opts.q.shadow_size > 0 ? r->opts.q.shadow_size : SHADOW_SIZE;
+    r->sil_size = r->opts.q.sil_size > 0 ? r->opts.q.sil_size : SIL_SIZE;
     r->stage_game = -2;
     r->ring_stage = -1;
     r->lut_size = r->opts.lut_size > 0 ? r->opts.lut_size : R_TONE_LUT_DEFAULT;
@@ -372,7 +407,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     /* light-space targets */
     gl.GenTextures(1, &r->shadow_tex);
     gl.BindTexture(GL_TEXTURE_2D, r->shadow_tex);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, SHADOW_SIZE, SHADOW_SIZE, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, r->shadow_size, r->shadow_size, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR); /* 2x2 PCF */
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
@@ -392,7 +427,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         gl.GenTextures(1, &sil[t]);
         gl.BindTexture(GL_TEXTURE_2D, sil[t]);
         for (int k = 0; k < SIL_LEVELS; k++)
-            gl.TexImage2D(GL_TEXTURE_2D, k, GL_R8, SIL_SIZE >> k, SIL_SIZE >> k, 0, GL_RED, GL_UNSIGNED_BYTE, NULL);
+            gl.TexImage2D(GL_TEXTURE_2D, k, GL_R8, r->sil_size >> k, r->sil_size >> k, 0, GL_RED, GL_UNSIGNED_BYTE, NULL);
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, SIL_LEVELS - 1);
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR); /* trilinear */
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -601,11 +636,13 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
         tex = r->mask_tex[r->mask_final];
     else if (!strncmp(name, "silhouette", 10) && (!name[10] || (name[10] >= '1' && name[10] < '0' + SIL_LEVELS && !name[11]))) {
         level = name[10] ? name[10] - '0' : 0; /* "silhouette2": blurred level 2 */
-        tex = r->sil_tex, tw = SIL_SIZE >> level, th = SIL_SIZE >> level;
+        tex = r->sil_tex, tw = r->sil_size >> level, th = r->sil_size >> level;
     }
     GLenum fmt = GL_RGBA;
     if (!strcmp(name, "depth")) /* one float per pixel, window depth */
         tex = r->depth_tex, fmt = GL_DEPTH_COMPONENT;
+    if (!strcmp(name, "shadow")) /* the SSFSM light depth map, one float per texel */
+        tex = r->shadow_tex, fmt = GL_DEPTH_COMPONENT, tw = th = r->shadow_size;
     if (!tex)
         return false;
     if (w)

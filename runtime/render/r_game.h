@@ -110,7 +110,8 @@ void r_game_report(r_game *r, FILE *out);
 r_graph *r_game_graph(r_game *r);
 
 /* Reads back the HDR buffer of the last frame (w*h*4 floats, bottom-up) or
- * a named intermediate ("hdr", "bloom", "mask", "depth" (w*h floats), "silhouette", the blurred
+ * a named intermediate ("hdr", "bloom", "mask", "depth" (w*h floats), "shadow" (the light depth
+ * map, one float a texel), "silhouette", the blurred
  * levels "silhouette1".."silhouette4"): tests.  out NULL: size only. */
 bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h);
 

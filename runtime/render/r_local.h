@@ -16,8 +16,8 @@
 #include "r_mesh.h"
 
 #define HUD_MAX_QUADS 4096
-#define SHADOW_SIZE 1024 /* SSFSM light depth map */
-#define SIL_SIZE 512     /* silhouette, level 0 */
+#define SHADOW_SIZE 1024 /* SSFSM light depth map: r->shadow_size (r_quality.shadow_size) */
+#define SIL_SIZE 512     /* silhouette, level 0: r->sil_size (r_quality.sil_size) */
 #define SIL_LEVELS 5     /* the sharp level and 4 blurred ones */
 #define SKY_SIZE 128     /* the environment as seen */
 #define LENS_ALPHA 0.15f
@@ -47,7 +47,7 @@ typedef struct prog {
     GLuint id;
 } prog;
 
-enum { P_FIGHTER, P_STAGE, P_LENS, P_DEPTH, P_SIL, P_SKY, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD,
+enum { P_FIGHTER, P_STAGE, P_LENS, P_DEPTH, P_SIL, P_SKY, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA,
        P_TONE, /* + 4 variants: bloom x flare */
        P_COUNT = P_TONE + 4 };
 
@@ -96,7 +96,8 @@ struct r_game {
     GLuint ibl_tex[R_IBL_MAPS][2], sky_tex, lut_tex, normal_tex, spec_tex, flare_tex;
     int lut_size;
     float lut_gamma;
-    /* light-space targets */
+    /* light-space targets, sides from r_quality (0: SHADOW_SIZE, SIL_SIZE) */
+    int shadow_size, sil_size;
     GLuint shadow_tex, shadow_fbo;
     GLuint sil_tex, sil_tmp, sil_fbo[SIL_LEVELS], sil_tmp_fbo[SIL_LEVELS];
     /* screen targets */
@@ -107,6 +108,7 @@ struct r_game {
     GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2];
     GLuint fl_tex, fl_fbo; /* the flare image, quarter size */
     GLuint sunvis_tex, sunvis_fbo;
+    GLuint ldr_tex, ldr_fbo; /* the tone map's output when the AA pass runs after it (RGBA8) */
     int mask_final; /* index of the filtered mask */
     /* graph */
     r_graph graph;
@@ -179,6 +181,7 @@ extern const r_pass r_shadow_passes[R_SHADOW_NPASS]; /* r_shadow.c */
 extern const r_pass r_scene_pass, r_sky_pass, r_lens_pass; /* r_scene.c */
 extern const r_pass r_post_passes[R_POST_NPASS];     /* r_post.c: bloom, sun visibility, flare, tone map */
 extern const r_pass r_hud_pass;                      /* r_hud.c */
+extern const r_pass r_aa_pass;                       /* r_aa.c: FXAA, tone map output -> output */
 void r_update_lut(r_game *r);                        /* r_post.c: the tone curve for the stage's gamma */
 GLuint r_hud_font(void);                             /* r_hud.c: the font texture */
 

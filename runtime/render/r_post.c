@@ -66,7 +66,8 @@ static void run_tonemap(void *u)
     frame *f = &r->f;
     bool bloom = r_ran(f, r, "bloom_blur"), flare = r_ran(f, r, "flare");
     GLuint p = r->prog[P_TONE + (bloom ? 1 : 0) + (flare ? 2 : 0)];
-    gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)f->out_fbo);
+    /* with anti-aliasing the AA pass (r_aa.c) writes the output from ldr_tex */
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r->opts.q.aa ? r->ldr_fbo : (GLuint)f->out_fbo);
     gl.Viewport(0, 0, f->w, f->h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);

@@ -25,7 +25,7 @@ static void run_shadow_map(void *u)
 {
     r_game *r = u;
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
-    gl.Viewport(0, 0, SHADOW_SIZE, SHADOW_SIZE);
+    gl.Viewport(0, 0, r->shadow_size, r->shadow_size);
     gl.Enable(GL_DEPTH_TEST);
     gl.DepthFunc(GL_LESS);
     gl.DepthMask(GL_TRUE);
@@ -41,7 +41,7 @@ static void run_silhouette(void *u)
 {
     r_game *r = u;
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->sil_fbo[0]);
-    gl.Viewport(0, 0, SIL_SIZE, SIL_SIZE);
+    gl.Viewport(0, 0, r->sil_size, r->sil_size);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
     gl.ClearColor(0, 0, 0, 0);
@@ -67,7 +67,7 @@ static void run_silhouette_mips(void *u)
     r_game *r = u;
     gl.Disable(GL_DEPTH_TEST);
     for (int k = 1; k < SIL_LEVELS; k++) {
-        int n = SIL_SIZE >> k;
+        int n = r->sil_size >> k;
         restrict_level(r->sil_tex, k - 1);
         r_down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
         restrict_level(r->sil_tex, k);
