@@ -21,6 +21,7 @@
 #include "../runtime/loop.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
+#include "../runtime/render/r_quality.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
@@ -32,7 +33,7 @@ static void help(void)
 {
     printf("usage: ringside play [--p1 human|cpu] [--p2 human|cpu] [--stage NAME] [--seed S] [--level L]\n"
            "                     [--record FILE] [--replay FILE] [--seconds N] [--screenshot FILE]\n"
-           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
+           "                     [--size WxH] [--quality Q] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
            "                     [--stage-file FILE] [--passes[=summary|frames]]\n"
            "                     [--hdr-format rgba16f|r11g11b10f]\n"
            "                     [--audio-out FILE.wav] [--mute] [--volume V] [--audio-device D]\n\n"
@@ -52,6 +53,10 @@ static void help(void)
            "  --seconds N      stop after N seconds of game time\n"
            "  --screenshot F   save the last frame as .png or .ppm\n"
            "  --size WxH       window or frame size (default 1280x720)\n"
+           "  --quality Q      draft, standard (default), high or reference: pixels drawn\n"
+           "                   per window pixel and the renderer's knobs (render --help,\n"
+           "                   docs/accuracy.md); a larger drawing is averaged down to the\n"
+           "                   window\n"
            "  --fullscreen     primary monitor, its current mode\n"
            "  --no-vsync       do not wait for the display\n"
            "  --headless       no window: EGL/OSMesa, one tick per frame, as fast as possible\n"
@@ -76,6 +81,10 @@ typedef struct play {
     r_game *r;
     r_target target; /* headless */
     int w, h;
+    const r_preset *quality;
+    /* the quality's larger drawing and the halvings that bring it to the window (ss_fit) */
+    r_target ss[4];
+    int nss, ss_w, ss_h;
     uint64_t limit;
     bool quit, failed;
     rs_err err;
@@ -130,17 +139,63 @@ static void on_step(void *user, const g_input in[2])
         s->failed = true;
 }
 
+static void ss_free(play *s)
+{
+    for (int i = 0; i < s->nss; i++)
+        r_target_destroy(&s->ss[i]);
+    s->nss = 0;
+}
+
+/* The drawing targets for a w x h frame under the quality: none when it
+ * draws 1:1; else the scaled size, then halvings down to at most twice
+ * the frame, so that each linear blit averages whole 2x2 blocks. */
+static bool ss_fit(play *s, int w, int h)
+{
+    int rw, rh;
+    r_preset_render_size(s->quality, w, h, R_RENDER_MAX, &rw, &rh);
+    if (s->ss_w == w && s->ss_h == h && (s->nss || (rw == w && rh == h)))
+        return true;
+    ss_free(s);
+    s->ss_w = w, s->ss_h = h;
+    while (rw > w || rh > h) {
+        if (s->nss == 4 || !r_target_create(&s->ss[s->nss], rw, rh, &s->err))
+            return s->nss == 4 ? rs_fail(&s->err, 1, "%dx%d: too many halvings", rw, rh) : false;
+        s->nss++;
+        if (rw <= 2 * w && rh <= 2 * h)
+            break;
+        rw = rw / 2 > w ? rw / 2 : w, rh = rh / 2 > h ? rh / 2 : h;
+    }
+    return true;
+}
+
+/* Draws the frame into fbo (w x h), through the quality's larger drawing. */
+static bool draw_frame(play *s, GLuint fbo, float alpha, int w, int h)
+{
+    if (!ss_fit(s, w, h))
+        return false;
+    const r_target *top = s->nss ? &s->ss[0] : NULL;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, top ? top->fbo : fbo);
+    if (!r_game_draw(s->r, &s->prev, &s->cur, alpha, top ? top->w : w, top ? top->h : h))
+        return rs_fail(&s->err, 1, "%s", r_game_error(s->r));
+    for (int i = 0; i < s->nss; i++) {
+        const r_target *src = &s->ss[i];
+        int dw = i + 1 < s->nss ? s->ss[i + 1].w : w, dh = i + 1 < s->nss ? s->ss[i + 1].h : h;
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, src->fbo);
+        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, i + 1 < s->nss ? s->ss[i + 1].fbo : fbo);
+        gl.BlitFramebuffer(0, 0, src->w, src->h, 0, 0, dw, dh, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    }
+    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    return true;
+}
+
 static void on_render(void *user, float alpha)
 {
     play *s = user;
     int w = s->w, h = s->h;
     if (plat_window(s->p))
         plat_size(s->p, &w, &h);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
-    if (w > 0 && h > 0 && !r_game_draw(s->r, &s->prev, &s->cur, alpha, w, h)) {
-        rs_fail(&s->err, 1, "%s", r_game_error(s->r));
+    if (w > 0 && h > 0 && !draw_frame(s, s->target.fbo, alpha, w, h))
         s->failed = true;
-    }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     plat_present(s->p);
 }
@@ -170,8 +225,10 @@ static bool screenshot(play *s, const char *path, rs_err *err)
     uint8_t *px = malloc((size_t)w * h * 4);
     if (!px)
         return rs_fail(err, 1, "out of memory for a %dx%d screenshot", w, h);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, s->target.fbo);
-    r_game_draw(s->r, &s->prev, &s->cur, 1.0f, w, h);
+    if (!draw_frame(s, s->target.fbo, 1.0f, w, h)) {
+        free(px);
+        return false;
+    }
     r_read_pixels(s->target.fbo, w, h, 4, px);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     bool ok = rs_mkdirs_for(path, err) && rs_image_write(path, w, h, 4, px, err);
@@ -258,7 +315,7 @@ int cmd_play(int argc, char **argv)
         {"hdr-format", required_argument, 0, 'X'},
         {"audio-out", required_argument, 0, 'A'}, {"mute", no_argument, 0, 'M'},
         {"volume", required_argument, 0, 'V'}, {"audio-device", required_argument, 0, 'D'},
-        {"help", no_argument, 0, 'h'},         {0}};
+        {"quality", required_argument, 0, 'Q'}, {"help", no_argument, 0, 'h'}, {0}};
     play *s = calloc(1, sizeof *s);
     if (!s)
         return RS_EXIT_FAIL;
@@ -266,6 +323,7 @@ int cmd_play(int argc, char **argv)
     s->kind[1] = RP_CPU;
     s->w = 1280;
     s->h = 720;
+    s->quality = &r_presets[R_PRESET_DEFAULT];
     int stage = 0, c, status = RS_EXIT_USAGE;
     long level = 2, seconds = 0;
     uint64_t seed = (uint64_t)time(NULL);
@@ -291,7 +349,8 @@ int cmd_play(int argc, char **argv)
         case 'R': replay = optarg; break;
         case 's': if (!cli_int("--seconds", optarg, 1, 7 * 24 * 3600, &seconds)) goto done; break;
         case 'o': shot = optarg; break;
-        case 'z': if (!cli_size("--size", optarg, 8192, &s->w, &s->h)) goto done; break;
+        case 'z': if (!cli_out_size("--size", optarg, &s->w, &s->h)) goto done; break;
+        case 'Q': if (!(s->quality = cli_quality("play", optarg))) goto done; break;
         case 'f': pd.fullscreen = true; break;
         case 'v': pd.no_vsync = true; break;
         case 'H': headless = true; break;
@@ -375,6 +434,7 @@ int cmd_play(int argc, char **argv)
         goto done;
     }
     go.quiet = quiet;
+    go.q = s->quality->q;
     s->r = r_game_create_opts(&go, &s->err);
     if (!s->r || !r_game_prepare(s->r, stage, &s->err) ||
         (headless && !r_target_create(&s->target, s->w, s->h, &s->err)))
@@ -432,6 +492,7 @@ done:
     if (status == RS_EXIT_FAIL || (status == RS_EXIT_USAGE && s->err.msg[0]))
         cli_error("play", "%s", s->err.msg);
     if (s->p) {
+        ss_free(s);
         r_target_destroy(&s->target);
         r_game_destroy(s->r);
         plat_destroy(s->p);

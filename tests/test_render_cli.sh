@@ -104,5 +104,38 @@ t_help_lists_the_options() {
     done
 }
 
-t_run passes_summary_and_frames ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
+# --quality sets the render size from the output size (unless --render-size says)
+# and the renderer's knobs; --size alone works from 16x16 to 3840x2160
+t_quality_and_sizes() {
+    short_replay || return 1
+    for qs in "draft:160x90:160x90" "standard:160x90:160x90" "high:160x90:320x180" "reference:160x90:640x360" \
+        "standard:1920x1080:1920x1080" "standard:16x16:16x16" "standard:3840x2160:3840x2160"; do
+        q=${qs%%:*} rest=${qs#*:}
+        size=${rest%%:*} drawn=${rest#*:}
+        "$RS_BIN" render short.rsr --ticks 100:101 --size "$size" --quality "$q" -o "q_$q.y4m" -y 2>q.txt ||
+            { cat q.txt; return 1; }
+        grep -q "frames $size (drawn at $drawn, quality $q)" q.txt || { echo "$qs:"; cat q.txt; return 1; }
+    done
+    # --render-size wins over the quality's scale; the knobs still apply (FXAA runs)
+    "$RS_BIN" render short.rsr --ticks 100:102 --size 160x90 --render-size 320x180 --quality standard --passes \
+        -o r.y4m -y 2>r.txt || { cat r.txt; return 1; }
+    grep -q "(drawn at 320x180, quality standard)" r.txt && grep -q "^fxaa  *2  *0 " r.txt || { cat r.txt; return 1; }
+    "$RS_BIN" render short.rsr --ticks 100:102 --size 160x90 --quality high --passes -o r.y4m -y 2>r.txt ||
+        { cat r.txt; return 1; }
+    grep -q "^fxaa  *0  *2 " r.txt || { echo "high draws no FXAA"; cat r.txt; return 1; }
+    expect_fail 2 "--quality 'ultra': expected draft, standard, high or reference" "$RS_BIN" render short.rsr --quality ultra \
+        -o x.y4m || return 1
+    expect_fail 2 "--size '8x8': the smallest output is 16x16" "$RS_BIN" render short.rsr --size 8x8 -o x.y4m || return 1
+    expect_fail 2 "larger than the render size" "$RS_BIN" render short.rsr --size 640x360 --render-size 320x180 \
+        -o x.y4m || return 1
+    # play: the same presets, a larger drawing averaged down to the frame
+    "$RS_BIN" play --headless --replay short.rsr --seconds 1 --size 160x90 --quality high --mute --screenshot h.png \
+        --quiet || return 1
+    "$RS_BIN" play --headless --replay short.rsr --seconds 1 --size 160x90 --quality standard --mute --screenshot s.png \
+        --quiet || return 1
+    ! cmp -s h.png s.png || { echo "play --quality high drew what standard drew"; return 1; }
+    expect_fail 2 "--quality 'ultra'" "$RS_BIN" play --headless --quality ultra || return 1
+}
+
+t_run passes_summary_and_frames quality_and_sizes ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
 t_done
