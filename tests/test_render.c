@@ -724,6 +724,41 @@ static void t_lens_stays_on_the_head(void)
     plat_destroy(p);
 }
 
+/* The fighters read on every stage: the mean Rec.709 luma of their pixels
+ * (the 8-bit output, where the mask's alpha says fighter) at tick 1500 of
+ * each demo lies in 0.07..0.75.  Harbor's night put them at 0.051, nearly
+ * black against the quay (now 0.118).  The floor is low because dojo's
+ * fighters stand against a sunset (0.080) and blue is dark in luma. */
+static void t_fighters_read_on_every_stage(void)
+{
+    plat *p = t_context("egl");
+    static const char *demos[] = {"dojo", "harbor", "mistvale", "plaza", "quarry", "shallows", "snowfield", "temple"};
+    static uint8_t px[W * H * 4];
+    t_fb f;
+    t_fb_make(&f, W, H);
+    int bad = 0;
+    for (size_t d = 0; d < sizeof demos / sizeof *demos; d++) {
+        g_state prev, cur;
+        t_state_at(demos[d], 1500, &prev, &cur);
+        r_game *r = t_game_opts(&(r_game_opts){.mask = true});
+        t_draw_read(r, &f, &prev, &cur, W, H, px, true);
+        double sum = 0;
+        int n = 0;
+        for (int k = 0; k < W * H; k++)
+            if (px[4 * k + 3] > 127)
+                sum += (0.2126 * px[4 * k] + 0.7152 * px[4 * k + 1] + 0.0722 * px[4 * k + 2]) / 255.0, n++;
+        double y = n ? sum / n : 0;
+        fprintf(stderr, "    %-9s fighters' mean luma %.3f over %d pixels\n", demos[d], y, n);
+        T_ASSERTF(n > 100, "%s: only %d fighter pixels", demos[d], n);
+        if (!(y >= 0.07 && y <= 0.75))
+            fprintf(stderr, "    %s: the fighters' mean luma %.3f is outside 0.07..0.75\n", demos[d], y), bad++;
+        r_game_destroy(r);
+    }
+    T_EQ(bad, 0);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 T_MAIN({"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"fighters_where_the_camera_says", t_fighters_where_the_camera_says},
        {"hud_shows_health_and_intro", t_hud_shows_health_and_intro},
@@ -733,4 +768,5 @@ T_MAIN({"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"mask_output_alpha", t_mask_output_alpha}, {"low_alpha_lens_shows_the_sun", t_low_alpha_lens_shows_the_sun},
        {"shadows_darken_the_floor", t_shadows_darken_the_floor},
        {"shadow_follows_the_key_light", t_shadow_follows_the_key_light}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
-       {"packed_float_hdr", t_packed_float_hdr}, {"lens_stays_on_the_head", t_lens_stays_on_the_head})
+       {"packed_float_hdr", t_packed_float_hdr}, {"lens_stays_on_the_head", t_lens_stays_on_the_head},
+       {"fighters_read_on_every_stage", t_fighters_read_on_every_stage})
