@@ -18,6 +18,14 @@ uniform mat4 u_view_proj; // camera, or the light's projection for LIGHT_VIEW
 uniform mat4 u_bones[16];
 uniform vec4 u_bone_color[16]; // rgb albedo, a: specular strength
 uniform float u_lens_side;     // LENS: +1 / -1, which side of the head is the face
+#ifdef LENS
+uniform vec3 u_eye;
+// The visor lies just inside the head (r_build_lens), so it can never cover
+// a pixel outside the head's silhouette; its depth alone is pulled this far
+// towards the eye so it wins the depth test over the face in front of it
+// (the deepest the face gets in front of the visor, at its edge, is 2.8 cm).
+const float LENS_PULL = 0.035;
+#endif
 
 #ifdef STAGE
 uniform mat4 u_light_proj;     // the silhouette projector
@@ -73,4 +81,8 @@ void main()
     v_fog = u_fog_on == 1 ? fog_depth(world.xyz) : 0.0;
 #endif
     gl_Position = u_view_proj * world;
+#ifdef LENS
+    vec4 q = u_view_proj * vec4(world.xyz + normalize(u_eye - world.xyz) * LENS_PULL, 1.0);
+    gl_Position.z = q.z / q.w * gl_Position.w;
+#endif
 }

@@ -253,8 +253,73 @@ static void t_empty_frame_is_refused(void)
     plat_destroy(p);
 }
 
+/* Fighter i's screen box at W x H (bottom-up rows): its bones' ends
+ * projected, grown by the widest bone's radius and 3 pixels. */
+static void fighter_box(const g_state *st, int i, int box[4])
+{
+    r_mat4 vp = r_game_camera(st, W, H, NULL);
+    g_capsule c[G_BONES];
+    g_fighter_capsules(st, i, c);
+    float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f, grow = 0;
+    for (int k = 0; k < G_BONES; k++)
+        for (int e = 0; e < 2; e++) {
+            float z = fx_to_float(c[k].z) * (float)st->f[i].facing, x, y;
+            r_vec3 w = r_v3(fx_to_float(e ? c[k].bx : c[k].ax), fx_to_float(e ? c[k].by : c[k].ay), z);
+            T_ASSERT(r_project(vp, w, W, H, &x, &y));
+            float x2, y2; /* a radius's length on screen, at this depth */
+            T_ASSERT(r_project(vp, r_v3(w.x, w.y + fx_to_float(c[k].r), w.z), W, H, &x2, &y2));
+            grow = fmaxf(grow, fabsf(y2 - y));
+            x0 = fminf(x0, x), x1 = fmaxf(x1, x), y0 = fminf(y0, y), y1 = fmaxf(y1, y);
+        }
+    box[0] = (int)floorf(x0 - grow) - 3, box[1] = (int)floorf(y0 - grow) - 3;
+    box[2] = (int)ceilf(x1 + grow) + 3, box[3] = (int)ceilf(y1 + grow) + 3;
+}
+
+static bool in_box(const int b[4], int x, int y) { return x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3]; }
+
+/* Tick 1005 of the dojo demo: P2 slides out of the ring while P1 stands
+ * (its bones move 0.1 m/s), and the camera follows P2 (P1's bones move
+ * 3 m/s in view space).  A fighter standing still leaves no copy in either
+ * mode: the camera's motion used to put one beside P1's head and body.
+ * P2, moving, does leave one. */
+static void t_afterimage_still_fighter_leaves_none(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    g_state prev, cur;
+    t_state_at("dojo", 1005, &prev, &cur);
+    r_game *r = t_game_new(true);
+    int still[4], moving[4];
+    fighter_box(&cur, 0, still);
+    fighter_box(&cur, 1, moving);
+    float *off = hdr_frame(r, &f, R_AFTERIMAGE_OFF, &prev, &cur);
+    for (r_afterimage mode = R_AFTERIMAGE_VIEW; mode <= R_AFTERIMAGE_WORLD; mode++) {
+        float *on = hdr_frame(r, &f, mode, &prev, &cur);
+        int by_still = 0, by_moving = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const float *a = off + 4 * ((size_t)y * W + x), *b = on + 4 * ((size_t)y * W + x);
+                if (!memcmp(a, b, 3 * sizeof *a))
+                    continue;
+                by_moving += in_box(moving, x, y);
+                by_still += in_box(still, x, y) && !in_box(moving, x, y);
+            }
+        fprintf(stderr, "    %s: %d pixels changed by the standing fighter, %d by the moving one\n",
+                mode == R_AFTERIMAGE_VIEW ? "view" : "world", by_still, by_moving);
+        T_ASSERTF(by_still == 0, "the standing fighter leaves an afterimage over %d pixels", by_still);
+        T_ASSERTF(by_moving > 20, "the moving fighter leaves only %d pixels of afterimage", by_moving);
+        free(on);
+    }
+    free(off);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 T_MAIN({"stage_switch_leaves_nothing_behind", t_stage_switch_leaves_nothing_behind},
        {"empty_frame_is_refused", t_empty_frame_is_refused},
        {"effects_run_only_where_asked", t_effects_run_only_where_asked},
        {"afterimage_trails_fast_limbs_only", t_afterimage_trails_fast_limbs_only},
-       {"afterimage_extremes", t_afterimage_extremes})
+       {"afterimage_extremes", t_afterimage_extremes},
+       {"afterimage_still_fighter_leaves_none", t_afterimage_still_fighter_leaves_none})

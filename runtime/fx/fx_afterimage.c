@@ -6,8 +6,10 @@
  * already drawn by "scene", which marks their pixels in the stencil
  * (R_STENCIL_FIGHTER); the copy is drawn after the sky with the stencil
  * test keeping it off those pixels, which is the same picture as drawing
- * it first.  The pass runs only on frames where some bone moves faster
- * than the stage's afterimage_speed, and only those bones are drawn. */
+ * it first.  The pass runs only on frames where some bone moves through
+ * the world faster than the stage's afterimage_speed, and only those bones
+ * are drawn.  Nothing in it is pixel-sized: the copy is placed in metres
+ * and its fade is in bone radii, so it looks the same at any render size. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -78,16 +80,14 @@ static r_vec3 bone_point(const float m[16], float t, const r_mat4 *v)
                 a[2] * p[0] + a[6] * p[1] + a[10] * p[2] + a[14]);
 }
 
-/* How fast a bone moves, m/s, as the velocity V of the shader sees it (in
- * view space, camera motion included, or in world space): the faster of
- * its origin and its far end (a forearm swung round the elbow barely moves
- * at its origin).  0 for NaN. */
-static float bone_speed(const float cur[16], const float prev[16], float len, const r_mat4 *view,
-                        const r_mat4 *view_prev)
+/* How fast a bone moves through the world, m/s: the faster of its origin
+ * and its far end (a forearm swung round the elbow barely moves at its
+ * origin).  0 for NaN. */
+static float bone_speed(const float cur[16], const float prev[16], float len)
 {
     float v = 0;
     for (int e = 0; e < 2; e++) {
-        r_vec3 d = r_sub(bone_point(cur, e * len, view), bone_point(prev, e * len, view_prev));
+        r_vec3 d = r_sub(bone_point(cur, e * len, NULL), bone_point(prev, e * len, NULL));
         v = fmaxf(v, sqrtf(r_dot(d, d)) * (float)G_HZ);
     }
     return isfinite(v) ? v : 0.0f;
@@ -102,11 +102,14 @@ static bool needed(void *u)
     a->any_fast = false;
     const frame *f = &r->f;
     float thr = r->stage.afterimage_speed;
-    bool view = r->stage.afterimage == R_AFTERIMAGE_VIEW;
+    /* Which bones leave a copy is the fighter's own motion in either mode:
+     * measured in view space, a fighter standing still while the camera
+     * followed the other one (a pan or zoom of 3 m/s at a head's far end)
+     * left a translucent copy beside its head and body.  The view mode
+     * still smears the fast bones along their view-space path. */
     for (int i = 0; i < 2; i++)
         for (int b = 0; b < G_BONES; b++) {
-            float v = bone_speed(f->bones_tick[i][b], f->bones_prev[i][b], a->radius[b], view ? &f->view : NULL,
-                                 view ? &f->view_prev : NULL);
+            float v = bone_speed(f->bones_tick[i][b], f->bones_prev[i][b], a->radius[b]);
             a->fast[i][b] = v > thr ? 1.0f : 0.0f;
             a->any_fast |= v > thr;
         }

@@ -55,7 +55,8 @@ extern const r_fx_module fx_lspsm_module;
 
 struct fx_lspsm_state {
     GLuint prog_map, prog_focus;
-    GLuint map_tex, flag_tex, map_fbo; /* 1024x1024 depth (compare mode) + R8 fighter flag */
+    GLuint map_tex, flag_tex, map_fbo; /* map x map depth (compare mode) + R8 fighter flag */
+    int map;                           /* the map's edge: r_quality.lspsm_size, 0 = R_LSPSM_MAP */
     GLuint focus_tex, focus_fbo;       /* 20x16 R32F */
     GLuint pbo;                        /* the samples of the frame drawn last */
     bool pending;                      /* pbo holds samples not used yet */
@@ -131,7 +132,7 @@ static void run_map(void *u)
     r_lspsm_build(&d, &ls->s);
 
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);
-    gl.Viewport(0, 0, R_LSPSM_MAP, R_LSPSM_MAP);
+    gl.Viewport(0, 0, ls->map, ls->map);
     gl.Enable(GL_DEPTH_TEST);
     gl.DepthFunc(GL_LESS);
     gl.DepthMask(GL_TRUE);
@@ -305,12 +306,14 @@ static bool lspsm_create(r_game *r, rs_err *err)
     /* the map: depth with hardware comparison, bilinear = 2x2 PCF; outside
      * it (the border) nothing casts */
     const float one[4] = {1, 1, 1, 1}, zero[4] = {0, 0, 0, 0};
-    ls->map_tex = r_tex2d(GL_DEPTH_COMPONENT24, R_LSPSM_MAP, R_LSPSM_MAP, GL_DEPTH_COMPONENT, GL_FLOAT, NULL, GL_LINEAR,
+    int q = r->opts.q.lspsm_size;
+    ls->map = q <= 0 ? R_LSPSM_MAP : q < 256 ? 256 : q > 4096 ? 4096 : q;
+    ls->map_tex = r_tex2d(GL_DEPTH_COMPONENT24, ls->map, ls->map, GL_DEPTH_COMPONENT, GL_FLOAT, NULL, GL_LINEAR,
                           GL_CLAMP_TO_BORDER);
     gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, one);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-    ls->flag_tex = r_tex2d(GL_R8, R_LSPSM_MAP, R_LSPSM_MAP, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_BORDER);
+    ls->flag_tex = r_tex2d(GL_R8, ls->map, ls->map, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_BORDER);
     gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, zero);
     gl.GenFramebuffers(1, &ls->map_fbo);
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);

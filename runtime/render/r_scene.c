@@ -170,11 +170,16 @@ static void run_lens(void *u)
 }
 
 /* The visor: part of a cylinder round the head bone, centred on the
- * bone's -y side (the face of a fighter facing +x; the shader mirrors it). */
+ * bone's -y side (the face of a fighter facing +x; the shader mirrors it).
+ * Its radius is inside the head's polygon (radius 0.11, 20 sides: 0.1086
+ * at a side's middle), so from any view it covers only the head: a visor
+ * floating outside the head (it was 0.128) showed edge-on, beside the head,
+ * as a bright strip of Fresnel reflection over the background.  scene.vert
+ * pulls its depth in front of the face. */
 bool r_build_lens(r_mesh_data *m)
 {
     const int seg = 16, rows = 4;
-    const float rad = 0.128f, x0 = 0.07f, x1 = 0.17f, span = 1.3f;
+    const float rad = 0.105f, x0 = 0.07f, x1 = 0.17f, span = 1.3f;
     m->v = calloc((size_t)(seg + 1) * (rows + 1), sizeof *m->v);
     m->idx = calloc((size_t)seg * rows * 6, sizeof *m->idx);
     if (!m->v || !m->idx)
