@@ -136,6 +136,31 @@ t_filters() {
     expect_fail 2 "--filter 'cubic'" "$RS_BIN" render short.rsr -o x.y4m --filter cubic || return 1
 }
 
+# bench quality at a tiny size: every configuration measured on each stage, the
+# error falls as the render scale grows, the presets chosen, the CSV complete
+t_bench_quality_small() {
+    "$RS_BIN" bench quality --size 64x36 --frames 1 --stages dojo,temple --csv q.csv --chart q.png -q >q.txt 2>&1 ||
+        { cat q.txt; return 1; }
+    for row in "reference 4x" "1x" "1.5x" "2x (the old default)" "3x" "1x fxaa" "1x shadow 512" "1x mask half" \
+        "1x bloom 1 level" "1x cheap"; do
+        grep -q "^$row  *[0-9.]* *[0-9.]* *[0-9.]* *[0-9.]*  *[0-9.]* *[0-9.]*\$" q.txt || { echo "no row '$row'"; cat q.txt; return 1; }
+    done
+    # the reference against itself; more pixels drawn per output pixel, closer to it
+    db() { awk -v r="$1" 'index($0, r) == 1 { print $(NF - 3) }' q.txt; }
+    awk -v a="$(db '1x  ')" -v b="$(db '2x (the')" -v c="$(db '3x  ')" 'BEGIN { exit !(a < b && b < c) }' ||
+        { echo "the error does not fall with the render scale"; cat q.txt; return 1; }
+    grep -q "^reference 4x .* 99.00  *1.0000  *99.00  *99.00$" q.txt || { cat q.txt; return 1; }
+    for p in draft standard high reference; do
+        grep -q "^$p  " q.txt || { echo "no preset line $p"; cat q.txt; return 1; }
+    done
+    grep -q "^fps per stage and preset" q.txt && grep -q "^temple " q.txt || { cat q.txt; return 1; }
+    rows=$(grep -c '^[a-z]' q.csv)
+    cfgs=$(awk '/^configuration /{on=1; next} on && NF == 0 {exit} on {n++} END {print n}' q.txt)
+    [ "$rows" = $((2 * cfgs + 1)) ] || { echo "q.csv: $rows lines for $cfgs configurations x 2 stages"; cat q.csv; return 1; }
+    [ -s q.png ] && [ -s q.svg ] || { echo "no chart"; return 1; }
+    expect_fail 2 "--stages 'dojo,moon': 'moon' is not a shipped demo" "$RS_BIN" bench quality --stages dojo,moon || return 1
+}
+
 t_bench_accuracy_small() {
     "$RS_BIN" bench accuracy --frames 1 --render-size 320x180 --size 160x90 --ibl-sizes 4,8,16 --ibl-reference 32 \
         --csv a.csv >a.txt 2>&1 ||
@@ -189,5 +214,5 @@ t_image_sequences() {
     expect_fail 1 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%n.png" || return 1
 }
 
-t_run streams_and_signals image_sequences filters bench_accuracy_small bench_capture_small async_equals_sequential y4m_plays mp4_exact_timing disk_full bad_input queue_cap_in_report
+t_run streams_and_signals image_sequences filters bench_accuracy_small bench_quality_small bench_capture_small async_equals_sequential y4m_plays mp4_exact_timing disk_full bad_input queue_cap_in_report
 t_done

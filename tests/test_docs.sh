@@ -136,7 +136,7 @@ t_usage_lines_match_option_lists() {
     for c in $(help_commands); do
         check_usage "$c" || bad=1
     done
-    for c in "bench capture" "bench accuracy" "bench upload" "bench encode" "bench audio" "replay sound" "replay events" "serve token"; do
+    for c in "bench capture" "bench accuracy" "bench upload" "bench encode" "bench audio" "bench quality" "replay sound" "replay events" "serve token"; do
         check_usage $c || bad=1
     done
     [ "$bad" = 0 ] || return 1
