@@ -201,6 +201,17 @@ static void res_compare(const char *demo, uint64_t tick, uint64_t history, int o
     }
     for (int i = 0; i + 1 < nk; i++)
         db[i] = psnr_rgb(down[i], down[nk - 1], ow * oh);
+    if (getenv("T_RES_DUMP"))
+        for (int i = 0; i < nk; i++) {
+            char path[256];
+            snprintf(path, sizeof path, "%s/res_%s_%dx.ppm", getenv("T_RES_DUMP"), demo, k[i]);
+            FILE *fp = fopen(path, "wb");
+            if (fp) {
+                fprintf(fp, "P6\n%d %d\n255\n", ow, oh);
+                fwrite(down[i], 3, (size_t)ow * oh, fp);
+                fclose(fp);
+            }
+        }
     for (int i = 0; i < nk; i++)
         free(down[i]);
 }
