@@ -23,7 +23,12 @@ static void quad(r_game *r, float x, float y, float w, float h, const float c[4]
     if (r->nhud + 6 > HUD_MAX_QUADS * 6 || w <= 0 || h <= 0)
         return;
     float du = (u1 - u0) / w, dv = (v1 - v0) / h;
-    x -= 1, y -= 1, w += 2, h += 2, u0 -= du, v0 -= dv, u1 += du, v1 += dv;
+    /* a glyph's cell has a blank column and row on its right and bottom:
+     * growing there would read the next glyph's texels */
+    bool glyph = u0 >= 0;
+    x -= 1, y -= 1, w += glyph ? 1 : 2, h += glyph ? 1 : 2, u0 -= du, v0 -= dv;
+    if (!glyph)
+        u1 += du, v1 += dv;
     hud_vertex q[4] = {{x, y, u0, v0, c[0], c[1], c[2], c[3]},
                        {x + w, y, u1, v0, c[0], c[1], c[2], c[3]},
                        {x + w, y + h, u1, v1, c[0], c[1], c[2], c[3]},
