@@ -30,6 +30,7 @@ uniform int u_material; // 0 planks; 1 planks, paving on the ground; 2 a buildin
 uniform sampler2D u_normal_map;
 uniform sampler2D u_spec_map;
 uniform sampler2D u_mask;
+uniform vec2 u_mask_uv; // 1 / the render size: the mask may be half size (linear filtered)
 in float v_fog;
 #endif
 uniform vec3 u_eye;
@@ -62,7 +63,7 @@ void main()
     vec4 sm = texture(u_spec_map, uv);
     vec3 spec_color = sm.rgb * v_color.a;
     float exponent = 16.0 + 112.0 * sm.a;
-    float key = u_shadows == 1 ? texelFetch(u_mask, ivec2(gl_FragCoord.xy), 0).r : 1.0;
+    float key = u_shadows == 1 ? texture(u_mask, gl_FragCoord.xy * u_mask_uv).r : 1.0;
     if (u_lspsm_on == 1)
         key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world, u_shadows == 1));
     vec3 albedo = v_color.rgb;

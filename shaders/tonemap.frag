@@ -17,6 +17,7 @@ uniform int u_write_mask; // alpha = the fighters' mask, else 1
 #ifdef BLOOM
 uniform sampler2D u_bloom0, u_bloom1;
 uniform float u_bloom;
+uniform float u_bloom1_on; // 0: the quality knob's one level (r_quality.bloom_levels 1)
 #endif
 #ifdef FLARE
 uniform sampler2D u_flare_img; // the flare pass's image (quarter size, HDR)
@@ -43,7 +44,7 @@ void main()
     vec3 c = hdr.rgb * u_exposure;
     vec2 uv = (gl_FragCoord.xy) / vec2(textureSize(u_hdr, 0));
 #ifdef BLOOM
-    c += u_bloom * (texture(u_bloom0, uv).rgb + texture(u_bloom1, uv).rgb);
+    c += u_bloom * (texture(u_bloom0, uv).rgb + u_bloom1_on * texture(u_bloom1, uv).rgb);
 #endif
 #ifdef FLARE
     c += texture(u_flare_img, uv).rgb;

@@ -62,7 +62,7 @@ r_mat4 r_game_camera(const g_state *st, int w, int h, r_vec3 *eye_out)
  * bones (each bone's origin +-0.4 m, which holds the longest limb's far
  * end too) projected, plus MASK_REACH pixels.  The shadow mask is 1
  * (lit) outside it, so its passes draw only inside (a scissor). */
-#define MASK_REACH 8 /* grow 1 px + blur 4 px, with room to spare */
+#define MASK_REACH 8 /* grow 1 px + blur 4 px at 720 rows (they scale with the height), with room to spare */
 static void fighter_box(frame *f, const float lo[3], const float hi[3])
 {
     float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
@@ -80,8 +80,9 @@ static void fighter_box(frame *f, const float lo[3], const float hi[3])
         f->fig_box[0] = f->fig_box[1] = 0, f->fig_box[2] = f->w, f->fig_box[3] = f->h;
         return;
     }
-    float bx0 = fmaxf(floorf(x0) - MASK_REACH, 0), by0 = fmaxf(floorf(y0) - MASK_REACH, 0);
-    float bx1 = fminf(ceilf(x1) + MASK_REACH, (float)f->w), by1 = fminf(ceilf(y1) + MASK_REACH, (float)f->h);
+    float reach = ceilf(MASK_REACH * fmaxf(1.0f, (float)f->h / R_REF_ROWS));
+    float bx0 = fmaxf(floorf(x0) - reach, 0), by0 = fmaxf(floorf(y0) - reach, 0);
+    float bx1 = fminf(ceilf(x1) + reach, (float)f->w), by1 = fminf(ceilf(y1) + reach, (float)f->h);
     f->fig_box[0] = (int)bx0, f->fig_box[1] = (int)by0;
     f->fig_box[2] = bx1 > bx0 ? (int)(bx1 - bx0) : 0, f->fig_box[3] = by1 > by0 ? (int)(by1 - by0) : 0;
 }

@@ -132,6 +132,9 @@ static void free_targets(r_game *r)
     for (size_t i = 0; i < sizeof tex / sizeof tex[0]; i++)
         if (tex[i])
             gl.DeleteTextures(1, &tex[i]);
+    for (int i = 0; i < BLOOM_XSTEPS; i++)
+        if (r->bx_tex[i])
+            gl.DeleteTextures(1, &r->bx_tex[i]), gl.DeleteFramebuffers(1, &r->bx_fbo[i]), r->bx_tex[i] = r->bx_fbo[i] = 0;
     for (size_t i = 0; i < sizeof fbo / sizeof fbo[0]; i++)
         if (fbo[i])
             gl.DeleteFramebuffers(1, &fbo[i]);
@@ -157,13 +160,22 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
     r->hdr_fbo = r_fbo_for(r->hdr_tex, 0, r->depth_tex);
     GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
     r->depth_fbo = r_fbo_for(0, 0, r->depth_tex);
+    /* the mask at half size with q.mask_half; bloom levels of fixed row counts (r_post.c) */
+    r->mask_w = r->opts.q.mask_half ? r_half(w, 1) : w, r->mask_h = r->opts.q.mask_half ? r_half(h, 1) : h;
+    r_bloom_plan(w, h, &r->bloom_steps, &r->b4_w);
+    r->b8_w = r_half(r->b4_w, 1);
     for (int i = 0; i < 2; i++) {
-        r->mask_tex[i] = r_tex2d(GL_R8, w, h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->mask_tex[i] = r_tex2d(GL_R8, r->mask_w, r->mask_h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->mask_fbo[i] = r_fbo_for(r->mask_tex[i], 0, 0);
-        r->b4_tex[i] = r_tex2d(GL_RGBA16F, r_half(w, 2), r_half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->b4_tex[i] = r_tex2d(GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->b4_fbo[i] = r_fbo_for(r->b4_tex[i], 0, 0);
-        r->b8_tex[i] = r_tex2d(GL_RGBA16F, r_half(w, 3), r_half(h, 3), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->b8_tex[i] = r_tex2d(GL_RGBA16F, r->b8_w, BLOOM_ROWS / 2, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->b8_fbo[i] = r_fbo_for(r->b8_tex[i], 0, 0);
+    }
+    for (int k = 2; k < r->bloom_steps; k++) {
+        r->bx_tex[k - 2] = r_tex2d(GL_RGBA16F, r_half(w, k), r_half(h, k), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR,
+                                   GL_CLAMP_TO_EDGE);
+        r->bx_fbo[k - 2] = r_fbo_for(r->bx_tex[k - 2], 0, 0);
     }
     r->b2_tex = r_tex2d(GL_RGBA16F, r_half(w, 1), r_half(h, 1), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     r->b2_fbo = r_fbo_for(r->b2_tex, 0, 0);
@@ -631,9 +643,9 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
     if (!strcmp(name, "hdr"))
         tex = r->hdr_tex;
     else if (!strcmp(name, "bloom"))
-        tex = r->b4_tex[0], tw = r_half(r->tw, 2), th = r_half(r->th, 2);
+        tex = r->b4_tex[0], tw = r->b4_w, th = BLOOM_ROWS;
     else if (!strcmp(name, "mask"))
-        tex = r->mask_tex[r->mask_final];
+        tex = r->mask_tex[r->mask_final], tw = r->mask_w, th = r->mask_h;
     else if (!strncmp(name, "silhouette", 10) && (!name[10] || (name[10] >= '1' && name[10] < '0' + SIL_LEVELS && !name[11]))) {
         level = name[10] ? name[10] - '0' : 0; /* "silhouette2": blurred level 2 */
         tex = r->sil_tex, tw = r->sil_size >> level, th = r->sil_size >> level;

@@ -147,6 +147,7 @@ void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int 
     gl.UseProgram(p);
     r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, src_tex);
     gl.Uniform1f(r_loc(p, "u_lod"), (float)lod);
+    gl.Uniform2f(r_loc(p, "u_dst"), (float)w, (float)h);
     gl.Uniform1f(r_loc(p, "u_threshold"), threshold);
     gl.Uniform1f(r_loc(p, "u_scale"), scale);
     r_fullscreen(r);

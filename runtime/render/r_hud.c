@@ -15,10 +15,20 @@ static bool need_hud(void *u)
     return !r->opts.no_hud && !r->opts.mask;
 }
 
+/* Each quad grows by a pixel each side (its uv with it), so the shader's
+ * coverage (hud.frag) can soften edges that fall between pixels: the HUD
+ * is sized in fractions of the height, and looks the same at any size. */
 static void quad(r_game *r, float x, float y, float w, float h, const float c[4], float u0, float v0, float u1, float v1)
 {
-    if (r->nhud + 6 > HUD_MAX_QUADS * 6)
+    if (r->nhud + 6 > HUD_MAX_QUADS * 6 || w <= 0 || h <= 0)
         return;
+    float du = (u1 - u0) / w, dv = (v1 - v0) / h;
+    /* a glyph's cell has a blank column and row on its right and bottom:
+     * growing there would read the next glyph's texels */
+    bool glyph = u0 >= 0;
+    x -= 1, y -= 1, w += glyph ? 1 : 2, h += glyph ? 1 : 2, u0 -= du, v0 -= dv;
+    if (!glyph)
+        u1 += du, v1 += dv;
     hud_vertex q[4] = {{x, y, u0, v0, c[0], c[1], c[2], c[3]},
                        {x + w, y, u1, v0, c[0], c[1], c[2], c[3]},
                        {x + w, y + h, u1, v1, c[0], c[1], c[2], c[3]},
@@ -28,9 +38,10 @@ static void quad(r_game *r, float x, float y, float w, float h, const float c[4]
         r->hud[r->nhud++] = q[order[k]];
 }
 
+/* uv -2..-1 across a rect tells the shader it is one (and where in it) */
 static void rect(r_game *r, float x, float y, float w, float h, const float c[4])
 {
-    quad(r, x, y, w, h, c, -1, -1, -1, -1);
+    quad(r, x, y, w, h, c, -2, -2, -1, -1);
 }
 
 static float text_width(const char *s, float px)
@@ -124,6 +135,8 @@ static void run_hud(void *u)
     gl.Viewport(0, 0, f->w, f->h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
+    gl.Enable(GL_BLEND); /* coverage in alpha; the output's alpha stays */
+    gl.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     gl.UseProgram(p);
     gl.Uniform2f(r_loc(p, "u_screen"), (float)f->w, (float)f->h);
     r_bind_tex(p, "u_font", 0, GL_TEXTURE_2D, r->font_tex);
@@ -132,6 +145,7 @@ static void run_hud(void *u)
     gl.BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(r->nhud * sizeof(hud_vertex)), r->hud);
     gl.DrawArrays(GL_TRIANGLES, 0, r->nhud);
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
+    gl.Disable(GL_BLEND);
 }
 
 GLuint r_hud_font(void)

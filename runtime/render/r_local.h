@@ -19,6 +19,11 @@
 #define SHADOW_SIZE 1024 /* SSFSM light depth map: r->shadow_size (r_quality.shadow_size) */
 #define SIL_SIZE 512     /* silhouette, level 0: r->sil_size (r_quality.sil_size) */
 #define SIL_LEVELS 5     /* the sharp level and 4 blurred ones */
+/* Screen-space sizes are fractions of the frame height, with today's
+ * look kept at R_REF_ROWS (docs/renderer.md, "Resolution independence"). */
+#define R_REF_ROWS 720
+#define BLOOM_ROWS 180 /* the bloom's first level at any render size; the second has half */
+#define BLOOM_XSTEPS 5 /* halvings past the half-size bright pass before the resample */
 #define SKY_SIZE 128     /* the environment as seen */
 #define LENS_ALPHA 0.15f
 
@@ -106,6 +111,9 @@ struct r_game {
     GLuint hdr_tex, depth_tex, hdr_fbo, depth_fbo;
     GLuint mask_tex[2], mask_fbo[2];
     GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2];
+    GLuint bx_tex[BLOOM_XSTEPS], bx_fbo[BLOOM_XSTEPS]; /* halvings between b2 and b4 (renders over 720 rows) */
+    int bloom_steps, b4_w, b8_w; /* hdr -> b4 in bloom_steps steps; b4 BLOOM_ROWS rows, b8 half */
+    int mask_w, mask_h;          /* the shadow mask: the render size, or half (q.mask_half) */
     GLuint fl_tex, fl_fbo; /* the flare image, quarter size */
     GLuint sunvis_tex, sunvis_fbo;
     GLuint ldr_tex, ldr_fbo; /* the tone map's output when the AA pass runs after it (RGBA8) */
@@ -154,6 +162,9 @@ void r_fullscreen(r_game *r);      /* one triangle: cap_fullscreen.vert */
 int r_half(int v, int k);          /* v >> k, at least 1 */
 void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
+/* The bloom pyramid for a w x h render: *steps down from the HDR image
+ * to the BLOOM_ROWS level (halvings, the last a resample), *w4 its width. */
+void r_bloom_plan(int w, int h, int *steps, int *w4);
 
 /* per-frame set-up (r_frame.c) */
 void r_frame_setup(r_game *r, frame *f); /* f->prev, cur, alpha, w, h, out_fbo set: the rest */

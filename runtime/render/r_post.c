@@ -25,22 +25,61 @@ static bool need_sun(void *u)
     return r->f.sun_on_screen;
 }
 
+/* The bloom's levels have BLOOM_ROWS and BLOOM_ROWS / 2 rows at any
+ * render size (the width by aspect), so the glow is the same fraction of
+ * the frame: the HDR image is halved until one step more would pass
+ * BLOOM_ROWS, and the last step resamples to it (a ratio in (1, 2]; 2 at
+ * 720 rows, where the pyramid is what it was at 1/4 and 1/8 size). */
+void r_bloom_plan(int w, int h, int *steps, int *w4)
+{
+    int n = 1;
+    while (n < BLOOM_XSTEPS + 2 && ((long)BLOOM_ROWS << n) < h)
+        n++;
+    *steps = n;
+    long v = ((long)w * BLOOM_ROWS * 2 + h) / (2L * h); /* rounded */
+    *w4 = v > 0 ? (int)v : 1;
+}
+
+/* step k's target (1 <= k < bloom_steps): b2, then the extra halvings */
+static GLuint bloom_step_fbo(r_game *r, int k)
+{
+    return k == r->bloom_steps ? r->b4_fbo[0] : k == 1 ? r->b2_fbo : r->bx_fbo[k - 2];
+}
+
+static GLuint bloom_step_tex(r_game *r, int k)
+{
+    return k == 1 ? r->b2_tex : r->bx_tex[k - 2];
+}
+
+static void bloom_step_size(r_game *r, int k, int *w, int *h)
+{
+    *w = k == r->bloom_steps ? r->b4_w : r_half(r->f.w, k);
+    *h = k == r->bloom_steps ? BLOOM_ROWS : r_half(r->f.h, k);
+}
+
 static void run_bloom_bright(void *u)
 {
     r_game *r = u;
+    int w, h;
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
-    r_down_into(r, r->b2_fbo, r->hdr_tex, 0, r_half(r->f.w, 1), r_half(r->f.h, 1), r->stage.bloom_threshold,
-              r->f.exposure);
+    bloom_step_size(r, 1, &w, &h);
+    r_down_into(r, bloom_step_fbo(r, 1), r->hdr_tex, 0, w, h, r->stage.bloom_threshold, r->f.exposure);
 }
 
 static void run_bloom_blur(void *u)
 {
     r_game *r = u;
-    int w4 = r_half(r->f.w, 2), h4 = r_half(r->f.h, 2), w8 = r_half(r->f.w, 3), h8 = r_half(r->f.h, 3);
-    r_down_into(r, r->b4_fbo[0], r->b2_tex, 0, w4, h4, -1, 1);
+    int w, h;
+    for (int k = 2; k <= r->bloom_steps; k++) {
+        bloom_step_size(r, k, &w, &h);
+        r_down_into(r, bloom_step_fbo(r, k), bloom_step_tex(r, k - 1), 0, w, h, -1, 1);
+    }
+    int w4 = r->b4_w, h4 = BLOOM_ROWS, w8 = r->b8_w, h8 = BLOOM_ROWS / 2;
     r_blur_into(r, r->b4_fbo[1], r->b4_tex[0], 0, w4, h4, 1, 0);
     r_blur_into(r, r->b4_fbo[0], r->b4_tex[1], 0, w4, h4, 0, 1);
+    if (r->opts.q.bloom_levels == 1) /* the quality knob: the BLOOM_ROWS level alone */
+        return;
     r_down_into(r, r->b8_fbo[0], r->b4_tex[0], 0, w8, h8, -1, 1);
     r_blur_into(r, r->b8_fbo[1], r->b8_tex[0], 0, w8, h8, 1, 0);
     r_blur_into(r, r->b8_fbo[0], r->b8_tex[1], 0, w8, h8, 0, 1);
@@ -83,6 +122,7 @@ static void run_tonemap(void *u)
         r_bind_tex(p, "u_bloom0", 2, GL_TEXTURE_2D, r->b4_tex[0]);
         r_bind_tex(p, "u_bloom1", 3, GL_TEXTURE_2D, r->b8_tex[0]);
         gl.Uniform1f(r_loc(p, "u_bloom"), r->stage.bloom);
+        gl.Uniform1f(r_loc(p, "u_bloom1_on"), r->opts.q.bloom_levels == 1 ? 0.0f : 1.0f);
     }
     if (flare)
         r_bind_tex(p, "u_flare_img", 4, GL_TEXTURE_2D, r->fl_tex);

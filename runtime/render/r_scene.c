@@ -59,6 +59,7 @@ static void run_scene(void *u)
     r_bind_tex(p, "u_normal_map", 0, GL_TEXTURE_2D, r->normal_tex);
     r_bind_tex(p, "u_spec_map", 1, GL_TEXTURE_2D, r->spec_tex);
     r_bind_tex(p, "u_mask", 2, GL_TEXTURE_2D, r->mask_tex[r->mask_final]);
+    gl.Uniform2f(r_loc(p, "u_mask_uv"), 1.0f / (float)f->w, 1.0f / (float)f->h);
     gl.Uniform1i(r_loc(p, "u_shadows"), shadows);
     r_fx_bind(r, p, R_FX_BIND_SCENE);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);

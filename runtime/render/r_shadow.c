@@ -97,14 +97,31 @@ static void run_z_prepass(void *u)
     r_draw_fighters(r, r->prog[P_DEPTH]);
 }
 
-/* The bound mask buffer: all 1 (lit), then draws limited to the fighters' box. */
+/* The mask's scale: mask pixels per render pixel (1, or 1/2 with
+ * q.mask_half) and mask pixels per 1/720 of the frame height, the unit
+ * its grow and blur are sized in (docs/renderer.md). */
+static float mask_unit(const r_game *r)
+{
+    return (float)r->mask_h / R_REF_ROWS;
+}
+
+/* The bound mask buffer: all 1 (lit), then draws limited to the fighters'
+ * box (render pixels, taken to the mask's, rounded outwards). */
 static void mask_clear_and_scissor(r_game *r)
 {
     gl.Disable(GL_SCISSOR_TEST);
     gl.ClearColor(1, 1, 1, 1);
     gl.Clear(GL_COLOR_BUFFER_BIT);
     gl.Enable(GL_SCISSOR_TEST);
-    gl.Scissor(r->f.fig_box[0], r->f.fig_box[1], r->f.fig_box[2], r->f.fig_box[3]);
+    const int *b = r->f.fig_box;
+    if (r->mask_w == r->f.w && r->mask_h == r->f.h) {
+        gl.Scissor(b[0], b[1], b[2], b[3]);
+        return;
+    }
+    double sx = (double)r->mask_w / r->f.w, sy = (double)r->mask_h / r->f.h;
+    int x0 = (int)floor(b[0] * sx), y0 = (int)floor(b[1] * sy);
+    int x1 = (int)ceil((b[0] + b[2]) * sx), y1 = (int)ceil((b[1] + b[3]) * sy);
+    gl.Scissor(x0, y0, x1 - x0, y1 - y0);
 }
 
 static void run_shadow_mask(void *u)
@@ -112,7 +129,7 @@ static void run_shadow_mask(void *u)
     r_game *r = u;
     GLuint p = r->prog[P_MASK];
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->mask_fbo[0]);
-    gl.Viewport(0, 0, r->f.w, r->f.h);
+    gl.Viewport(0, 0, r->mask_w, r->mask_h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
     mask_clear_and_scissor(r);
@@ -122,25 +139,29 @@ static void run_shadow_mask(void *u)
     gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, r->f.inv_vp.m);
     gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, r->f.light.m);
     gl.Uniform2f(r_loc(p, "u_size"), (float)r->f.w, (float)r->f.h);
+    gl.Uniform1f(r_loc(p, "u_step"), r->mask_h == r->f.h ? 1.0f : 2.0f);
     gl.Uniform1f(r_loc(p, "u_bias"), 0.0015f);
     r_fullscreen(r);
     gl.Disable(GL_SCISSOR_TEST);
 }
 
-/* SSFSM step 3: grow dark by a pixel, then blur (mask 0 -> 1 -> 0 -> 1) */
+/* SSFSM step 3: grow dark by 1/720 of the frame height, then blur (sigma
+ * 2/720 of it) (mask 0 -> 1 -> 0 -> 1) */
 static void run_mask_filter(void *u)
 {
     r_game *r = u;
     GLuint p = r->prog[P_GROW];
+    float k = mask_unit(r);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->mask_fbo[1]);
-    gl.Viewport(0, 0, r->f.w, r->f.h);
+    gl.Viewport(0, 0, r->mask_w, r->mask_h);
     mask_clear_and_scissor(r);
     gl.UseProgram(p);
     r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, r->mask_tex[0]);
+    gl.Uniform1f(r_loc(p, "u_radius"), k);
     r_fullscreen(r);
     /* outside the box both buffers hold 1, so the blur reads the truth there */
-    r_blur_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->f.w, r->f.h, 1, 0);
-    r_blur_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->f.w, r->f.h, 0, 1);
+    r_blur_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->mask_w, r->mask_h, k, 0);
+    r_blur_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->mask_w, r->mask_h, 0, k);
     gl.Disable(GL_SCISSOR_TEST);
     r->mask_final = 1;
 }
