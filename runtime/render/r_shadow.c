@@ -99,10 +99,16 @@ static void restrict_level(GLuint tex, int k)
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, k);
 }
 
-static void clear_level(GLuint fbo)
+/* Bind fbo, clear it whole, and scissor the draws that follow to b (x0 y0
+ * x1 y1): the draw then binds the same framebuffer, so the clear goes in
+ * with it (llvmpipe flushes on a framebuffer change, not on a clear). */
+static void clear_then_scissor(GLuint fbo, const int b[4])
 {
     gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    gl.Disable(GL_SCISSOR_TEST);
     gl.Clear(GL_COLOR_BUFFER_BIT);
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(b[0], b[1], b[2] - b[0], b[3] - b[1]);
 }
 
 static void run_silhouette_mips(void *u)
@@ -121,14 +127,11 @@ static void run_silhouette_mips(void *u)
             b[a] = b[a] / 2 - 2 - 4 - 1, b[a + 2] = (b[a + 2] + 1) / 2 + 1 + 4 + 1;
             b[a] = b[a] < 0 ? 0 : b[a], b[a + 2] = b[a + 2] > n ? n : b[a + 2];
         }
-        gl.Disable(GL_SCISSOR_TEST);
-        clear_level(r->sil_fbo[k]);
-        clear_level(r->sil_tmp_fbo[k]);
-        gl.Enable(GL_SCISSOR_TEST);
-        gl.Scissor(b[0], b[1], b[2] - b[0], b[3] - b[1]);
         restrict_level(r->sil_tex, k - 1);
+        clear_then_scissor(r->sil_fbo[k], b);
         r_down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
         restrict_level(r->sil_tex, k);
+        clear_then_scissor(r->sil_tmp_fbo[k], b);
         r_blur_into(r, r->sil_tmp_fbo[k], r->sil_tex, 0, n, n, 1, 0);
         restrict_level(r->sil_tmp, k);
         r_blur_into(r, r->sil_fbo[k], r->sil_tmp, 0, n, n, 0, 1);
