@@ -33,9 +33,13 @@ static void run_shadow_map(void *u)
     gl.Clear(GL_DEPTH_BUFFER_BIT);
     gl.Enable(GL_POLYGON_OFFSET_FILL);
     gl.PolygonOffset(2.0f, 4.0f);
-    gl.Disable(GL_CULL_FACE);
+    /* the capsules are closed: the nearest surface faces the light, so
+     * the back faces only cost fragments (most of this pass on llvmpipe) */
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
     light_view_draw(r, r->prog[P_DEPTH]);
     gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_CULL_FACE);
 }
 
 static void run_silhouette(void *u)
@@ -44,10 +48,13 @@ static void run_silhouette(void *u)
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->sil_fbo[0]);
     gl.Viewport(0, 0, r->sil_size, r->sil_size);
     gl.Disable(GL_DEPTH_TEST);
-    gl.Disable(GL_CULL_FACE);
+    /* closed capsules: their front faces cover what the whole mesh does */
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
     gl.ClearColor(0, 0, 0, 0);
     gl.Clear(GL_COLOR_BUFFER_BIT);
     light_view_draw(r, r->prog[P_SIL]);
+    gl.Disable(GL_CULL_FACE);
 }
 
 
