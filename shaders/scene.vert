@@ -32,6 +32,7 @@ uniform mat4 u_light_proj;     // the silhouette projector
 uniform vec3 u_light_dir;      // towards the key light
 uniform vec3 u_waist[2];       // the casters' waists
 uniform float u_lod_start, u_lod_scale;
+uniform sampler2D u_silhouette; // scene.frag's: its size scales the level
 uniform int u_material;        // 3: a hole's inside, seen from within the sphere
 out vec3 v_proj;               // projector uv, z: 1 when this vertex may receive
 out float v_lod;
@@ -75,7 +76,10 @@ void main()
     bool facing = dot(u_material == 3 ? -v_normal : v_normal, u_light_dir) > 0.0;
     bool behind = dot(world.xyz - w, u_light_dir) > 0.0;
     v_proj = vec3(lp.xy * 0.5 + 0.5, facing && !behind ? 1.0 : 0.0);
-    v_lod = clamp((d - u_lod_start) * u_lod_scale, 0.0, 4.0);
+    // the levels are tuned for a 512 silhouette: a smaller one is already
+    // blurrier by a level per halving (r_quality.sil_size)
+    float lod = (d - u_lod_start) * u_lod_scale - log2(512.0 / float(textureSize(u_silhouette, 0).x));
+    v_lod = clamp(lod, 0.0, 4.0);
 #endif
 #if defined(FIGHTER) || defined(LENS)
     v_fog = u_fog_on == 1 ? fog_depth(world.xyz) : 0.0;

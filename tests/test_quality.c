@@ -285,6 +285,96 @@ static void t_water_grid(void)
     plat_destroy(p);
 }
 
+/* ---- the silhouette mip chain ---- */
+
+/* One texel of src (n x n, RGBA floats, red used), 0 outside (clamp to border). */
+static float sil_at(const float *src, int n, int x, int y)
+{
+    return x < 0 || y < 0 || x >= n || y >= n ? 0.0f : src[4 * ((size_t)y * n + x)];
+}
+
+/* The chain as downsample.frag and blur.frag define it, in floats: a 4x4
+ * box to half size, then the 9-tap Gaussian (sigma 2) along x, then y. */
+static float *sil_level_cpu(const float *src, int n)
+{
+    int h = n / 2;
+    float *d = calloc((size_t)h * h * 4, sizeof *d), *t = calloc((size_t)h * h * 4, sizeof *t);
+    T_ASSERT(d && t);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < h; x++) {
+            float s = 0;
+            for (int j = -1; j <= 2; j++)
+                for (int i = -1; i <= 2; i++)
+                    s += sil_at(src, n, 2 * x + i, 2 * y + j);
+            d[4 * ((size_t)y * h + x)] = s / 16;
+        }
+    /* blur.frag's 5 bilinear taps as 9 texel weights */
+    const float w0 = 0.2042f, w1 = 0.3040f, w2 = 0.0931f, f1 = 0.3846f, f2 = 0.2308f;
+    const float w[5] = {w0, w1 * (1 - f1), w1 * f1, w2 * (1 - f2), w2 * f2};
+    for (int pass = 0; pass < 2; pass++) {
+        const float *a = pass ? t : d;
+        float *b = pass ? d : t;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < h; x++) {
+                float s = w[0] * sil_at(a, h, x, y);
+                for (int k = 1; k < 5; k++)
+                    s += w[k] * (pass ? sil_at(a, h, x, y - k) + sil_at(a, h, x, y + k)
+                                      : sil_at(a, h, x - k, y) + sil_at(a, h, x + k, y));
+                b[4 * ((size_t)y * h + x)] = s;
+            }
+    }
+    free(t);
+    return d;
+}
+
+/* silhouette_mips draws each level only round the fighters (a scissor):
+ * every level must still be the whole chain's, computed here from the
+ * level the GPU built before it (llvmpipe: 8-bit texels and bilinear
+ * weights, so a small tolerance). */
+static void t_silhouette_mips_whole(void)
+{
+    plat *p = t_context("egl");
+    static const struct { const char *demo; uint64_t tick; int sil; } cases[] = {
+        {"dojo", 1200, 0}, {"temple", 900, 256}, {"harbor", 600, 1024}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        g_state prev, cur;
+        t_fb f;
+        t_fb_make(&f, 160, 90);
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.sil_size = cases[c].sil}});
+        /* a frame of another pose first: texels it left must not survive */
+        t_state_at(cases[c].demo, cases[c].tick - 500, &prev, &cur);
+        t_draw(r, &f, &prev, &cur, 160, 90);
+        t_state_at(cases[c].demo, cases[c].tick, &prev, &cur);
+        t_draw(r, &f, &prev, &cur, 160, 90);
+        int n = cases[c].sil ? cases[c].sil : 512;
+        float *lv = t_read(r, "silhouette", 4, n, n);
+        for (int k = 1; k < 5; k++) {
+            char name[16];
+            snprintf(name, sizeof name, "silhouette%d", k);
+            float *gpu = t_read(r, name, 4, n >> k, n >> k), *cpu = sil_level_cpu(lv, n >> (k - 1));
+            float worst = 0, mass = 0;
+            int at = 0;
+            for (int i = 0; i < (n >> k) * (n >> k); i++) {
+                float e = fabsf(gpu[4 * i] - cpu[4 * i]);
+                mass += cpu[4 * i];
+                if (e > worst)
+                    worst = e, at = i;
+            }
+            fprintf(stderr, "    %s sil %d level %d: max |gpu - cpu| %.4f at (%d, %d), mass %.1f\n", cases[c].demo, n, k,
+                    worst, at % (n >> k), at / (n >> k), mass);
+            T_ASSERTF(mass > 1, "%s level %d: empty", cases[c].demo, k);
+            T_ASSERTF(worst < 0.02f, "%s sil %d level %d: texel (%d, %d) is %.3f, the whole chain gives %.3f", cases[c].demo,
+                      n, k, at % (n >> k), at / (n >> k), gpu[4 * at], cpu[4 * at]);
+            free(cpu), free(lv);
+            lv = gpu;
+        }
+        free(lv);
+        r_game_destroy(r);
+        t_fb_free(&f);
+    }
+    plat_destroy(p);
+}
+
 static void refused(r_quality q, const char *says)
 {
     rs_err e = {0};
@@ -311,4 +401,5 @@ static void t_out_of_range_refused(void)
 
 T_MAIN({"defaults_spelled_out_are_zero", t_defaults_spelled_out_are_zero}, {"fxaa", t_fxaa},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
+       {"silhouette_mips_whole", t_silhouette_mips_whole},
        {"water_grid", t_water_grid}, {"out_of_range_refused", t_out_of_range_refused})

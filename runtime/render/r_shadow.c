@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../game/g_skel.h"
 #include "r_local.h"
 
 static bool need_shadows(void *u)
@@ -32,9 +33,13 @@ static void run_shadow_map(void *u)
     gl.Clear(GL_DEPTH_BUFFER_BIT);
     gl.Enable(GL_POLYGON_OFFSET_FILL);
     gl.PolygonOffset(2.0f, 4.0f);
-    gl.Disable(GL_CULL_FACE);
+    /* the capsules are closed: the nearest surface faces the light, so
+     * the back faces only cost fragments (most of this pass on llvmpipe) */
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
     light_view_draw(r, r->prog[P_DEPTH]);
     gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_CULL_FACE);
 }
 
 static void run_silhouette(void *u)
@@ -43,18 +48,57 @@ static void run_silhouette(void *u)
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->sil_fbo[0]);
     gl.Viewport(0, 0, r->sil_size, r->sil_size);
     gl.Disable(GL_DEPTH_TEST);
-    gl.Disable(GL_CULL_FACE);
+    /* closed capsules: their front faces cover what the whole mesh does */
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
     gl.ClearColor(0, 0, 0, 0);
     gl.Clear(GL_COLOR_BUFFER_BIT);
     light_view_draw(r, r->prog[P_SIL]);
+    gl.Disable(GL_CULL_FACE);
 }
 
+
+/* The texels of the silhouette (level 0, x0 y0 x1 y1, x1 y1 exclusive)
+ * the fighters can cover: each capsule's ends projected by the light
+ * (orthographic), grown by its radius and a texel for rasterisation.
+ * The light's box is fitted round a sphere holding both fighters, so
+ * they fill only part of it: the mip chain draws inside this. */
+static void sil_footprint(const r_game *r, int b[4])
+{
+    const float *L = r->f.light.m;
+    float sx = sqrtf(L[0] * L[0] + L[4] * L[4] + L[8] * L[8]), sy = sqrtf(L[1] * L[1] + L[5] * L[5] + L[9] * L[9]);
+    float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
+    for (int i = 0; i < 2; i++)
+        for (int k = 0; k < G_BONES; k++) {
+            const float *m = r->f.bones[i][k];
+            float len = fx_to_float(g_bones[k].length), rad = fx_to_float(g_bones[k].radius);
+            for (int e = 0; e < 2; e++) {
+                float p[3] = {m[12] + m[0] * len * e, m[13] + m[1] * len * e, m[14] + m[2] * len * e};
+                float x = L[0] * p[0] + L[4] * p[1] + L[8] * p[2] + L[12];
+                float y = L[1] * p[0] + L[5] * p[1] + L[9] * p[2] + L[13];
+                lo[0] = fminf(lo[0], x - rad * sx), hi[0] = fmaxf(hi[0], x + rad * sx);
+                lo[1] = fminf(lo[1], y - rad * sy), hi[1] = fmaxf(hi[1], y + rad * sy);
+            }
+        }
+    float n = (float)r->sil_size;
+    for (int a = 0; a < 2; a++) {
+        /* NaN (a broken matrix) or out of the map: the whole map */
+        float t0 = (lo[a] * 0.5f + 0.5f) * n - 1, t1 = (hi[a] * 0.5f + 0.5f) * n + 1;
+        b[a] = t0 >= 0 && t0 <= n ? (int)floorf(t0) : 0;
+        b[a + 2] = t1 >= 0 && t1 <= n ? (int)ceilf(t1) : r->sil_size;
+        if (!(t0 <= t1))
+            b[a] = 0, b[a + 2] = r->sil_size;
+    }
+}
 
 /* Blurred mipmap projection shadow: level k = blur(downsample(level k-1)),
  * for 4 levels.  Each draw reads one level while writing another (or the
  * same level of the other texture); BASE/MAX_LEVEL restrict what the
  * sampler can see to the level read, so there is no feedback loop, and
- * the shaders then address it as level 0. */
+ * the shaders then address it as level 0.
+ * Only the texels that can be non-zero are drawn (a scissor per level),
+ * the rest cleared: the same bytes as drawing all, for a fraction of the
+ * fragments (llvmpipe pays per fragment; level 1 is 3/4 of them). */
 static void restrict_level(GLuint tex, int k)
 {
     gl.BindTexture(GL_TEXTURE_2D, tex);
@@ -62,19 +106,44 @@ static void restrict_level(GLuint tex, int k)
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, k);
 }
 
+/* Bind fbo, clear it whole, and scissor the draws that follow to b (x0 y0
+ * x1 y1): the draw then binds the same framebuffer, so the clear goes in
+ * with it (llvmpipe flushes on a framebuffer change, not on a clear). */
+static void clear_then_scissor(GLuint fbo, const int b[4])
+{
+    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(b[0], b[1], b[2] - b[0], b[3] - b[1]);
+}
+
 static void run_silhouette_mips(void *u)
 {
     r_game *r = u;
+    int b[4];
+    sil_footprint(r, b);
     gl.Disable(GL_DEPTH_TEST);
+    gl.ClearColor(0, 0, 0, 0);
     for (int k = 1; k < SIL_LEVELS; k++) {
         int n = r->sil_size >> k;
+        /* where level k can be non-zero: the downsample reads source
+         * texels 2i-1..2i+2, each blur reaches 4 texels (downsample.frag,
+         * blur.frag); a texel more for rounding */
+        for (int a = 0; a < 2; a++) {
+            b[a] = b[a] / 2 - 2 - 4 - 1, b[a + 2] = (b[a + 2] + 1) / 2 + 1 + 4 + 1;
+            b[a] = b[a] < 0 ? 0 : b[a], b[a + 2] = b[a + 2] > n ? n : b[a + 2];
+        }
         restrict_level(r->sil_tex, k - 1);
+        clear_then_scissor(r->sil_fbo[k], b);
         r_down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
         restrict_level(r->sil_tex, k);
+        clear_then_scissor(r->sil_tmp_fbo[k], b);
         r_blur_into(r, r->sil_tmp_fbo[k], r->sil_tex, 0, n, n, 1, 0);
         restrict_level(r->sil_tmp, k);
         r_blur_into(r, r->sil_fbo[k], r->sil_tmp, 0, n, n, 0, 1);
     }
+    gl.Disable(GL_SCISSOR_TEST);
     gl.BindTexture(GL_TEXTURE_2D, r->sil_tex);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, SIL_LEVELS - 1);
