@@ -10,6 +10,7 @@
 // everything below, and it is 0 whenever the map was not drawn this frame.
 uniform int u_lspsm_on;
 uniform sampler2DShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware
+uniform float u_lspsm_texel;         // one texel of the map, in texture coordinates
 uniform sampler2D u_lspsm_flag;      // 1 where the nearest caster is a fighter
 uniform mat4 u_lspsm_shadow;         // world -> (u, v, depth, w)
 uniform vec3 u_lspsm_eye;
@@ -47,13 +48,21 @@ float lspsm_visibility(vec3 p, vec3 n, float offset, bool no_fighters)
     vec3 c = s.xyz / s.w;
     if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0))))
         return 1.0; // outside the map: nothing casts there
-    float lit = texture(u_lspsm_map, vec3(c.xy, c.z - u_lspsm_bias));
+    // four bilinear (2x2 PCF) taps half a texel either way: a 3x3-texel
+    // quadratic B-spline, smooth across texel edges, where one tap's tent
+    // left the warp's long far texels as a staircase along shadow edges
+    float h = 0.5 * u_lspsm_texel, z = c.z - u_lspsm_bias;
+    float lit = 0.25 * (texture(u_lspsm_map, vec3(c.xy + vec2(-h, -h), z)) + texture(u_lspsm_map, vec3(c.xy + vec2(h, -h), z)) +
+                        texture(u_lspsm_map, vec3(c.xy + vec2(-h, h), z)) + texture(u_lspsm_map, vec3(c.xy + vec2(h, h), z)));
     // a flagged texel's caster is a fighter, so whatever it shadows counts
-    // as lit: the filtered sum of the flagged texels' weights goes back in
-    // (exact where those texels shadow the receiver, as they do but for a
-    // receiver nearer the light than the fighter; the clamp covers that)
+    // as lit: the filtered sum of the flagged texels' weights (the same
+    // taps) goes back in (exact where those texels shadow the receiver, as
+    // they do but for a receiver nearer the light than the fighter; the
+    // clamp covers that)
     if (no_fighters)
-        lit = min(lit + texture(u_lspsm_flag, c.xy).r, 1.0);
+        lit = min(lit + 0.25 * (texture(u_lspsm_flag, c.xy + vec2(-h, -h)).r + texture(u_lspsm_flag, c.xy + vec2(h, -h)).r +
+                                texture(u_lspsm_flag, c.xy + vec2(-h, h)).r + texture(u_lspsm_flag, c.xy + vec2(h, h)).r),
+                  1.0);
     return mix(1.0, lit, strength);
 }
 

@@ -432,8 +432,109 @@ static void t_deterministic(void)
     plat_destroy(p);
 }
 
+/* plaza@1500 at 640x360 (the default job), RGBA8 top-down, with map edge `size` (0: default). */
+static uint8_t *plaza_frame(int size, bool lspsm, float **depth)
+{
+    enum { FW = 640, FH = 360 };
+    t_fb f;
+    t_fb_make(&f, FW, FH);
+    r_game *r = t_game_opts(&(r_game_opts){.q = {.lspsm_size = size}});
+    r_stage st = plaza();
+    st.lspsm = lspsm;
+    set_stage(r, &st);
+    uint8_t *px = malloc((size_t)FW * FH * 4);
+    T_ASSERT(px);
+    for (uint64_t t = 1498; t <= 1500; t++) {
+        g_state prev, cur;
+        t_state_at("plaza", t, &prev, &cur);
+        t_draw_read(r, &f, &prev, &cur, FW, FH, px, false);
+    }
+    if (depth)
+        *depth = t_read(r, "depth", 1, FW, FH);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    return px;
+}
+
+static double luma8(const uint8_t *p)
+{
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
+
+/* The far shadow edges are smooth at the default 1024 map: on the ground
+ * beyond 25 m, where the buildings' shadows fall (a pixel darker by 10 %+
+ * than without the map in either render), the frame is close to the one
+ * drawn with a 4096 map.  The warp tuned for the camera's 0.1 m near plane
+ * left 2 m texels at 80 m along the view, and one bilinear tap drew them as
+ * a staircase along every far edge: 30.6 dB here, where this wants 33. */
+static void t_far_shadow_edges_smooth(void)
+{
+    enum { FW = 640, FH = 360 };
+    plat *p = t_context("egl");
+    float *depth = NULL;
+    uint8_t *a = plaza_frame(0, true, &depth), *b = plaza_frame(4096, true, NULL), *off = plaza_frame(0, false, NULL);
+    T_ASSERT(depth);
+    double se = 0;
+    int n = 0;
+    for (int i = 0; i < FW * FH; i++) {
+        /* view depth from window depth: the game camera's 0.1 .. 200 m */
+        double zn = 2.0 * depth[i] - 1, dist = 2 * 0.1 * 200 / (200 + 0.1 - zn * (200 - 0.1));
+        double la = luma8(a + 4 * i), lb = luma8(b + 4 * i), lo = luma8(off + 4 * i);
+        if (!(depth[i] < 1) || dist < 25 || (la > 0.9 * lo && lb > 0.9 * lo))
+            continue;
+        se += (la - lb) * (la - lb);
+        n++;
+    }
+    double psnr = n ? 10 * log10(255.0 * 255.0 / fmax(se / n, 1e-9)) : 0;
+    fprintf(stderr, "    plaza@1500 640x360, far shadows (%d pixels): 1024 map vs 4096, PSNR %.2f dB\n", n, psnr);
+    T_ASSERTF(n > FW * FH / 100, "only %d pixels of far shadow", n);
+    T_ASSERTF(psnr > 33, "far shadow edges: PSNR %.2f dB against the 4096 map", psnr);
+    free(a), free(b), free(off), free(depth);
+    plat_destroy(p);
+}
+
+/* r_quality.lspsm_size sizes the map (and its flag target): 512 reads back
+ * as 512x512, 0 as R_LSPSM_MAP, out-of-range values clamp to 256..4096. */
+static void t_map_size_knob(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    const int ask[] = {512, 0, 100, 9000}, want[] = {512, R_LSPSM_MAP, 256, 4096};
+    for (int k = 0; k < 4; k++) {
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.lspsm_size = ask[k]}});
+        r_stage st = plaza();
+        set_stage(r, &st);
+        draw_run(r, &f, "plaza", 600, 1);
+        float size[4] = {0};
+        T_ASSERT(fx_lspsm_read(r, "size", size));
+        T_ASSERTF(size[0] == want[k] && size[1] == want[k] && size[2] == want[k] && size[3] == want[k],
+                  "lspsm_size %d: map %gx%g, flag %gx%g, want %d", ask[k], size[0], size[1], size[2], size[3], want[k]);
+        if (k == 0) { /* the map reads back as exactly 512x512 floats, scenery in it */
+            size_t n = 512 * 512;
+            float *map = malloc((n + 16) * sizeof *map);
+            T_ASSERT(map);
+            for (size_t i = 0; i < n + 16; i++)
+                map[i] = -1;
+            T_ASSERT(fx_lspsm_read(r, "map", map));
+            size_t scenery = 0, untouched = 0;
+            for (size_t i = 0; i < n; i++)
+                scenery += map[i] >= 0 && map[i] < 1;
+            for (size_t i = n; i < n + 16; i++)
+                untouched += map[i] == -1;
+            T_EQ(untouched, 16);
+            T_ASSERTF(scenery > n / 40, "%zu scenery texels", scenery);
+            free(map);
+        }
+        r_game_destroy(r);
+    }
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 T_MAIN({"buildings_cast_shadows", t_buildings_cast_shadows}, {"culling_keeps_the_map", t_culling_keeps_the_map},
        {"focus_reads_the_pattern_one_frame_late", t_focus_reads_the_pattern_one_frame_late},
        {"fighters_no_self_shadow_but_each_others", t_fighters_no_self_shadow_but_each_others},
        {"parallel_and_antiparallel_light", t_parallel_and_antiparallel_light}, {"fp16_extremes", t_fp16_extremes},
-       {"deterministic", t_deterministic})
+       {"deterministic", t_deterministic}, {"far_shadow_edges_smooth", t_far_shadow_edges_smooth},
+       {"map_size_knob", t_map_size_knob})

@@ -802,7 +802,45 @@ static void t_density_rows(void)
     free(buf), free(cbuf);
 }
 
+/* Texels per metre along the warp axis (map y) at p. */
+static double axis_density(const r_lspsm *s, r_vec3 p)
+{
+    double a[4], b[4], h = 1e-3;
+    clip(&s->light_vp, add(p, scale(s->axis[1], -h)), a);
+    clip(&s->light_vp, add(p, scale(s->axis[1], h)), b);
+    return R_LSPSM_MAP / 2.0 * fabs(b[1] / b[3] - a[1] / a[3]) / (2 * h);
+}
+
+/* The warp is chosen for warp_near (2 m), not the camera's 0.1 m: with the
+ * light across the game camera's view, 80 m away the texels along the view
+ * were 2 m long (the far shadow edges a staircase); now they are a third
+ * of that, and at 3 m, the nearest ground in view, still denser than
+ * uniform.  warp_near below the body's near is the near. */
+static void t_warp_near(void)
+{
+    r_lspsm_desc d = {.cam = game_cam()};
+    basis b = cam_basis(&d.cam);
+    d.to_light = b.u; /* 90 deg */
+    r_lspsm now, old, un, low;
+    r_lspsm_build(&d, &now);
+    d.warp_near = 0.1f;
+    r_lspsm_build(&d, &old);
+    d.warp_near = 0.01f;
+    r_lspsm_build(&d, &low);
+    d.warp_near = 0, d.uniform = true;
+    r_lspsm_build(&d, &un);
+    r_vec3 p3 = add(d.cam.eye, scale(b.v, 3)), p80 = add(d.cam.eye, scale(b.v, 80));
+    double f_now = axis_density(&now, p80), f_old = axis_density(&old, p80), f_un = axis_density(&un, p80);
+    double n_now = r_lspsm_texels_per_metre(&now, p3, R_LSPSM_MAP), n_un = r_lspsm_texels_per_metre(&un, p3, R_LSPSM_MAP);
+    printf("  along the view at 80 m: %.2f texels/m (warp near 0.1 m: %.2f, uniform %.2f); at 3 m %.1fx uniform; n %.2f m (was %.2f)\n",
+           f_now, f_old, f_un, n_now / n_un, (double)now.n, (double)old.n);
+    T_ASSERTF(f_now > 3 * f_old, "80 m: %.3f texels/m, %.3f with the camera's near", f_now, f_old);
+    T_ASSERTF(n_now > 3 * n_un, "3 m: %.2f texels/m, uniform %.2f", n_now, n_un);
+    T_ASSERT(low.warp == old.warp && memcmp(&low.light_vp, &old.light_vp, sizeof low.light_vp) == 0);
+}
+
 T_MAIN({"unit_cube_random", t_unit_cube_random}, {"unit_cube_degenerate", t_unit_cube_degenerate},
        {"density", t_density}, {"no_pop", t_no_pop}, {"focus_pattern", t_focus_pattern},
        {"focus_grow_shrink", t_focus_grow_shrink}, {"focus_memory", t_focus_memory}, {"focus_nan", t_focus_nan}, {"fade", t_fade},
-       {"box_exit", t_box_exit}, {"cull", t_cull}, {"camera_from", t_camera_from}, {"density_rows", t_density_rows})
+       {"box_exit", t_box_exit}, {"cull", t_cull}, {"camera_from", t_camera_from}, {"density_rows", t_density_rows},
+       {"warp_near", t_warp_near})

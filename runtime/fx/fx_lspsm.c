@@ -247,6 +247,7 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
     r_vec3 L = to_light(r);
     gl.Uniform3f(r_loc(p, "u_lspsm_dir"), L.x, L.y, L.z);
     gl.Uniform1f(r_loc(p, "u_lspsm_bias"), DEPTH_BIAS);
+    gl.Uniform1f(r_loc(p, "u_lspsm_texel"), 1.0f / (float)ls->map);
     gl.Uniform1f(r_loc(p, "u_lspsm_keep"), KEEP);
     /* the fighters' boxes: each bone's origin +-0.4 m holds its far end too */
     float box[4][3];
@@ -447,6 +448,18 @@ bool fx_lspsm_read(r_game *r, const char *what, float *out)
         bool map = what[0] == 'm';
         gl.BindTexture(GL_TEXTURE_2D, map ? ls->map_tex : ls->flag_tex);
         gl.GetTexImage(GL_TEXTURE_2D, 0, map ? GL_DEPTH_COMPONENT : GL_RED, GL_FLOAT, out);
+        gl.BindTexture(GL_TEXTURE_2D, 0);
+        return true;
+    }
+    if (!strcmp(what, "size")) {
+        GLuint tex[2] = {ls->map_tex, ls->flag_tex};
+        for (int i = 0; i < 2; i++) {
+            GLint w = 0, h = 0;
+            gl.BindTexture(GL_TEXTURE_2D, tex[i]);
+            gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
+            gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
+            out[2 * i] = (float)w, out[2 * i + 1] = (float)h;
+        }
         gl.BindTexture(GL_TEXTURE_2D, 0);
         return true;
     }

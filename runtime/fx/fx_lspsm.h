@@ -20,8 +20,10 @@ bool fx_lspsm_stats_get(struct r_game *r, fx_lspsm_stats *out);
 /* Tests and bench: force the light direction (NULL: the stage's key),
  * switch caster culling off, or the warp (plain uniform shadow mapping). */
 void fx_lspsm_test_set(struct r_game *r, const float *light, bool no_cull, bool uniform);
-/* Tests: "map" (1024x1024 depth floats), "flag" (1024x1024), "focus"
- * (20x16 depth samples of the frame drawn last), "shadow" (16 floats). */
+/* Tests: "map" (N x N depth floats, N = r_quality.lspsm_size clamped to
+ * 256..4096, 0: R_LSPSM_MAP 1024), "flag" (N x N), "size" (4 floats: the
+ * map's and the flag's width and height as GL has them), "focus" (20x16
+ * depth samples of the frame drawn last), "shadow" (16 floats). */
 bool fx_lspsm_read(struct r_game *r, const char *what, float *out);
 
 #endif

@@ -104,6 +104,7 @@ void r_lspsm_build(const r_lspsm_desc *d, r_lspsm *out)
     double reach = pick(d->caster_reach, R_LSPSM_CASTER_REACH);
     double margin = pick(d->margin, R_LSPSM_MARGIN), fade = fmin(pick(d->fade, R_LSPSM_FADE), 1);
     double fovy = fmin(pick(cam->fovy, 0.75), 3.0), aspect = pick(cam->aspect, 1);
+    double wnear = fmin(fmax(pick(d->warp_near, R_LSPSM_WARP_NEAR), near), far);
 
     dv3 eye = d_finite(dv(cam->eye)) ? dv(cam->eye) : (dv3){0, 0, 0};
     dv3 view = d_unit(dv(cam->dir), (dv3){0, 0, -1});
@@ -138,7 +139,9 @@ void r_lspsm_build(const r_lspsm_desc *d, r_lspsm *out)
     /* The warp, t = 1 / (distance of its centre behind the body's nearest
      * y) = blend * edge / n_opt, with Wimmer's n_opt = (near + sqrt(near *
      * far)) / sin(gamma): sin(gamma) lands in the numerator, nothing divides
-     * by zero.  blend: 1 out of the angle band, smoothly 0 at its end.
+     * by zero.  Its near is warp_near, not the camera's: n_opt balances
+     * the error at the two ends of near..far, and the nearest receiver the
+     * game's camera shows is the ground a few metres away.  blend: 1 out of the angle band, smoothly 0 at its end.
      * edge: where the view frustum's edges point backwards along y (small
      * gamma with a wide view, worst along the diagonals) the body reaches
      * behind the eye, and a warp would spend its texels on the body's far
@@ -153,7 +156,7 @@ void r_lspsm_build(const r_lspsm_desc *d, r_lspsm *out)
             emin = fmin(emin, d_dot(d_unit(d_sub(body[k], eye), y_axis), y_axis));
         double e = fmin(emin / sin(EDGE_BAND), 1);
         if (e > 0)
-            t = blend * e * e * (3 - 2 * e) * sing / (near + sqrt(near * far));
+            t = blend * e * e * (3 - 2 * e) * sing / (wnear + sqrt(wnear * far));
     }
 
     /* the body in the frame, warped by w = 1 + t (y - ymin); x, y fit round

@@ -40,6 +40,7 @@
 #define R_LSPSM_FADE 0.2f         /* last 20 % of the limit fades out */
 #define R_LSPSM_SHRINK 0.02f      /* focus range shrinks at most 2 % a frame */
 #define R_LSPSM_MIN_RANGE 1.0f    /* focus never closer than this, metres */
+#define R_LSPSM_WARP_NEAR 2.0f    /* the warp's near distance, metres (below) */
 
 /* The viewer.  r_lspsm_camera_from() reads one off a view and a perspective
  * projection matrix (r_look_at, r_perspective). */
@@ -59,6 +60,10 @@ typedef struct r_lspsm_desc {
     float caster_reach;     /* R_LSPSM_CASTER_REACH metres towards the light */
     float margin, fade;     /* R_LSPSM_MARGIN, R_LSPSM_FADE: where shadows fade */
     bool uniform;           /* no warp at all: plain (uniform) shadow mapping */
+    float warp_near;        /* R_LSPSM_WARP_NEAR: the near distance Wimmer's n_opt
+                               is chosen for (at least `near`); the camera's 0.1 m
+                               would spend the map on the first metres, where the
+                               game shows nothing, and leave 2 m texels at 80 m */
 } r_lspsm_desc;
 
 typedef struct r_lspsm {
