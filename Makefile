@@ -194,7 +194,7 @@ demo: $(BUILD)/ringside
 	@mkdir -p out
 	$(BUILD)/ringside replay verify demos/dojo.rsr
 	$(BUILD)/ringside render demos/dojo.rsr -y -o out/demo.mp4
-	@echo "demo: out/demo.mp4, demos/dojo.rsr rendered headless (1280x720 drawn, 640x360 H.264, 60 fps)"
+	@echo "demo: out/demo.mp4, demos/dojo.rsr rendered headless (quality standard: 640x360 drawn and written, H.264, 60 fps, AAC)"
 
 bench: $(BUILD)/ringside
 	@mkdir -p out
@@ -203,6 +203,7 @@ bench: $(BUILD)/ringside
 	$(BUILD)/ringside bench capture -y --csv out/bench-capture.csv --chart out/bench-capture.png
 	$(BUILD)/ringside bench upload -y --csv out/bench-upload.csv
 	$(BUILD)/ringside bench audio -y --csv out/bench-audio.csv
+	$(BUILD)/ringside bench quality -y --csv out/bench-quality.csv --chart out/bench-quality.png
 
 # The bundled demo replays (demos/*.rsr), made by the CPU recorder.  The
 # same commands must reproduce them byte for byte (tests/test_replay.sh).

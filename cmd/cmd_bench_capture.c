@@ -14,6 +14,7 @@
 #include "../capture/cap.h"
 #include "bench_chart.h"
 #include "cli.h"
+#include "../runtime/render/r_quality.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
@@ -161,7 +162,7 @@ static bool do_run(bench *b, run *r, rs_err *err)
 
 static void help(void)
 {
-    printf("usage: ringside bench capture [--frames N] [--runs N] [--size WxH] [--render-size WxH]\n"
+    printf("usage: ringside bench capture [--frames N] [--runs N] [--size WxH] [--quality Q] [--render-size WxH]\n"
            "                              [--sink mp4|y4m|null] [--csv FILE] [--chart FILE.png] [-y|-n] [--quiet]\n\n"
            "Renders %s same frames of demos/dojo.rsr (from tick 600) through every capture\n"
            "configuration and prints fps and milliseconds per frame for each stage:\n"
@@ -171,7 +172,8 @@ static void help(void)
            "writer-only) are measured in the same run (medians of interleaved runs).\n\n"
            "  --frames N         frames per configuration (default 300)\n"
            "  --size WxH         output size (default 640x360)\n"
-           "  --render-size WxH  render size (default 1280x720)\n"
+           "  --quality Q        the renderer's preset, as render --quality (default standard)\n"
+           "  --render-size WxH  render size (default: the quality's, from the output size)\n"
            "  --sink S           mp4 (H.264, default), y4m (raw, disk-bound) or null\n"
            "  --runs N           repeat every configuration N times, report medians (default 3)\n"
            "  --csv FILE         the table as CSV (default out/bench-capture.csv)\n"
@@ -190,11 +192,12 @@ int bench_capture(int argc, char **argv)
                                          {"render-size", required_argument, 0, 'r'}, {"sink", required_argument, 0, 'k'},
                                          {"csv", required_argument, 0, 'c'},    {"chart", required_argument, 0, 'C'},
                                          {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
-                                         {"runs", required_argument, 0, 'R'},
+                                         {"runs", required_argument, 0, 'R'},   {"quality", required_argument, 0, 'L'},
                                          {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
     long nrep = 3;
-    bench b = {.frames = 300, .sw = 1280, .sh = 720, .w = 640, .h = 360, .start = 600};
+    bench b = {.frames = 300, .w = 640, .h = 360, .start = 600};
+    const r_preset *quality = &r_presets[R_PRESET_DEFAULT];
     const char *sink = "mp4", *csv = "out/bench-capture.csv", *chart = "out/bench-capture.png";
     bool quiet = false, overwrite = false, user_csv = false, user_chart = false;
     long v;
@@ -205,7 +208,8 @@ int bench_capture(int argc, char **argv)
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 10, 100000, &v)) return RS_EXIT_USAGE; b.frames = (int)v; break;
         case 's': if (!cli_size("--size", optarg, 8192, &b.w, &b.h)) return RS_EXIT_USAGE; break;
-        case 'r': if (!cli_size("--render-size", optarg, 8192, &b.sw, &b.sh)) return RS_EXIT_USAGE; break;
+        case 'r': if (!cli_size("--render-size", optarg, R_RENDER_MAX, &b.sw, &b.sh)) return RS_EXIT_USAGE; break;
+        case 'L': if (!(quality = cli_quality("bench", optarg))) return RS_EXIT_USAGE; break;
         case 'k':
             if (strcmp(optarg, "mp4") && strcmp(optarg, "y4m") && strcmp(optarg, "null")) {
                 cli_error("bench", "--sink '%s': expected mp4, y4m or null", optarg);
@@ -224,6 +228,8 @@ int bench_capture(int argc, char **argv)
         }
     }
     rs_err err = {0};
+    if (!b.sw)
+        r_preset_render_size(quality, b.w, b.h, R_RENDER_MAX, &b.sw, &b.sh);
     if (!cap_check_sizes(b.sw, b.sh, b.w, b.h, &err)) {
         cli_error("bench", "%s", err.msg);
         return RS_EXIT_USAGE;
@@ -256,7 +262,7 @@ int bench_capture(int argc, char **argv)
     cap_sink probe;
     if (strcmp(sink, "null") && (!rs_mkdirs_for(outpath, &err) || !cap_sink_for(outpath, b.w, b.h, &probe, &err)))
         goto done;
-    if (!(p = plat_create(&(plat_desc){.hidden = true}, &err)) || !(b.r = r_game_create(&err)))
+    if (!(p = plat_create(&(plat_desc){.hidden = true}, &err)) || !(b.r = r_game_create_opts(&(r_game_opts){.q = quality->q}, &err)))
         goto done;
     b.mem = malloc(cap_frame_bytes(CAP_I420, b.w, b.h) * (size_t)b.frames);
     if (!b.mem) {
@@ -304,7 +310,8 @@ int bench_capture(int argc, char **argv)
     if (!quiet && isatty(2))
         fprintf(stderr, "\r%60s\r", "");
 
-    printf("bench capture: %d frames of demos/dojo.rsr, drawn %dx%d, out %dx%d, sink %s, %s\n", b.frames, b.sw, b.sh,
+    printf("bench capture: %d frames of demos/dojo.rsr, quality %s, drawn %dx%d, out %dx%d, sink %s, %s\n", b.frames,
+           quality->name, b.sw, b.sh,
            b.w, b.h, sink, glcaps.renderer);
     printf("fps: median of %ld interleaved runs; stage times and peaks: the last run\n", nrep);
     printf("%-16s %7s %8s %8s %8s %8s %8s %8s %8s %5s %7s\n", "config", "fps", "render", "dscale", "readbk", "fence",

@@ -33,9 +33,9 @@ static void help(void)
 {
     printf("usage: ringside play [--p1 human|cpu] [--p2 human|cpu] [--stage NAME] [--seed S] [--level L]\n"
            "                     [--record FILE] [--replay FILE] [--seconds N] [--screenshot FILE]\n"
-           "                     [--size WxH] [--quality Q] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
+           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
            "                     [--stage-file FILE] [--passes[=summary|frames]]\n"
-           "                     [--hdr-format rgba16f|r11g11b10f]\n"
+           "                     [--hdr-format rgba16f|r11g11b10f] [--quality draft|standard|high|reference]\n"
            "                     [--audio-out FILE.wav] [--mute] [--volume V] [--audio-device D]\n\n"
            "Plays the game at a fixed 60 Hz in a window (GLFW; needs X, or xvfb-run -a).\n"
            "Keys: player 1 W A S D, J punch, K kick, L guard; player 2 arrows, numpad\n"

@@ -27,7 +27,8 @@
 
 static void help(void)
 {
-    printf("usage: ringside render REPLAY -o OUT [--size WxH] [--quality Q] [--render-size WxH]\n"
+    printf("usage: ringside render REPLAY -o OUT [--size WxH] [--render-size WxH]\n"
+           "                       [--quality draft|standard|high|reference]\n"
            "                       [--capture async|sequential] [--downscale gpu|cpu]\n"
            "                       [--filter box|bilinear|nearest|lanczos3] [--pbo N] [--queue N]\n"
            "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"

@@ -116,13 +116,14 @@ t_bash_completion() {
     complete_words ringside render demo.rsr --capt >got.txt && want "render --capt" --capture || return 1
     complete_words ringside render demo.rsr --capture "" >got.txt && want "render --capture" async sequential || return 1
     complete_words ringside render x --hdr-format r >got.txt && want "render --hdr-format" r11g11b10f rgba16f || return 1
+    complete_words ringside render x --quality "" >got.txt && want "render --quality" draft high reference standard || return 1
     # file names after -o and for the replay; nothing to guess after --size
     touch out.mp4 other.y4m fight.rsr
     complete_words ringside render fight.rsr -o o >got.txt && want "render -o" other.y4m out.mp4 || return 1
     complete_words ringside render f >got.txt && want "render REPLAY" fight.rsr || return 1
     complete_words ringside render x --size "" >got.txt && want "render --size" || return 1
     # subcommands and their own options
-    complete_words ringside bench "" >got.txt && want "bench" platform sim capture accuracy upload encode audio || return 1
+    complete_words ringside bench "" >got.txt && want "bench" platform sim capture accuracy upload encode audio quality || return 1
     complete_words ringside bench capture --si >got.txt && want "bench capture --si" --sink --size || return 1
     complete_words ringside bench capture --sink "" >got.txt && want "bench capture --sink" mp4 y4m null || return 1
     complete_words ringside replay v >got.txt && want "replay" verify || return 1

@@ -13,6 +13,7 @@
 
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
+#include "../runtime/fx/fx_fog.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/replay/rp.h"
 #include "t.h"
@@ -285,6 +286,45 @@ static void t_water_grid(void)
     plat_destroy(p);
 }
 
+/* fog_size: the mist's density map at the asked edge (0: the look's 128),
+ * and a smaller map moves mistvale's picture a little, not a lot. */
+static void t_fog_size(void)
+{
+    plat *p = t_context("egl");
+    enum { W = 320, H = 180 };
+    const int want[] = {0, 64, 256};
+    uint8_t *px[3];
+    for (int i = 0; i < 3; i++) {
+        r_game_opts o = {.q = {.fog_size = want[i]}};
+        px[i] = frame_of("mistvale", 700, 10, &o, W, H);
+        /* the map's size: a game made with the same knob, one frame drawn */
+        g_state prev, cur;
+        t_state_at("mistvale", 700, &prev, &cur);
+        r_game *r = t_game_opts(&o);
+        t_fb f;
+        t_fb_make(&f, 64, 36);
+        t_draw(r, &f, &prev, &cur, 64, 36);
+        int size = 0;
+        T_ASSERT(fx_fog_read_map(r, NULL, &size, NULL));
+        T_ASSERTF(size == (want[i] ? want[i] : 128), "fog_size %d: a %d map", want[i], size);
+        t_fb_free(&f);
+        r_game_destroy(r);
+    }
+    for (int i = 1; i < 3; i++) {
+        double se = 0;
+        for (size_t k = 0; k < (size_t)W * H * 4; k += 4)
+            for (int c = 0; c < 3; c++)
+                se += (double)(px[0][k + c] - px[i][k + c]) * (px[0][k + c] - px[i][k + c]);
+        double psnr = se > 0 ? 10 * log10(255.0 * 255.0 / (se / (W * H * 3))) : 99;
+        fprintf(stderr, "    mistvale, fog map %d vs 128: PSNR %.1f dB\n", want[i], psnr);
+        T_ASSERTF(se > 0, "fog_size %d drew the same bytes as 128: the knob is ignored", want[i]);
+        T_ASSERTF(psnr > 30, "fog_size %d differs too much from 128: %.1f dB", want[i], psnr);
+    }
+    for (int i = 0; i < 3; i++)
+        free(px[i]);
+    plat_destroy(p);
+}
+
 /* ---- the silhouette mip chain ---- */
 
 /* One texel of src (n x n, RGBA floats, red used), 0 outside (clamp to border). */
@@ -402,4 +442,4 @@ static void t_out_of_range_refused(void)
 T_MAIN({"defaults_spelled_out_are_zero", t_defaults_spelled_out_are_zero}, {"fxaa", t_fxaa},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
        {"silhouette_mips_whole", t_silhouette_mips_whole},
-       {"water_grid", t_water_grid}, {"out_of_range_refused", t_out_of_range_refused})
+       {"water_grid", t_water_grid}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})

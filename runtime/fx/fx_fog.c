@@ -315,7 +315,8 @@ static bool fog_create(r_game *r, rs_err *err)
     gl.VertexAttribDivisor(0, 1); /* one particle per instance */
     gl.BindVertexArray(0);
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
-    if (!make_map(fg, fg->look.map_size, err)) {
+    /* the quality knob (r_quality.fog_size, range checked at create) or the look's */
+    if (!make_map(fg, r->opts.q.fog_size > 0 ? r->opts.q.fog_size : fg->look.map_size, err)) {
         fog_destroy(r);
         return false;
     }
