@@ -29,32 +29,10 @@
 
 enum { W = 320, H = 180 };
 
-/* One picture of a demo with its stage file, the way render makes it:
- * the frames of the `history` ticks before it are drawn first, so the
- * stage effects' simulations (docs/effects.md) have that much past. */
 static void picture_sized(const char *demo, uint64_t tick, uint64_t history, const r_game_opts *o, int w, int h,
                           uint8_t *px)
 {
-    g_state prev, cur;
-    uint64_t first = tick > history ? tick - history : 0;
-    t_state_at(demo, first, &prev, &cur);
-    char path[1024];
-    snprintf(path, sizeof path, RS_SOURCE_DIR "/demos/%s.rsr", demo);
-    rp_replay rp;
-    rs_err e = {0};
-    T_ASSERTF(rp_read(path, &rp, &e), "%s", e.msg);
-    r_game *r = t_game_opts(o);
-    t_fb f;
-    t_fb_make(&f, w, h);
-    for (uint64_t t = first; t < tick; t++) {
-        t_draw_read(r, &f, &prev, &cur, w, h, NULL, true);
-        prev = cur;
-        g_step(&cur, &rp.inputs[2 * t], NULL);
-    }
-    t_draw_read(r, &f, &prev, &cur, w, h, px, true);
-    rp_free(&rp);
-    t_fb_free(&f);
-    r_game_destroy(r);
+    t_picture(demo, tick, history, o, w, h, px);
 }
 
 static void picture_after(const char *demo, uint64_t tick, uint64_t history, const r_game_opts *o, uint8_t *px)
