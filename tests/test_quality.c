@@ -415,8 +415,12 @@ static void t_out_of_range_refused(void)
     refused((r_quality){.water_grid = 512}, "16..256");
     refused((r_quality){.shadow_size = -1}, "shadow_size -1");
     refused((r_quality){.aa = (r_aa)7}, "aa 7 unknown");
+    refused((r_quality){.fog_size = 32}, "fog_size 32 out of range");
+    refused((r_quality){.fog_size = 2048}, "64..1024");
+    refused((r_quality){.bloom_levels = 3}, "bloom_levels 3 out of range");
     /* the ends of the ranges are taken */
-    r_game_destroy(t_game_opts(&(r_game_opts){.q = {.shadow_size = 128, .sil_size = 64, .water_grid = 256}}));
+    r_game_destroy(t_game_opts(&(r_game_opts){.q = {.shadow_size = 128, .sil_size = 64, .water_grid = 256,
+                                                     .fog_size = 1024, .bloom_levels = 1}}));
     plat_destroy(p);
 }
 

@@ -306,11 +306,13 @@ static bool check_quality(const r_quality *q, rs_err *err)
         {"shadow_size", "the SSFSM light depth map's side", 128, 4096},
         {"sil_size", "the silhouette's side", 64, 2048},
         {"water_grid", "the water surface's quads a side", 16, 256},
+        {"fog_size", "the mist's density map's side", 64, 1024},
+        {"bloom_levels", "the bloom levels added", 1, 2},
     };
-    const int v[] = {q->shadow_size, q->sil_size, q->water_grid};
+    const int v[] = {q->shadow_size, q->sil_size, q->water_grid, q->fog_size, q->bloom_levels};
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
         if (v[i] != 0 && (v[i] < k[i].lo || v[i] > k[i].hi))
-            return rs_fail(err, 1, "quality: %s %d out of range: %s is %d..%d texels (0 = default)", k[i].name, v[i],
+            return rs_fail(err, 1, "quality: %s %d out of range: %s is %d..%d (0 = default)", k[i].name, v[i],
                            k[i].what, k[i].lo, k[i].hi);
     if (q->aa != R_AA_OFF && q->aa != R_AA_FXAA)
         return rs_fail(err, 1, "quality: aa %d unknown (0 off, 1 fxaa)", (int)q->aa);

@@ -45,7 +45,7 @@ typedef struct r_quality {
     bool mask_half;   /* SSFSM's shadow mask and its filter at half the render size */
     int bloom_levels; /* bloom pyramid levels added, 1..2: 0 = 2 (1/4 and 1/8 of 720 rows) */
     r_aa aa;          /* post-process anti-aliasing on the tone-mapped image */
-    int lspsm_size;   /* LSPSM shadow map, texels a side, 256..4096: 0 = the module's default */
+    int lspsm_size;   /* LSPSM shadow map, texels a side: 0 = the module's default; clamped to 256..4096 */
     int fog_size;     /* the mist's top-down density map, 64..1024: 0 = the module's default */
     int water_grid;   /* water surface quads a side, 16..256: 0 = the module's default */
 } r_quality;

@@ -35,9 +35,5 @@ const char *r_preset_list(void);
 /* The render size for an output of w x h: the scale, reduced (the same on
  * both axes) where it would pass max on either axis, never below 1. */
 void r_preset_render_size(const r_preset *p, int w, int h, int max, int *rw, int *rh);
-/* "scale 2, fxaa, shadow 1024, ..." for reports (into buf, n bytes). */
-const char *r_quality_describe(double scale, const r_quality *q, char *buf, int n);
-/* Checks a knob set's ranges (r_game_create_opts does too). */
-bool r_quality_check(const r_quality *q, rs_err *err);
 
 #endif
