@@ -331,7 +331,7 @@ async function main() {
     if (opt.token && !row.posterSrc.startsWith('blob:')) fail(`with a token the poster came from ${row.posterSrc}`);
     if (!/^temple · cpu vs cpu · /.test(row.match)) fail(`match cell: '${row.match}'`);
     if (!row.output.includes(opt.size) || !row.output.includes(opt.format + '/' + (opt.format === 'webm' ? 'vp9' : 'h264')) ||
-        !/ kB| MB/.test(row.output)) fail(`output cell: '${row.output}'`);
+        !/ kB| MB/.test(row.output) || !/ · draft · /.test(row.output)) fail(`output cell: '${row.output}'`);
     await page.click(`${rowSel} details.log summary`);
     await waitFor(page, `job ${id}'s log`, () => page.$eval(`${rowSel} + tr.log-row pre`,
       (pre) => /== render, attempt 1, process \d+: exit status 0/.test(pre.textContent) &&
