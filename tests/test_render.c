@@ -123,7 +123,9 @@ static void t_golden_egl(void)
     /* the stage effects, with 2 s of history for their simulations */
     golden_after("egl", "shallows", 380, 120);  /* waves round the fighters' feet, reflections */
     golden_after("egl", "snowfield", 900, 120); /* footprints in the snow, texture-space light */
-    golden_after("egl", "mistvale", 700, 120);  /* mist stirred by the fight, fog at the horizon */
+    golden_after("egl", "mistvale", 700, 700);  /* mist stirred by the fight, fog at the horizon: the mist
+                                                   carries its history from tick 0 (R_FX_FROM_START), so the
+                                                   golden does too: it is the frame render --ticks 699:700 writes */
     golden_after("egl", "plaza", 1500, 30);     /* LSPSM: the landmark's shadow across the ring */
     golden("egl", "quarry", 3000);              /* nine holes cut into the ring with stencil */
     plat_destroy(p);

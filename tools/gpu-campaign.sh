@@ -442,7 +442,8 @@ if step_begin golden 10 8; then
         fi
         dims=$(head -c 40 "$g" | tr -c '0-9P' ' ' | awk '{ print $2 "x" $3 }')
         fr=$tmp/g_${st}_$tick.y4m
-        run_timed 5 "$(left)" "$tmp/o" "$tmp/e" "$RS" render "$demo" --ticks $((tick - 1)):"$tick" --render-size "$dims" \
+        # the goldens are drawn with every knob at full: --quality high gives those knobs (the size is given)
+        run_timed 5 "$(left)" "$tmp/o" "$tmp/e" "$RS" render "$demo" --ticks $((tick - 1)):"$tick" --quality high --render-size "$dims" \
             --size "$dims" --capture sequential --downscale cpu --quiet -y -o "$fr"
         if [ "$RC" -ne 0 ]; then
             [ "$RC" -eq 125 ] && nskip=$((nskip + 1)) || nbad=$((nbad + 1))
