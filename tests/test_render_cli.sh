@@ -108,7 +108,7 @@ t_help_lists_the_options() {
 # and the renderer's knobs; --size alone works from 16x16 to 3840x2160
 t_quality_and_sizes() {
     short_replay || return 1
-    for qs in "draft:160x90:160x90" "standard:160x90:160x90" "high:160x90:320x180" "reference:160x90:640x360" \
+    for qs in "draft:160x90:160x90" "standard:160x90:160x90" "high:160x90:480x270" "reference:160x90:640x360" \
         "standard:1920x1080:1920x1080" "standard:16x16:16x16" "standard:3840x2160:3840x2160"; do
         q=${qs%%:*} rest=${qs#*:}
         size=${rest%%:*} drawn=${rest#*:}
