@@ -38,8 +38,9 @@ struct cap {
     /* GPU stage */
     cap_scaler *scaler;
     GLuint vao, prog_luma, prog_chroma;
-    GLint u_rgb_luma, u_rgb_chroma;
-    target rgb, luma, chroma;
+    GLint u_rgb_luma, u_rgb_chroma, u_size_chroma;
+    target rgb;
+    target planes;     /* I420 as one R8 image of w x 3h/2: Y rows, then Cb and Cr packed (gpu_setup) */
     GLuint read_fbo;   /* to read the source texture (CPU path) */
     /* PBO ring (async) */
     GLuint pbo[CAP_MAX_PBO];
@@ -114,13 +115,24 @@ static bool gpu_setup(cap *c, rs_err *err)
         return false;
     c->u_rgb_luma = gl.GetUniformLocation(c->prog_luma, "u_rgb");
     c->u_rgb_chroma = gl.GetUniformLocation(c->prog_chroma, "u_rgb");
+    c->u_size_chroma = gl.GetUniformLocation(c->prog_chroma, "u_size");
     gl.GenVertexArrays(1, &c->vao);
     int w = c->d.w, h = c->d.h;
     if (c->fmt == CAP_RGBA)
         return make_target(&c->rgb, w, h, 1, GL_RGBA8, GL_RGBA, err);
+    /* The three planes in one R8 image whose bytes, read bottom row first,
+     * are the I420 frame itself: rows 0..h-1 the Y plane; rows h..3h/2-1,
+     * w bytes each, the Cb plane and then the Cr plane, each (w/2)(h/2)
+     * bytes, packed across row ends (cap_chroma.frag).  One glReadPixels at
+     * offset 0 of one single-attachment target: reading three planes from
+     * two targets into offsets of one PBO took NVIDIA's driver 17-20 ms of
+     * CPU a frame at 640x360 (a slow pack path in the two chroma reads),
+     * where this single read costs what the luma read alone did. */
+    if (h + h / 2 > glcaps.max_texture_size)
+        return rs_fail(err, CAP_ERR_SIZE, "capture: output %dx%d needs a %dx%d plane image, over this GL's %d limit", w, h, w,
+                       h + h / 2, glcaps.max_texture_size);
     return make_target(&c->rgb, w, h, 1, GL_RGBA8, GL_RGBA, err) &&
-           make_target(&c->luma, w, h, 1, GL_R8, GL_RED, err) &&
-           make_target(&c->chroma, w / 2, h / 2, 2, GL_R8, GL_RED, err);
+           make_target(&c->planes, w, h + h / 2, 1, GL_R8, GL_RED, err);
 }
 
 /* Downscale src into rgb, then Y, Cb, Cr planes; nothing is read back here. */
@@ -135,16 +147,16 @@ static void gpu_convert(cap *c, GLuint src)
     gl.BindVertexArray(c->vao);
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindTexture(GL_TEXTURE_2D, c->rgb.tex[0]);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, c->luma.fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, c->planes.fbo);
     gl.Viewport(0, 0, c->d.w, c->d.h);
     gl.UseProgram(c->prog_luma);
     gl.Uniform1i(c->u_rgb_luma, 0);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
 
-    gl.BindFramebuffer(GL_FRAMEBUFFER, c->chroma.fbo);
-    gl.Viewport(0, 0, c->d.w / 2, c->d.h / 2);
+    gl.Viewport(0, c->d.h, c->d.w, c->d.h / 2);
     gl.UseProgram(c->prog_chroma);
     gl.Uniform1i(c->u_rgb_chroma, 0);
+    gl.Uniform2i(c->u_size_chroma, c->d.w, c->d.h);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
 
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -153,28 +165,16 @@ static void gpu_convert(cap *c, GLuint src)
     gl.UseProgram(0);
 }
 
-/* The three planes into `dst`: a client pointer, or an offset into the
- * bound GL_PIXEL_PACK_BUFFER (offsets 0, nY, nY + nC, as in the seed). */
+/* The frame into `dst`: a client pointer, or an offset into the bound
+ * GL_PIXEL_PACK_BUFFER.  One read either way: the RGBA image, or the plane
+ * image, whose rows are the I420 planes back to back (gpu_setup). */
 static void read_planes(cap *c, uint8_t *dst)
 {
-    size_t ny = (size_t)c->d.w * c->d.h, nc = (size_t)(c->d.w / 2) * (c->d.h / 2);
+    const target *t = c->fmt == CAP_RGBA ? &c->rgb : &c->planes;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    if (c->fmt == CAP_RGBA) {
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, c->rgb.fbo);
-        gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-        gl.ReadPixels(0, 0, c->d.w, c->d.h, GL_RGBA, GL_UNSIGNED_BYTE, dst);
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
-        gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-        return;
-    }
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, c->luma.fbo);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
     gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    gl.ReadPixels(0, 0, c->d.w, c->d.h, GL_RED, GL_UNSIGNED_BYTE, dst);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, c->chroma.fbo);
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    gl.ReadPixels(0, 0, c->d.w / 2, c->d.h / 2, GL_RED, GL_UNSIGNED_BYTE, dst + ny);
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-    gl.ReadPixels(0, 0, c->d.w / 2, c->d.h / 2, GL_RED, GL_UNSIGNED_BYTE, dst + ny + nc);
+    gl.ReadPixels(0, 0, t->w, t->h, c->fmt == CAP_RGBA ? GL_RGBA : GL_RED, GL_UNSIGNED_BYTE, dst);
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
 }
@@ -397,8 +397,7 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err)
     if (c->d.mode == CAP_ASYNC && c->pbo[0])
         gl.DeleteBuffers(c->d.pbo, c->pbo);
     free_target(&c->rgb);
-    free_target(&c->luma);
-    free_target(&c->chroma);
+    free_target(&c->planes);
     if (c->read_fbo)
         gl.DeleteFramebuffers(1, &c->read_fbo);
     if (c->vao)
