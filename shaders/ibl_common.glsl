@@ -13,6 +13,12 @@ vec3 ibl_diffuse(vec3 n, float key)
     return mix(texture(u_diffuse_off, n).rgb, texture(u_diffuse_on, n).rgb, key);
 }
 
+// exponent 16 alone: ibl_specular(r, 16.0, key) without the 128 maps' taps
+vec3 ibl_specular16(vec3 r, float key)
+{
+    return mix(texture(u_spec16_off, r).rgb, texture(u_spec16_on, r).rgb, key);
+}
+
 vec3 ibl_specular(vec3 r, float exponent, float key)
 {
     vec3 s16 = mix(texture(u_spec16_off, r).rgb, texture(u_spec16_on, r).rgb, key);

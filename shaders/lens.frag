@@ -1,4 +1,5 @@
 #version 330 core
+// variants: - FX_FOG
 // A fighter's visor: a low-alpha glass lens in HDR (techniques A1).  The
 // blend is premultiplied (ONE, ONE_MINUS_SRC_ALPHA): the tint is scaled by
 // alpha, the reflection is not, so a lens of alpha 0.15 still shows the sun
@@ -31,10 +32,12 @@ void main()
     vec3 tint = vec3(0.05, 0.07, 0.09) * ibl_diffuse(n, 1.0);
     vec3 refl = ibl_specular(r, 128.0, 1.0) * mix(0.3, 1.0, fresnel);
     vec3 c = tint * u_lens_alpha + refl;
+#ifdef FX_FOG
     if (u_fog_on == 1) {
         float t = exp(-v_fog);
         c = c * t + fog_light(-v) * ((1.0 - t) * u_lens_alpha);
     }
+#endif
     // blended result = c + (1 - alpha) * dst with dst <= 65504: keeping c
     // under 65504 * alpha keeps the sum finite in half float on any GPU
     c = min(c, vec3(65504.0 * u_lens_alpha));

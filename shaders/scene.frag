@@ -1,5 +1,5 @@
 #version 330 core
-// variants: FIGHTER STAGE
+// variants: FIGHTER STAGE FIGHTER+SHADOWS+FX_FOG+FX_LSPSM STAGE+SHADOWS+FX_FOG+FX_LSPSM STAGE+MATERIAL=1 STAGE+MATERIAL=2+SHADOWS+FX_LSPSM STAGE+MATERIAL=3+SHADOWS
 // The HDR scene pass (techniques A1, A2, A5): image-based lighting only,
 // no ambient term.  Every surface blends its key-on and key-off IBL
 // results by its shadow factor: the filtered screen-space mask for the
@@ -10,6 +10,14 @@
 // the stage where its scenery casts, the fighters where the ray to the
 // light leaves their own box (no self-shadow) and never below
 // u_lspsm_keep, so they keep their directional shading in shadow.
+// Compiled per look (r_game.c, build_look_programs): SHADOWS, FX_FOG and
+// FX_LSPSM when the stage uses them, MATERIAL for the stage's surfaces,
+// so that no pixel runs code for what its stage or surface does not have
+// (a software rasteriser runs both sides of a branch).  The flat surfaces
+// (MATERIAL 0-2) get the diffuse light from the vertex shader: with one
+// normal per face it is the same value, and two cube-map taps a pixel
+// fewer; the planks and the paving have exponent 16 alone, so they tap
+// those two specular maps and not the 128 ones.
 #include "ibl_common.glsl"
 #include "fog_common.glsl"
 #include "lspsm_common.glsl"
@@ -20,11 +28,16 @@ in vec4 v_tangent;
 in vec2 v_uv;
 in vec4 v_color;
 #ifdef STAGE
+#ifndef MATERIAL
+#define MATERIAL 0 // 0 planks; 1 planks, paving on the ground; 2 a building; 3 a hole's inside (R_MAT_*)
+#endif
 in vec3 v_proj;
 in float v_lod;
+#if MATERIAL != 3
+flat in vec3 v_diff_on, v_diff_off; // the face's ibl_diffuse maps (scene.vert)
+#endif
 uniform sampler2D u_silhouette;
 uniform vec3 u_ring_color;
-uniform int u_material; // 0 planks; 1 planks, paving on the ground; 2 a building; 3 a hole's inside
 #endif
 #ifdef FIGHTER
 uniform sampler2D u_normal_map;
@@ -48,9 +61,8 @@ vec3 hdr_out(vec3 c)
 void main()
 {
     vec3 n = normalize(v_normal);
-#ifdef STAGE
-    if (u_material == 3)
-        n = -n; // the crater is the sphere's inside
+#if defined(STAGE) && MATERIAL == 3
+    n = -n; // the crater is the sphere's inside
 #endif
     vec3 v = normalize(u_eye - v_world);
 #ifdef FIGHTER
@@ -63,9 +75,15 @@ void main()
     vec4 sm = texture(u_spec_map, uv);
     vec3 spec_color = sm.rgb * v_color.a;
     float exponent = 16.0 + 112.0 * sm.a;
+#ifdef SHADOWS
     float key = u_shadows == 1 ? texture(u_mask, gl_FragCoord.xy * u_mask_uv).r : 1.0;
+#else
+    float key = 1.0;
+#endif
+#ifdef FX_LSPSM
     if (u_lspsm_on == 1)
         key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world, u_shadows == 1));
+#endif
     vec3 albedo = v_color.rgb;
     float alpha = 1.0;
 #endif
@@ -77,44 +95,61 @@ void main()
     vec3 albedo = u_ring_color * grain * seam;
     vec3 spec_color = vec3(0.04);
     float exponent = 16.0;
-    if (u_material == 1 && v_world.y < -2.95) {
+#if MATERIAL == 1
+    if (v_world.y < -2.95) {
         // paving: 1 m slabs, each a little different, dark joints
         vec2 slab = floor(v_world.xz);
         float tone = 0.85 + 0.15 * fract(sin(dot(slab, vec2(12.9898, 78.233))) * 43758.5453);
         vec2 f = fract(v_world.xz);
         float joint = min(smoothstep(0.0, 0.03, min(f.x, f.y)), smoothstep(0.0, 0.03, min(1.0 - f.x, 1.0 - f.y)));
         albedo = vec3(0.46, 0.44, 0.41) * tone * (0.6 + 0.4 * joint);
-    } else if (u_material == 3) {
-        // broken boards over packed earth and rubble, darker deeper down
-        vec3 cell = floor(v_world * 9.0);
-        float grit = fract(sin(dot(cell, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
-        float depth = clamp(-v_world.y / 0.4, 0.0, 1.0);
-        albedo = mix(u_ring_color * 0.8, vec3(0.42, 0.36, 0.29), smoothstep(0.0, 0.12, depth));
-        albedo *= (0.7 + 0.3 * grit) * mix(1.0, 0.6, depth);
-    } else if (u_material == 2) {
-        // concrete with a grid of glass windows (3.5 m floors, 2.5 m bays)
-        float along = abs(n.x) > 0.5 ? v_world.z : v_world.x;
-        vec2 cell = fract(vec2(along / 2.5, (v_world.y + 3.0) / 3.5));
-        bool wall = abs(n.y) < 0.5 && v_world.y > -1.0;
-        bool glass = wall && cell.x > 0.18 && cell.x < 0.82 && cell.y > 0.28 && cell.y < 0.86;
-        vec3 block = floor(v_world / 12.0);
-        float tone = 0.8 + 0.2 * fract(sin(dot(block, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
-        albedo = glass ? vec3(0.03, 0.035, 0.04) : vec3(0.56, 0.53, 0.49) * tone;
-        spec_color = glass ? vec3(0.6) : vec3(0.03);
-        exponent = glass ? 128.0 : 16.0;
     }
+#elif MATERIAL == 3
+    // broken boards over packed earth and rubble, darker deeper down
+    vec3 cell = floor(v_world * 9.0);
+    float grit = fract(sin(dot(cell, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
+    float depth = clamp(-v_world.y / 0.4, 0.0, 1.0);
+    albedo = mix(u_ring_color * 0.8, vec3(0.42, 0.36, 0.29), smoothstep(0.0, 0.12, depth));
+    albedo *= (0.7 + 0.3 * grit) * mix(1.0, 0.6, depth);
+#elif MATERIAL == 2
+    // concrete with a grid of glass windows (3.5 m floors, 2.5 m bays)
+    float along = abs(n.x) > 0.5 ? v_world.z : v_world.x;
+    vec2 cell = fract(vec2(along / 2.5, (v_world.y + 3.0) / 3.5));
+    bool wall = abs(n.y) < 0.5 && v_world.y > -1.0;
+    bool glass = wall && cell.x > 0.18 && cell.x < 0.82 && cell.y > 0.28 && cell.y < 0.86;
+    vec3 block = floor(v_world / 12.0);
+    float tone = 0.8 + 0.2 * fract(sin(dot(block, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
+    albedo = glass ? vec3(0.03, 0.035, 0.04) : vec3(0.56, 0.53, 0.49) * tone;
+    spec_color = glass ? vec3(0.6) : vec3(0.03);
+    exponent = glass ? 128.0 : 16.0;
+#endif
     float key = 1.0;
+#ifdef SHADOWS
     if (u_shadows == 1 && v_proj.z > 0.5)
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
+#endif
+#ifdef FX_LSPSM
     if (u_lspsm_on == 1) // with the A5 shadows on, the fighters' come from the silhouette
         key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), u_shadows == 1);
+#endif
     float alpha = 0.0;
 #endif
     vec3 r = reflect(-v, n);
     float ndv = max(dot(n, v), 0.0);
     float fresnel = 0.25 + 0.75 * pow(1.0 - ndv, 5.0);
-    vec3 lit = albedo * ibl_diffuse(n, key) + spec_color * fresnel * ibl_specular(r, exponent, key);
+#if defined(STAGE) && MATERIAL != 3
+    vec3 diffuse = mix(v_diff_off, v_diff_on, key);
+#else
+    vec3 diffuse = ibl_diffuse(n, key);
+#endif
+#if defined(STAGE) && MATERIAL < 2
+    vec3 specular = ibl_specular16(r, key);
+#else
+    vec3 specular = ibl_specular(r, exponent, key);
+#endif
+    vec3 lit = albedo * diffuse + spec_color * fresnel * specular;
     lit += u_flash * 2.0 * albedo;
+#ifdef FX_FOG
     if (u_fog_on == 1) {
 #ifdef STAGE
         // the ring and the ground are a few huge triangles (the ground is
@@ -126,5 +161,6 @@ void main()
 #endif
         lit = fog_apply(lit, tau, -v);
     }
+#endif
     o_color = vec4(hdr_out(lit), alpha);
 }

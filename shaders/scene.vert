@@ -1,12 +1,14 @@
 #version 330 core
-// variants: FIGHTER STAGE LENS LIGHT_VIEW LIGHT_VIEW+SILHOUETTE LIGHT_VIEW+LSPSM
+// variants: FIGHTER STAGE LENS LIGHT_VIEW LIGHT_VIEW+SILHOUETTE LIGHT_VIEW+LSPSM FIGHTER+FX_FOG LENS+FX_FOG STAGE+MATERIAL=1 STAGE+MATERIAL=2 STAGE+MATERIAL=3
 // Scene geometry for every pass that draws it: rigid skinning, one matrix
 // per bone (bone index -1: world space).  Variants by #define:
 //   FIGHTER, STAGE, LENS   the HDR scene pass (scene.frag)
 //   LIGHT_VIEW             shadow map / silhouette from the key light
-// FIGHTER and LENS compute the fog map's optical depth per vertex (fog A8);
-// STAGE leaves it to the fragment shader (scene.frag says why).
+// FIGHTER and LENS compute the fog map's optical depth per vertex (fog A8,
+// when FX_FOG); STAGE leaves it to the fragment shader (scene.frag says
+// why), and gives the flat surfaces (MATERIAL 0-2) their diffuse light.
 #include "fog_common.glsl"
+#include "ibl_common.glsl"
 
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
@@ -33,9 +35,16 @@ uniform vec3 u_light_dir;      // towards the key light
 uniform vec3 u_waist[2];       // the casters' waists
 uniform float u_lod_start, u_lod_scale;
 uniform sampler2D u_silhouette; // scene.frag's: its size scales the level
-uniform int u_material;        // 3: a hole's inside, seen from within the sphere
+#ifndef MATERIAL
+#define MATERIAL 0             // 3: a hole's inside, seen from within the sphere
+#endif
 out vec3 v_proj;               // projector uv, z: 1 when this vertex may receive
 out float v_lod;
+#if MATERIAL != 3
+// a face's diffuse light with the key light on and off: its vertices share
+// one normal, so this is what scene.frag would fetch at each of its pixels
+flat out vec3 v_diff_on, v_diff_off;
+#endif
 #endif
 
 out vec3 v_world;
@@ -73,16 +82,25 @@ void main()
     vec3 w = distance(world.xyz, u_waist[0]) < distance(world.xyz, u_waist[1]) ? u_waist[0] : u_waist[1];
     float d = distance(world.xyz, w);
     vec4 lp = u_light_proj * world;
-    bool facing = dot(u_material == 3 ? -v_normal : v_normal, u_light_dir) > 0.0;
+    bool facing = dot(MATERIAL == 3 ? -v_normal : v_normal, u_light_dir) > 0.0;
     bool behind = dot(world.xyz - w, u_light_dir) > 0.0;
     v_proj = vec3(lp.xy * 0.5 + 0.5, facing && !behind ? 1.0 : 0.0);
     // the levels are tuned for a 512 silhouette: a smaller one is already
     // blurrier by a level per halving (r_quality.sil_size)
     float lod = (d - u_lod_start) * u_lod_scale - log2(512.0 / float(textureSize(u_silhouette, 0).x));
     v_lod = clamp(lod, 0.0, 4.0);
+#if MATERIAL != 3
+    vec3 fn = normalize(v_normal);
+    v_diff_on = textureLod(u_diffuse_on, fn, 0.0).rgb;
+    v_diff_off = textureLod(u_diffuse_off, fn, 0.0).rgb;
+#endif
 #endif
 #if defined(FIGHTER) || defined(LENS)
+#ifdef FX_FOG
     v_fog = u_fog_on == 1 ? fog_depth(world.xyz) : 0.0;
+#else
+    v_fog = 0.0;
+#endif
 #endif
     gl_Position = u_view_proj * world;
 #ifdef LENS

@@ -327,11 +327,16 @@ static bool fog_create(r_game *r, rs_err *err)
 /* History: the mist particles, restarted (seeded by the tick) on a reset,
  * then stirred and stepped once per tick: every tick since the reset
  * counts.  fog_advance is the pass's step 1 without the map. */
+static const char *fog_define(const r_game *r)
+{
+    return r->stage.fog ? "FX_FOG" : NULL;
+}
+
 const r_fx_module fx_fog_module = {
     .name = "fog", .create = fog_create, .destroy = fog_destroy,
     .pass = {fog_passes}, .npass = {(int)(sizeof fog_passes / sizeof fog_passes[0])},
     .res = {{RES_FOGMAP, "fog map", false}}, .scene_reads = RES_FOGMAP,
-    .units = 1, .bind = fog_bind,
+    .units = 1, .bind = fog_bind, .scene_define = fog_define,
     .warmup = fog_warmup, .advance = fog_advance,
 };
 

@@ -95,7 +95,7 @@ static void run_holes(void *u)
     gl.CullFace(GL_BACK);
 
     /* 1: the destructible terrain's depth */
-    GLuint pd = r->prog[P_DEPTH], ps = r->prog[P_STAGE];
+    GLuint pd = r->prog[P_DEPTH];
     gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     r_camera_uniforms(r, pd);
     gl.BindVertexArray(r->ring_vao);
@@ -110,7 +110,7 @@ static void run_holes(void *u)
     }
     qsort(o, (size_t)n, sizeof o[0], nearer_first);
 
-    r_stage_uniforms(r, ps, 3); /* the crater's inside */
+    GLuint ps = r_stage_program(r, R_MAT_HOLE); /* the crater's inside */
     gl.Enable(GL_STENCIL_TEST);
     gl.StencilMask(STENCIL_HOLES);
     gl.BindVertexArray(hs->vao);
@@ -148,7 +148,6 @@ static void run_holes(void *u)
     gl.CullFace(GL_BACK);
     gl.DepthFunc(GL_LESS);
     gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    gl.Uniform1i(r_loc(ps, "u_material"), 0);
 }
 
 static const r_pass holes_passes[] = {

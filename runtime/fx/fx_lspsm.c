@@ -176,15 +176,13 @@ static void run_buildings(void *u)
 {
     r_game *r = u;
     struct fx_lspsm_state *ls = LSPSM(r);
-    GLuint p = r->prog[P_STAGE];
     r_begin_opaque(r);
-    r_stage_uniforms(r, p, 2);
+    GLuint p = r_stage_program(r, R_MAT_BUILDING);
     /* the fighters' blurred silhouette stops short of the buildings: this
      * map casts them there (u_shadows 0 counts its fighter texels) */
     gl.Uniform1i(r_loc(p, "u_shadows"), 0);
     gl.BindVertexArray(ls->city_vao);
     gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
-    gl.Uniform1i(r_loc(p, "u_material"), 0);
     gl.Disable(GL_CULL_FACE);
 }
 
@@ -405,13 +403,18 @@ static void lspsm_advance(r_game *r)
         take_focus(LSPSM(r), true);
 }
 
+static const char *lspsm_define(const r_game *r)
+{
+    return r->stage.lspsm ? "FX_LSPSM" : NULL;
+}
+
 const r_fx_module fx_lspsm_module = {
     .name = "lspsm", .create = lspsm_create, .destroy = lspsm_destroy, .load = lspsm_load,
     .pass = {map_passes, surface_passes, focus_passes},
     .npass = {(int)(sizeof map_passes / sizeof map_passes[0]), (int)(sizeof surface_passes / sizeof surface_passes[0]),
               (int)(sizeof focus_passes / sizeof focus_passes[0])},
     .res = {{RES_LSPSM, "lspsm map", false}}, .scene_reads = RES_LSPSM,
-    .units = 2, .bind = lspsm_bind,
+    .units = 2, .bind = lspsm_bind, .scene_define = lspsm_define,
     .warmup = lspsm_warmup, .advance = lspsm_advance, .needs_frame = lspsm_needs_frame,
 };
 

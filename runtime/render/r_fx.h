@@ -37,6 +37,16 @@
  * R_FX_UNIT_FIRST in table order.  A module binds its maps there (or 0
  * with its "on" uniform off when its pass did not run this frame).
  *
+ * The look's programs.  scene_define names a preprocessor symbol that the
+ * scene programs (scene.vert/.frag, sky.frag, lens.frag) are compiled with
+ * while the loaded stage uses the effect, NULL while it does not: the
+ * effect's code in those shaders sits inside #ifdef NAME, so a stage
+ * without it pays nothing for it.  (A uniform "on" test is not enough:
+ * a software rasteriser such as llvmpipe runs both sides of every branch,
+ * and mist and LSPSM taps on every pixel of every stage cost dojo's scene
+ * pass a quarter of its time.)  The "on" uniform stays, for the frames
+ * whose pass did not run.
+ *
  * Inside "scene".  scene_cleared says the effect already cleared the HDR
  * target and drew into it this frame (the holes: stencil volumes before
  * the fighters), so scene must not clear it; draw_ring draws the ring mesh
@@ -136,6 +146,7 @@ typedef struct r_fx_module {
     /* binding into the scene: `units` texture units from `unit` on */
     int units;
     void (*bind)(r_game *r, GLuint prog, int unit, int what);
+    const char *(*scene_define)(const r_game *r); /* the look's define, or NULL */
     /* inside "scene" (NULL: nothing to do there) */
     bool (*scene_cleared)(r_game *r);
     bool (*draw_ring)(r_game *r);

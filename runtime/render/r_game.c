@@ -14,6 +14,8 @@
 #include "r_tone.h"
 #include "r_local.h"
 
+static bool build_look_programs(r_game *r, rs_err *err);
+
 static const char *const core_res_names[R_RES_CORE] = {"env", "shadow map", "silhouette", "depth", "shadow mask",
                                                        "hdr", "bloom", "sun visibility", "output", "flare"};
 
@@ -89,6 +91,8 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
     /* the ring has the size of the match's stage (r_game_draw), which a
      * --stage-file look for another game stage does not change */
     if (!build_ring(r, game_stage >= 0 ? game_stage : st->game_index, err))
+        return false;
+    if (!build_look_programs(r, err))
         return false;
     r->stage_game = game_stage;
     r->have_stage = true;
@@ -200,18 +204,15 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
 }
 
 
+/* The programs that do not depend on the look: built once at create. */
 static bool build_programs(r_game *r, rs_err *err)
 {
     static const struct {
         int id;
         const char *vs, *fs, *defines;
     } d[] = {
-        {P_FIGHTER, "scene.vert", "scene.frag", "#define FIGHTER 1\n"},
-        {P_STAGE, "scene.vert", "scene.frag", "#define STAGE 1\n"},
-        {P_LENS, "scene.vert", "lens.frag", "#define LENS 1\n"},
         {P_DEPTH, "scene.vert", "light_depth.frag", "#define LIGHT_VIEW 1\n"},
         {P_SIL, "scene.vert", "light_depth.frag", "#define LIGHT_VIEW 1\n#define SILHOUETTE 1\n"},
-        {P_SKY, "sky.vert", "sky.frag", NULL},
         {P_MASK, "cap_fullscreen.vert", "shadow_mask.frag", NULL},
         {P_GROW, "cap_fullscreen.vert", "mask_grow.frag", NULL},
         {P_BLUR, "cap_fullscreen.vert", "blur.frag", NULL},
@@ -228,6 +229,69 @@ static bool build_programs(r_game *r, rs_err *err)
     for (size_t i = 0; i < sizeof d / sizeof d[0]; i++)
         if (!(r->prog[d[i].id] = r_program(&(r_program_desc){.vs = d[i].vs, .fs = d[i].fs, .defines = d[i].defines}, err)))
             return false;
+    return true;
+}
+
+static void free_look_programs(r_game *r)
+{
+    for (int i = 0; i < P_LOOK_END; i++) {
+        gl.DeleteProgram(r->prog[i]);
+        r->prog[i] = 0;
+    }
+    r->look_defines[0] = 0;
+}
+
+/* The look's programs: the scene's, compiled with what the loaded stage
+ * uses (SHADOWS, each effect's scene_define, the ring's MATERIAL), so
+ * that code for what it does not use is not there at all (r_fx.h says
+ * why a uniform test is not enough).  Kept while the defines stay the
+ * same from one look to the next. */
+static bool build_look_programs(r_game *r, rs_err *err)
+{
+    char defs[256];
+    size_t n = (size_t)snprintf(defs, sizeof defs, "%s", r->stage.shadows ? "#define SHADOWS 1\n" : "");
+    for (int m = 0; m < r_fx_nmodules; m++) {
+        const char *name = r_fx_modules[m]->scene_define ? r_fx_modules[m]->scene_define(r) : NULL;
+        if (name && n < sizeof defs)
+            n += (size_t)snprintf(defs + n, sizeof defs - n, "#define %s 1\n", name);
+    }
+    if (n >= sizeof defs)
+        return rs_fail(err, 1, "the look's shader defines are longer than %zu bytes", sizeof defs - 1);
+    /* the buildings and the craters: only on a look that has them */
+    bool buildings = r->stage.buildings > 0, holes = r->stage.holes;
+    char key[sizeof defs + 32];
+    snprintf(key, sizeof key, "%s/%d%d%d", defs, r_ring_material(r), buildings, holes);
+    if (r->prog[P_FIGHTER] && !strcmp(key, r->look_defines))
+        return true;
+    free_look_programs(r);
+    const struct {
+        int id;
+        const char *vs, *fs, *kind;
+        int material;
+        bool want;
+    } d[] = {
+        {P_FIGHTER, "scene.vert", "scene.frag", "FIGHTER", -1, true},
+        {P_STAGE, "scene.vert", "scene.frag", "STAGE", r_ring_material(r), true},
+        {P_STAGE_BUILDING, "scene.vert", "scene.frag", "STAGE", R_MAT_BUILDING, buildings},
+        {P_STAGE_HOLE, "scene.vert", "scene.frag", "STAGE", R_MAT_HOLE, holes},
+        {P_LENS, "scene.vert", "lens.frag", "LENS", -1, true},
+        {P_SKY, "sky.vert", "sky.frag", NULL, -1, true},
+    };
+    for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) {
+        if (!d[i].want)
+            continue;
+        char all[sizeof defs + 64];
+        int k = snprintf(all, sizeof all, "%s", defs);
+        if (d[i].kind)
+            k += snprintf(all + k, sizeof all - (size_t)k, "#define %s 1\n", d[i].kind);
+        if (d[i].material >= 0)
+            snprintf(all + k, sizeof all - (size_t)k, "#define MATERIAL %d\n", d[i].material);
+        if (!(r->prog[d[i].id] = r_program(&(r_program_desc){.vs = d[i].vs, .fs = d[i].fs, .defines = all}, err))) {
+            free_look_programs(r);
+            return false;
+        }
+    }
+    snprintf(r->look_defines, sizeof r->look_defines, "%s", key);
     return true;
 }
 

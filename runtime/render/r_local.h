@@ -52,9 +52,17 @@ typedef struct prog {
     GLuint id;
 } prog;
 
-enum { P_FIGHTER, P_STAGE, P_LENS, P_DEPTH, P_SIL, P_SKY, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA,
+/* P_FIGHTER .. P_STAGE_HOLE are the look's programs: compiled when a look
+ * loads, with the look's defines (build_look_programs in r_game.c); the
+ * rest once at create.  P_STAGE draws the ring and the ground, P_STAGE_BUILDING
+ * the city's buildings and P_STAGE_HOLE the craters' insides (0 on a look
+ * without them). */
+enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK_END,
+       P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA,
        P_TONE, /* + 4 variants: bloom x flare */
        P_COUNT = P_TONE + 4 };
+/* scene.frag's materials (MATERIAL): what the stage programs draw */
+enum { R_MAT_PLANKS, R_MAT_PAVED, R_MAT_BUILDING, R_MAT_HOLE };
 
 typedef struct frame {
     const g_state *prev, *cur;
@@ -81,6 +89,7 @@ struct r_game {
     r_game_opts opts;
     char stage_file[1024];
     GLuint prog[P_COUNT];
+    char look_defines[320]; /* what the look's programs were compiled with */
     GLuint fighter_vao, fighter_vbo, fighter_ibo;
     GLsizei fighter_count;
     GLuint lens_vao, lens_vbo, lens_ibo;
@@ -173,9 +182,12 @@ bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run thi
 /* the scene (r_scene.c) */
 void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
 void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
-/* The P_STAGE program's uniforms for this frame (lighting, shadows, the
- * effects' maps through r_fx_bind); material as scene.frag's u_material. */
-void r_stage_uniforms(r_game *r, GLuint p, int material);
+/* Uses the stage program that draws `material` (R_MAT_*) and sets its
+ * uniforms for this frame (lighting, shadows, the effects' maps through
+ * r_fx_bind); returns it.  The ring's material is r_ring_material's
+ * (paved ground on a look with buildings). */
+GLuint r_stage_program(r_game *r, int material);
+int r_ring_material(const r_game *r);
 /* Opaque drawing into the HDR target: its FBO and the frame's viewport,
  * depth test (less) and writes, back faces culled, no blending. */
 void r_begin_opaque(r_game *r);

@@ -74,9 +74,8 @@ static void run_scene(void *u)
     gl.StencilMask(0xFF);
 
     /* the ring and the ground, with the projected silhouette */
-    p = r->prog[P_STAGE];
     gl.DepthFunc(GL_LESS);
-    r_stage_uniforms(r, p, r->stage.buildings > 0 ? 1 : 0);
+    r_stage_program(r, r_ring_material(r));
     gl.BindVertexArray(r->ring_vao);
     /* an effect may draw the ring in its own order (the holes: r_fx.h) */
     if (!r_fx_draw_ring(r))
@@ -95,15 +94,20 @@ void r_begin_opaque(r_game *r)
     gl.Disable(GL_BLEND);
 }
 
-void r_stage_uniforms(r_game *r, GLuint p, int material)
+int r_ring_material(const r_game *r)
+{
+    return r->stage.buildings > 0 ? R_MAT_PAVED : R_MAT_PLANKS;
+}
+
+GLuint r_stage_program(r_game *r, int material)
 {
     frame *f = &r->f;
+    GLuint p = r->prog[material == R_MAT_BUILDING ? P_STAGE_BUILDING : material == R_MAT_HOLE ? P_STAGE_HOLE : P_STAGE];
     r_camera_uniforms(r, p);
     r_bind_ibl(r, p);
     r_bind_tex(p, "u_silhouette", 0, GL_TEXTURE_2D, r->sil_tex);
     gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "mask_filter") && r_ran(f, r, "silhouette_mips"));
     r_fx_bind(r, p, R_FX_BIND_SCENE);
-    gl.Uniform1i(r_loc(p, "u_material"), material);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
     gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
@@ -112,6 +116,7 @@ void r_stage_uniforms(r_game *r, GLuint p, int material)
     gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
     gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
     gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
+    return p;
 }
 
 static void run_sky(void *u)

@@ -384,7 +384,7 @@ char *r_shader_variants(const char *root, const char *name)
     return out;
 }
 
-/* "B+C" -> "#define B 1\n#define C 1\n"; "-" -> "". */
+/* "B+C" -> "#define B 1\n#define C 1\n"; "B=2" -> "#define B 2\n"; "-" -> "". */
 void r_shader_variant_defines(const char *tok, size_t len, char *out, size_t n)
 {
     out[0] = 0;
@@ -394,7 +394,10 @@ void r_shader_variant_defines(const char *tok, size_t len, char *out, size_t n)
         while (k < len && tok[k] != '+')
             k++;
         if (k > 0 && !(k == 1 && tok[0] == '-')) {
-            int w = snprintf(out + at, n - at, "#define %.*s 1\n", (int)k, tok);
+            const char *eq = memchr(tok, '=', k);
+            int w = eq ? snprintf(out + at, n - at, "#define %.*s %.*s\n", (int)(eq - tok), tok, (int)(k - (size_t)(eq - tok) - 1),
+                                  eq + 1)
+                       : snprintf(out + at, n - at, "#define %.*s 1\n", (int)k, tok);
             if (w < 0 || (size_t)w >= n - at)
                 return;
             at += (size_t)w;
