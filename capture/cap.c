@@ -34,11 +34,12 @@ struct cap {
     size_t frame_bytes;
     cap_pixfmt fmt;    /* what the sink takes: I420 planes or RGBA */
     bool gpu;          /* GPU downscale + convert */
+    bool same_size;    /* I420 at the render size: the conversion reads the frame itself (no scaler pass) */
     bool failed;
     /* GPU stage */
     cap_scaler *scaler;
     GLuint vao, prog_luma, prog_chroma;
-    GLint u_rgb_luma, u_rgb_chroma, u_size_chroma;
+    GLint u_rgb_luma, u_rgb_chroma, u_size_chroma, u_flip_luma, u_flip_chroma;
     target rgb;
     target planes;     /* I420 as one R8 image of w x 3h/2: Y rows, then Cb and Cr packed (gpu_setup) */
     GLuint read_fbo;   /* to read the source texture (CPU path) */
@@ -106,9 +107,13 @@ static void free_target(target *t)
 
 static bool gpu_setup(cap *c, rs_err *err)
 {
-    c->scaler = cap_scaler_create(c->d.filter, c->d.src_w, c->d.src_h, c->d.w, c->d.h, err);
-    if (c->scaler)
-        c->prog_luma = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "cap_luma.frag"}, err);
+    /* at 1:1 every filter is the identity: the Y and CbCr draws read the
+     * rendered frame, flipped, instead of a copy of it (the same bytes, one
+     * full-frame pass less; the default job writes at the render size) */
+    c->same_size = c->fmt == CAP_I420 && c->d.src_w == c->d.w && c->d.src_h == c->d.h;
+    if (!c->same_size && !(c->scaler = cap_scaler_create(c->d.filter, c->d.src_w, c->d.src_h, c->d.w, c->d.h, err)))
+        return false;
+    c->prog_luma = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "cap_luma.frag"}, err);
     if (c->prog_luma)
         c->prog_chroma = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "cap_chroma.frag"}, err);
     if (!c->prog_chroma)
@@ -116,6 +121,8 @@ static bool gpu_setup(cap *c, rs_err *err)
     c->u_rgb_luma = gl.GetUniformLocation(c->prog_luma, "u_rgb");
     c->u_rgb_chroma = gl.GetUniformLocation(c->prog_chroma, "u_rgb");
     c->u_size_chroma = gl.GetUniformLocation(c->prog_chroma, "u_size");
+    c->u_flip_luma = gl.GetUniformLocation(c->prog_luma, "u_flip");
+    c->u_flip_chroma = gl.GetUniformLocation(c->prog_chroma, "u_flip");
     gl.GenVertexArrays(1, &c->vao);
     int w = c->d.w, h = c->d.h;
     if (c->fmt == CAP_RGBA)
@@ -131,32 +138,37 @@ static bool gpu_setup(cap *c, rs_err *err)
     if (h + h / 2 > glcaps.max_texture_size)
         return rs_fail(err, CAP_ERR_SIZE, "capture: output %dx%d needs a %dx%d plane image, over this GL's %d limit", w, h, w,
                        h + h / 2, glcaps.max_texture_size);
-    return make_target(&c->rgb, w, h, 1, GL_RGBA8, GL_RGBA, err) &&
+    return (c->same_size || make_target(&c->rgb, w, h, 1, GL_RGBA8, GL_RGBA, err)) &&
            make_target(&c->planes, w, h + h / 2, 1, GL_R8, GL_RED, err);
 }
 
 /* Downscale src into rgb, then Y, Cb, Cr planes; nothing is read back here. */
 static void gpu_convert(cap *c, GLuint src)
 {
-    cap_scaler_run(c->scaler, src, c->rgb.fbo);
+    if (!c->same_size)
+        cap_scaler_run(c->scaler, src, c->rgb.fbo);
     if (c->fmt == CAP_RGBA)
         return; /* image sequences take the downscaled RGBA as it is */
+    /* u_flip: the source's height when it is the rendered frame (bottom-up), else 0 */
+    int flip = c->same_size ? c->d.src_h : 0;
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.Disable(GL_CULL_FACE);
     gl.BindVertexArray(c->vao);
     gl.ActiveTexture(GL_TEXTURE0);
-    gl.BindTexture(GL_TEXTURE_2D, c->rgb.tex[0]);
+    gl.BindTexture(GL_TEXTURE_2D, c->same_size ? src : c->rgb.tex[0]);
     gl.BindFramebuffer(GL_FRAMEBUFFER, c->planes.fbo);
     gl.Viewport(0, 0, c->d.w, c->d.h);
     gl.UseProgram(c->prog_luma);
     gl.Uniform1i(c->u_rgb_luma, 0);
+    gl.Uniform1i(c->u_flip_luma, flip);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
 
     gl.Viewport(0, c->d.h, c->d.w, c->d.h / 2);
     gl.UseProgram(c->prog_chroma);
     gl.Uniform1i(c->u_rgb_chroma, 0);
     gl.Uniform2i(c->u_size_chroma, c->d.w, c->d.h);
+    gl.Uniform1i(c->u_flip_chroma, flip);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
 
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -9,6 +9,7 @@
 // JPEG/MPEG-1 "C420jpeg").
 uniform sampler2D u_rgb;
 uniform ivec2 u_size; // the output's w, h (both even)
+uniform int u_flip;   // u_rgb's height when it is the rendered frame (bottom-up, 1:1), else 0
 out vec4 o_c;
 
 void main()
@@ -20,8 +21,14 @@ void main()
         j -= nc;
     int row = j / cw;
     ivec2 p = ivec2(j - row * cw, row) * 2;
+    int dy = 1;
+    if (u_flip > 0) { // image rows 2k, 2k+1 are GL rows h-1-2k, h-2-2k
+        p.y = u_flip - 1 - p.y;
+        dy = -1;
+    }
+    // the same four texels, added in the same order, as from a flipped copy
     vec3 rgb = (texelFetch(u_rgb, p, 0).rgb + texelFetch(u_rgb, p + ivec2(1, 0), 0).rgb +
-                texelFetch(u_rgb, p + ivec2(0, 1), 0).rgb + texelFetch(u_rgb, p + ivec2(1, 1), 0).rgb) * 0.25;
+                texelFetch(u_rgb, p + ivec2(0, dy), 0).rgb + texelFetch(u_rgb, p + ivec2(1, dy), 0).rgb) * 0.25;
     vec2 c = chroma709(rgb);
     o_c = vec4(cr ? c.y : c.x, 0.0, 0.0, 1.0);
 }

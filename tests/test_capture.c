@@ -332,11 +332,11 @@ static void APIENTRY counting_read_pixels(GLint x, GLint y, GLsizei w, GLsizei h
 /* Captures GRAB_FRAMES distinct pictures, in order, with one glReadPixels
  * a frame whatever the path: NVIDIA's driver spent 17-20 ms of CPU a frame
  * when the planes came back in three reads into one PBO (docs/capture.md). */
-static void capture_all(const GLuint *tex, cap_mode mode, cap_downscale ds, int pbo, grab *g)
+static void capture_all(const GLuint *tex, int src_w, int src_h, cap_mode mode, cap_downscale ds, int pbo, grab *g)
 {
     cap_sink s = {.ops = &grab_ops, .impl = g, .w = 160, .h = 90, .fmt = CAP_I420};
     rs_err e = {0};
-    cap *c = cap_open(&(cap_desc){.src_w = 320, .src_h = 180, .w = 160, .h = 90, .mode = mode, .downscale = ds,
+    cap *c = cap_open(&(cap_desc){.src_w = src_w, .src_h = src_h, .w = 160, .h = 90, .mode = mode, .downscale = ds,
                                   .pbo = pbo},
                       &s, &e);
     T_ASSERTF(c, "%s", e.msg);
@@ -362,21 +362,23 @@ static double psnr(const uint8_t *a, const uint8_t *b, size_t n)
     return se == 0 ? 99.0 : 10 * log10(255.0 * 255.0 * n / se);
 }
 
-static void gpu_vs_cpu(const char *backend)
+/* sw x sh frames (320x180: a 2x downscale; 160x90: the output's size,
+ * where the conversion reads the frame itself) through every path */
+static void gpu_vs_cpu(const char *backend, int sw, int sh)
 {
     plat *p = t_context(backend);
     static uint8_t px[GRAB_FRAMES][320 * 180 * 4];
     GLuint tex[GRAB_FRAMES];
     for (int i = 0; i < GRAB_FRAMES; i++)
-        tex[i] = test_texture(320, 180, px[i], 5 * i);
+        tex[i] = test_texture(sw, sh, px[i], 5 * i);
     static grab gpu_async, gpu_seq, cpu_seq, pbo1, pbo3, pbo8;
     memset(&gpu_async, 0, sizeof gpu_async);
-    capture_all(tex, CAP_ASYNC, CAP_DS_GPU, 2, &gpu_async);
-    capture_all(tex, CAP_SEQUENTIAL, CAP_DS_GPU, 0, &gpu_seq);
-    capture_all(tex, CAP_SEQUENTIAL, CAP_DS_CPU, 0, &cpu_seq);
-    capture_all(tex, CAP_ASYNC, CAP_DS_GPU, 1, &pbo1);
-    capture_all(tex, CAP_ASYNC, CAP_DS_GPU, 3, &pbo3);
-    capture_all(tex, CAP_ASYNC, CAP_DS_GPU, 8, &pbo8); /* a ring longer than the clip */
+    capture_all(tex, sw, sh, CAP_ASYNC, CAP_DS_GPU, 2, &gpu_async);
+    capture_all(tex, sw, sh, CAP_SEQUENTIAL, CAP_DS_GPU, 0, &gpu_seq);
+    capture_all(tex, sw, sh, CAP_SEQUENTIAL, CAP_DS_CPU, 0, &cpu_seq);
+    capture_all(tex, sw, sh, CAP_ASYNC, CAP_DS_GPU, 1, &pbo1);
+    capture_all(tex, sw, sh, CAP_ASYNC, CAP_DS_GPU, 3, &pbo3);
+    capture_all(tex, sw, sh, CAP_ASYNC, CAP_DS_GPU, 8, &pbo8); /* a ring longer than the clip */
     size_t n = sizeof gpu_async.frame[0];
     for (int i = 0; i < GRAB_FRAMES; i++) {
         /* same downscale, same bytes, frame by frame, whatever the path or ring */
@@ -397,8 +399,9 @@ static void gpu_vs_cpu(const char *backend)
     plat_destroy(p);
 }
 
-static void t_gpu_matches_cpu_egl(void) { gpu_vs_cpu("egl"); }
-static void t_gpu_matches_cpu_osmesa(void) { gpu_vs_cpu("osmesa"); }
+static void t_gpu_matches_cpu_egl(void) { gpu_vs_cpu("egl", 320, 180); }
+static void t_gpu_matches_cpu_osmesa(void) { gpu_vs_cpu("osmesa", 320, 180); }
+static void t_gpu_matches_cpu_same_size(void) { gpu_vs_cpu("egl", 160, 90); }
 
 T_MAIN({"queue_cap_holds", t_queue_cap_holds}, {"inline_queue", t_inline_queue},
        {"writer_error_reaches_the_game_thread", t_writer_error_reaches_the_game_thread},
@@ -406,4 +409,5 @@ T_MAIN({"queue_cap_holds", t_queue_cap_holds}, {"inline_queue", t_inline_queue},
        {"cpu_downscale_averages_and_flips", t_cpu_downscale_averages_and_flips}, {"sizes", t_sizes},
        {"sink_errors", t_sink_errors}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"segment_names", t_segment_names},
-       {"gpu_matches_cpu_egl", t_gpu_matches_cpu_egl}, {"gpu_matches_cpu_osmesa", t_gpu_matches_cpu_osmesa})
+       {"gpu_matches_cpu_egl", t_gpu_matches_cpu_egl}, {"gpu_matches_cpu_osmesa", t_gpu_matches_cpu_osmesa},
+       {"gpu_matches_cpu_same_size", t_gpu_matches_cpu_same_size})
