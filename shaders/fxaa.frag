@@ -1,4 +1,8 @@
 #version 330 core
+// variants: - MARK MARK+GATHER
+#ifdef GATHER
+#extension GL_ARB_texture_gather : require
+#endif
 // Post-process anti-aliasing (r_quality.aa = R_AA_FXAA) on the tone-mapped
 // LDR image, one full-screen pass, before the HUD:
 //   1. luma of the pixel and its 4 neighbours; a small contrast (most of
@@ -11,7 +15,19 @@
 //      blended across the edge more than pixels near its middle
 //   4. one bilinear tap offset across the edge by the larger of 2 and 3
 // Alpha (the fighters' mask under --mask) is the pixel's own.
-uniform sampler2D u_src; // RGBA8, the render's size, linear filter, clamped
+// MARK: the early out alone, as a pass of its own before this one
+// (r_aa.c): it discards the pixels whose 4 neighbours are surely flat and
+// marks the others in the stencil, read from the tone map's 8-bit luma
+// image (two textureGather calls with GATHER, else five fetches).  Its
+// test is step 1's with a margin for that luma's rounding (each value
+// within 2/255 of step 1's), so every pixel it leaves unmarked is one that
+// step 1 returns untouched; the filter then runs on the marked pixels over
+// a copy of the image, and the output is one full pass's, byte for byte.
+// (Why two passes: llvmpipe runs the rest of a shader for pixels that
+// discarded or branched away, but skips shading a block that fails the
+// stencil test before the shader.)
+uniform sampler2D u_src;  // RGBA8, the render's size, linear filter, clamped
+uniform sampler2D u_luma; // R8, the same size: luma(u_src) before rounding
 out vec4 o_color;
 
 const float EDGE_MIN = 0.0625; // contrast below this is no edge (dark areas)
@@ -30,6 +46,27 @@ float luma(vec4 c)
 
 void main()
 {
+#ifdef MARK
+#ifdef GATHER
+    vec2 lpx = 1.0 / vec2(textureSize(u_luma, 0));
+    vec4 a = textureGather(u_luma, (gl_FragCoord.xy - 0.5) * lpx); // west, this, south, south-west
+    vec4 b = textureGather(u_luma, (gl_FragCoord.xy + 0.5) * lpx); // north, north-east, east, this
+    float qmax = max(max(a.x, a.y), max(a.z, max(b.x, b.z)));
+    float qmin = min(min(a.x, a.y), min(a.z, min(b.x, b.z)));
+#else
+    ivec2 iq = ivec2(gl_FragCoord.xy), lq = textureSize(u_luma, 0) - 1;
+    float q0 = texelFetch(u_luma, iq, 0).r;
+    float q1 = texelFetch(u_luma, clamp(iq + ivec2(0, 1), ivec2(0), lq), 0).r;
+    float q2 = texelFetch(u_luma, clamp(iq + ivec2(0, -1), ivec2(0), lq), 0).r;
+    float q3 = texelFetch(u_luma, clamp(iq + ivec2(1, 0), ivec2(0), lq), 0).r;
+    float q4 = texelFetch(u_luma, clamp(iq + ivec2(-1, 0), ivec2(0), lq), 0).r;
+    float qmax = max(q0, max(max(q1, q2), max(q3, q4)));
+    float qmin = min(q0, min(min(q1, q2), min(q3, q4)));
+#endif
+    if (qmax - qmin + 4.0 / 255.0 < max(EDGE_MIN, (qmax - 2.0 / 255.0) * EDGE_REL))
+        discard;
+    o_color = vec4(0.0); // colour writes are off: the stencil is the mark
+#else
     vec2 px = 1.0 / vec2(textureSize(u_src, 0));
     vec2 uv = gl_FragCoord.xy * px;
     ivec2 ip = ivec2(gl_FragCoord.xy), last = textureSize(u_src, 0) - 1;
@@ -93,4 +130,5 @@ void main()
     float off = max(edge_off, sub);
     vec2 o = horz ? vec2(0.0, off * step_len) : vec2(off * step_len, 0.0);
     o_color = vec4(textureLod(u_src, uv + o, 0.0).rgb, c.a);
+#endif
 }

@@ -1,12 +1,14 @@
 #version 330 core
-// variants: - BLOOM FLARE BLOOM+FLARE
+// variants: - BLOOM FLARE BLOOM+FLARE AA BLOOM+FLARE+AA
 // Tone map (techniques A3), one full-screen pass:
 //   1. RGB -> Y, Cb, Cr (CbCr unnormalised: B - Y and R - Y)
 //   2. Y' from the curve ((1 - exp(-x^2))^1.5)^(1/gamma) in a float table
 //   3. CbCr scaled by Y'/Y (guarded near 0) and by the saturation
 //   4. back to RGB
 // Bloom (BLOOM) and the sun flare (FLARE) are added in HDR before step 1;
-// those variants exist only when their passes ran this frame.
+// those variants exist only when their passes ran this frame.  With the
+// AA pass after it (AA), it writes the image's luma beside it, as the AA
+// pass's early out reads it (fxaa.frag).
 uniform sampler2D u_hdr;
 uniform sampler1D u_lut;
 uniform int u_lut_size;
@@ -22,7 +24,10 @@ uniform float u_bloom1_on; // 0: the quality knob's one level (r_quality.bloom_l
 #ifdef FLARE
 uniform sampler2D u_flare_img; // the flare pass's image (quarter size, HDR)
 #endif
-out vec4 o_color;
+layout(location = 0) out vec4 o_color;
+#ifdef AA
+layout(location = 1) out vec4 o_luma;
+#endif
 
 const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
 const float X_MAX = 4.0; // R_TONE_X_MAX
@@ -59,4 +64,7 @@ void main()
     float r = y2 + cr, b = y2 + cb;
     float g = (y2 - LUMA.r * r - LUMA.b * b) / LUMA.g;
     o_color = vec4(clamp(vec3(r, g, b), 0.0, 1.0), u_write_mask == 1 ? hdr.a : 1.0);
+#ifdef AA
+    o_luma = vec4(dot(o_color.rgb, vec3(0.299, 0.587, 0.114)), 0.0, 0.0, 1.0); // fxaa.frag's luma()
+#endif
 }

@@ -170,6 +170,56 @@ static void t_fxaa(void)
     plat_destroy(p);
 }
 
+/* The early out (r_aa.c): the marked pass draws one full pass's bytes,
+ * with a minority of the pixels marked for the filter, and FXAA does
+ * change the picture (so the comparison can fail). */
+static void t_fxaa_early_out_same_bytes(void)
+{
+    plat *p = t_context("egl");
+    const struct {
+        const char *demo;
+        uint64_t tick;
+    } cases[] = {{"temple", 900}, {"dojo", 1200}, {"plaza", 1500}};
+    int w = 320, h = 180;
+    size_t n = (size_t)w * h * 4;
+    uint8_t *fast = malloc(n), *plain = malloc(n), *off = malloc(n), *st = malloc((size_t)w * h);
+    T_ASSERT(fast && plain && off && st);
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        g_state prev, cur;
+        t_state_at(cases[c].demo, cases[c].tick, &prev, &cur);
+        t_fb f;
+        t_fb_make(&f, w, h);
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.aa = R_AA_FXAA}});
+        t_draw_read(r, &f, &prev, &cur, w, h, fast, true);
+        /* the marks: the stencil the pass left */
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, f.fbo);
+        gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+        gl.ReadPixels(0, 0, w, h, GL_STENCIL_INDEX, GL_UNSIGNED_BYTE, st);
+        gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+        int marked = 0;
+        for (int i = 0; i < w * h; i++)
+            marked += st[i] == 1;
+        r_game_destroy(r);
+        r = t_game_opts(&(r_game_opts){.q = {.aa = R_AA_FXAA}, .aa_plain = true});
+        t_draw_read(r, &f, &prev, &cur, w, h, plain, true);
+        r_game_destroy(r);
+        r = t_game_opts(NULL);
+        t_draw_read(r, &f, &prev, &cur, w, h, off, true);
+        r_game_destroy(r);
+        t_fb_free(&f);
+        size_t diff = 0, changed = 0;
+        for (size_t i = 0; i < n; i++)
+            diff += fast[i] != plain[i], changed += plain[i] != off[i];
+        T_ASSERTF(diff == 0, "%s@%llu: %zu bytes differ between the marked and the plain pass", cases[c].demo,
+                  (unsigned long long)cases[c].tick, diff);
+        T_ASSERTF(changed > 0, "%s: FXAA changed nothing", cases[c].demo);
+        T_ASSERTF(marked > 0 && marked < w * h / 2, "%s: %d of %d pixels marked for the filter", cases[c].demo, marked,
+                  w * h);
+    }
+    free(fast), free(plain), free(off), free(st);
+    plat_destroy(p);
+}
+
 /* The pass is in the graph: runs with aa on, skipped (and no target) off. */
 static void t_fxaa_pass_in_graph(void)
 {
@@ -425,6 +475,7 @@ static void t_out_of_range_refused(void)
 }
 
 T_MAIN({"defaults_spelled_out_are_zero", t_defaults_spelled_out_are_zero}, {"fxaa", t_fxaa},
+       {"fxaa_early_out_same_bytes", t_fxaa_early_out_same_bytes},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
        {"silhouette_mips_whole", t_silhouette_mips_whole},
        {"water_grid", t_water_grid}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})

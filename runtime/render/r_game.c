@@ -130,7 +130,7 @@ const r_stage *r_game_stage(const r_game *r)
 static void free_targets(r_game *r)
 {
     GLuint tex[] = {r->hdr_tex, r->depth_tex, r->mask_tex[0], r->mask_tex[1], r->b2_tex, r->b4_tex[0],
-                    r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex};
+                    r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex, r->luma_tex};
     GLuint fbo[] = {r->hdr_fbo, r->depth_fbo, r->mask_fbo[0], r->mask_fbo[1], r->b2_fbo, r->b4_fbo[0],
                     r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo};
     for (size_t i = 0; i < sizeof tex / sizeof tex[0]; i++)
@@ -144,7 +144,7 @@ static void free_targets(r_game *r)
             gl.DeleteFramebuffers(1, &fbo[i]);
     r->hdr_tex = r->depth_tex = r->b2_tex = r->sunvis_tex = r->fl_tex = 0;
     r->hdr_fbo = r->depth_fbo = r->b2_fbo = r->sunvis_fbo = r->fl_fbo = 0;
-    r->ldr_tex = r->ldr_fbo = 0;
+    r->ldr_tex = r->ldr_fbo = r->luma_tex = 0;
     memset(r->mask_tex, 0, sizeof r->mask_tex), memset(r->mask_fbo, 0, sizeof r->mask_fbo);
     memset(r->b4_tex, 0, sizeof r->b4_tex), memset(r->b4_fbo, 0, sizeof r->b4_fbo);
     memset(r->b8_tex, 0, sizeof r->b8_tex), memset(r->b8_fbo, 0, sizeof r->b8_fbo);
@@ -190,6 +190,12 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
     if (r->opts.q.aa) { /* the tone map's image for the AA pass: linear, its walk taps between texels */
         r->ldr_tex = r_tex2d(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->ldr_fbo = r_fbo_for(r->ldr_tex, 0, 0);
+        /* and its luma beside it, which the AA pass gathers for its early out */
+        r->luma_tex = r_tex2d(GL_R8, w, h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, r->luma_tex, 0);
+        const GLenum two[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        gl.DrawBuffers(2, two);
+        gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
     }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
@@ -221,14 +227,25 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_FLARE, "cap_fullscreen.vert", "flare.frag", NULL},
         {P_HUD, "hud.vert", "hud.frag", NULL},
         {P_FXAA, "cap_fullscreen.vert", "fxaa.frag", NULL},
+        {P_FXAA_MARK, "cap_fullscreen.vert", "fxaa.frag", "#define MARK 1\n"},
         {P_TONE, "cap_fullscreen.vert", "tonemap.frag", NULL},
         {P_TONE + 1, "cap_fullscreen.vert", "tonemap.frag", "#define BLOOM 1\n"},
         {P_TONE + 2, "cap_fullscreen.vert", "tonemap.frag", "#define FLARE 1\n"},
         {P_TONE + 3, "cap_fullscreen.vert", "tonemap.frag", "#define BLOOM 1\n#define FLARE 1\n"},
     };
-    for (size_t i = 0; i < sizeof d / sizeof d[0]; i++)
-        if (!(r->prog[d[i].id] = r_program(&(r_program_desc){.vs = d[i].vs, .fs = d[i].fs, .defines = d[i].defines}, err)))
+    /* with the AA pass, the tone map writes the luma too (r_aa.c), and the
+     * pass's early out gathers it where the GL can (else five fetches) */
+    bool aa = r->opts.q.aa == R_AA_FXAA;
+    r->aa_gather = aa && !r->opts.aa_plain && (glcaps.major > 3 || rgl_has_extension("GL_ARB_texture_gather"));
+    const char *aa_defs = r->aa_gather ? "#define GATHER 1\n" : "";
+    for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) {
+        char defs[160];
+        bool tone = d[i].id >= P_TONE, fxaa = d[i].id == P_FXAA || d[i].id == P_FXAA_MARK;
+        snprintf(defs, sizeof defs, "%s%s%s", d[i].defines ? d[i].defines : "", tone && aa ? "#define AA 1\n" : "",
+                 fxaa ? aa_defs : "");
+        if (!(r->prog[d[i].id] = r_program(&(r_program_desc){.vs = d[i].vs, .fs = d[i].fs, .defines = defs}, err)))
             return false;
+    }
     return true;
 }
 

@@ -59,6 +59,7 @@ typedef struct r_game_opts {
     const char *cache_dir;  /* NULL: r_ibl_cache_dir(); "" = no cache */
     int lut_size;           /* 0: R_TONE_LUT_DEFAULT */
     bool quiet;             /* no note when prefiltering takes a while */
+    bool aa_plain;          /* tests: FXAA as one full pass over every pixel (no early out; the same bytes) */
     r_quality q;            /* zero: full quality */
 } r_game_opts;
 

@@ -58,7 +58,7 @@ typedef struct prog {
  * the city's buildings and P_STAGE_HOLE the craters' insides (0 on a look
  * without them). */
 enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK_END,
-       P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA,
+       P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA, P_FXAA_MARK,
        P_TONE, /* + 4 variants: bloom x flare */
        P_COUNT = P_TONE + 4 };
 /* scene.frag's materials (MATERIAL): what the stage programs draw */
@@ -126,6 +126,8 @@ struct r_game {
     GLuint fl_tex, fl_fbo; /* the flare image, quarter size */
     GLuint sunvis_tex, sunvis_fbo;
     GLuint ldr_tex, ldr_fbo; /* the tone map's output when the AA pass runs after it (RGBA8) */
+    GLuint luma_tex;         /* beside it (attachment 1): its luma, R8, for the AA pass's early out (r_aa.c) */
+    bool aa_gather;          /* the AA pass's early out may use textureGather (GL 4.0 or ARB_texture_gather) */
     int mask_final; /* index of the filtered mask */
     /* graph */
     r_graph graph;
