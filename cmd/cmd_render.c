@@ -15,10 +15,12 @@
 #include "job_audio.h"
 #include "job_poster.h"
 #include "job_render.h"
+#include "job_split.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_quality.h"
+#include "../runtime/render/r_stage.h"
 #include "../runtime/render/r_target.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
@@ -38,7 +40,8 @@ static void help(void)
            "                       [--ticks A:B] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
            "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
            "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n"
-           "                       [--audio on|off] [--audio-bitrate RATE] [--loudness LUFS] [--wav FILE]\n\n"
+           "                       [--audio on|off] [--audio-bitrate RATE] [--loudness LUFS] [--wav FILE]\n"
+           "                       [--jobs N|auto]\n\n"
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension (any\n"
            "case) or --format: %s.\n"
@@ -118,6 +121,12 @@ static void help(void)
            "                     exactly those samples of the whole match's track\n"
            "  --wav FILE         also write the track of the rendered ticks as a 16-bit WAV,\n"
            "                     beside any output (Y4M, images); obeys -y/-n\n"
+           "  --jobs N|auto      draw the video as N segments at once, in processes of their\n"
+           "                     own, and join them (a .mp4, .mkv or .webm file; not with\n"
+           "                     --segment, --passes, --wav or --format).  auto (default): one\n"
+           "                     per CPU, each at least %d frames, when the GL renderer is a\n"
+           "                     software one (llvmpipe), else 1.  The frames are the same;\n"
+           "                     docs/capture.md, Parallel segments\n"
            "  --progress MODE    tty: one line redrawn in place; plain: a line every 5 s and\n"
            "                     the last, for logs; off.  Default: tty when stderr is a\n"
            "                     terminal, else plain\n"
@@ -126,11 +135,32 @@ static void help(void)
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n",
            cap_sink_formats(), CLI_SIZE_MIN, R_RENDER_MAX, cli_quality_help(), CAP_MAX_SCALE, CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO, JOB_AUDIO_LUFS_MIN,
-           JOB_AUDIO_LUFS_MAX, JOB_AUDIO_LUFS_DEFAULT);
+           JOB_AUDIO_LUFS_MAX, JOB_AUDIO_LUFS_DEFAULT, JOB_SPLIT_MIN_FRAMES);
 }
 
 /* long-only options (no letter): the encoder's */
-enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW };
+enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW, OPT_JOBS };
+
+/* What a segment of a parallel render (--jobs) is given of the user's
+ * options: the ones that decide the pictures and the encoding.  The rest
+ * (outputs, ticks, progress, sound) the parent handles (job_split.h). */
+static bool for_segments(int c)
+{
+    switch (c) {
+    case 's': case 'r': case 'L': case 'c': case 'd': case 'p': case 'Q': case 'F': case 'T': case 'U': case 'X':
+    case 'b': case OPT_CODEC: case OPT_CRF: case OPT_BITRATE: case OPT_PRESET: case OPT_PIXFMT: case OPT_HW:
+        return true;
+    default:
+        return false;
+    }
+}
+
+/* A software GL renderer: the one --jobs auto splits for. */
+static bool software_gl(void)
+{
+    const char *r = glcaps.renderer ? glcaps.renderer : "";
+    return strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "Software Rasterizer");
+}
 
 /* The metadata every video carries (cap_meta_keys): from the replay's header. */
 static void render_meta(cap_sink *s, const char *replay, const rp_replay *rp)
@@ -186,7 +216,7 @@ int cmd_render(int argc, char **argv)
         {"poster", required_argument, 0, 'O'},     {"quality", required_argument, 0, 'L'},
         {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
         {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
-        {0}};
+        {"jobs", required_argument, 0, OPT_JOBS}, {0}};
     cap_enc enc = {0};
     job_audio audio = {0};
     const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL, *poster_path = NULL;
@@ -200,7 +230,7 @@ int cmd_render(int argc, char **argv)
     long first = 0, end = -1; /* --ticks; end -1: the whole replay */
     long progress_fd = -1;
     long v;
-    int c;
+    int c, jobs = 0; /* 0: auto */
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
@@ -317,6 +347,14 @@ int cmd_render(int argc, char **argv)
             }
             break;
         case 'O': poster_path = optarg; break;
+        case OPT_JOBS:
+            if (!strcmp(optarg, "auto"))
+                jobs = 0;
+            else if (!cli_int("--jobs", optarg, 1, JOB_SPLIT_MAX, &v))
+                return RS_EXIT_USAGE;
+            else
+                jobs = (int)v;
+            break;
         case JOB_AUDIO_OPT_AUDIO: case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS: case JOB_AUDIO_OPT_WAV:
             if (!job_audio_option(&audio, "render", c, optarg))
                 return RS_EXIT_USAGE;
@@ -428,6 +466,73 @@ int cmd_render(int argc, char **argv)
     }
     if (sink.enc_note[0])
         fprintf(stderr, "ringside render: %s\n", sink.enc_note); /* once: the choice is made here, for the whole run */
+    /* --jobs: segments drawn at once by processes of their own, then joined
+     * (job_split.h), where the output can be joined */
+    bool splittable = fmt == CAP_I420 && !format && !segment && !passes && !audio.wav && cap_seg_format_of(out);
+    if (jobs > 1 && !splittable) {
+        cli_error("render", "--jobs %d: only a .mp4, .mkv or .webm file is rendered in segments at once (not %s%s)", jobs,
+                  segment ? "with --segment" : passes ? "with --passes" : audio.wav ? "with --wav" : format ? "with --format" : out,
+                  "");
+        status = RS_EXIT_USAGE;
+        goto done;
+    }
+    int split = 1;
+    if (splittable && jobs != 1) {
+        uint64_t frames = t_end - t_first;
+        split = jobs ? (frames < (uint64_t)jobs ? (int)frames : jobs) : job_split_auto(frames);
+        if (jobs == 0 && split > 1) {
+            /* auto: a software rasteriser gains, a GPU does not need it; the
+             * context this render would draw with says which (and is kept if so) */
+            if (!(p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err))) {
+                status = cli_plat_status(&err);
+                goto done;
+            }
+            if (!software_gl())
+                split = 1;
+            else
+                plat_destroy(p), p = NULL;
+        }
+    }
+    if (split > 1) {
+        /* what every segment would refuse, refused once here: the look */
+        r_stage look;
+        if (go.stage_file ? !r_stage_load(&look, go.stage_file, &err) : !r_stage_for_game(&look, rp.stage, &err))
+            goto done;
+        /* the user's options that decide the pictures and the encoding, for every segment */
+        const char *pass[96];
+        int np = 0;
+        optind = 1;
+        while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1 && np < 94) {
+            if (!for_segments(c))
+                continue;
+            for (const struct option *o = opts; o->name; o++)
+                if (o->val == c) {
+                    static char name[96][40];
+                    snprintf(name[np], sizeof name[np], "--%s", o->name);
+                    pass[np] = name[np];
+                    np++;
+                    if (o->has_arg == required_argument)
+                        pass[np++] = optarg;
+                    break;
+                }
+        }
+        pass[np] = NULL;
+        char exe[1100], what[160];
+        ssize_t ne = readlink("/proc/self/exe", exe, sizeof exe - 1);
+        if (ne <= 0) {
+            rs_fail(&err, 1, "cannot find this program (/proc/self/exe): %s", strerror(errno));
+            goto done;
+        }
+        exe[ne] = 0;
+        snprintf(what, sizeof what, "%dx%d (drawn at %dx%d, quality %s)", cd.w, cd.h, cd.src_w, cd.src_h, quality->name);
+        job_split_desc jd = {.exe = exe, .replay = replay, .out = out, .first = t_first, .end = t_end, .jobs = split,
+                             .pass = pass, .rp = &rp, .sink = &sink, .audio = &audio, .hashes = hashes,
+                             .poster = poster.due ? poster_path : NULL, .overwrite = overwrite,
+                             .progress = quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress, .progress_fd = (int)progress_fd,
+                             .quiet = quiet, .what = what, .said = sink.enc_note, .stop = &stop_requested};
+        status = job_split_run(&jd, &err);
+        goto done;
+    }
     /* a manifest says "complete": an older one must not vouch for the files this render replaces */
     if (segment && unlink(seg_manifest) != 0 && errno != ENOENT) {
         rs_fail(&err, 1, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
@@ -445,8 +550,7 @@ int cmd_render(int argc, char **argv)
     }
     if (!job_audio_plan(&audio, &sink, &rp, replay, t_first, t_end, &err))
         goto done;
-    p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err);
-    if (!p) {
+    if (!p && !(p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err))) {
         status = cli_plat_status(&err);
         goto done;
     }

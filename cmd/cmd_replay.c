@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "job_poster.h"
 #include "../runtime/audio/au.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_progress.h"
@@ -90,6 +91,11 @@ static int info(const char *path)
     printf("input ticks  P1 %" PRIu64 ", P2 %" PRIu64 " (ticks with a button or direction held)\n", active[0], active[1]);
     printf("checkpoints  %zu, every %d ticks\n", rp.ncheck, rp.interval);
     printf("final hash   %016" PRIx64 "\n", rp.final_hash);
+    if (rp.ticks > 0) { /* the frame render --poster writes (simulates the match: about 1 ms a minute of it) */
+        int why;
+        uint64_t t = job_poster_tick(&rp, &why);
+        printf("poster       frame %" PRIu64 " (%s)\n", t, job_poster_why_name(why));
+    }
     rp_free(&rp);
     return RS_EXIT_OK;
 }

@@ -180,8 +180,11 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
             add(&a, "--segment");
             add(&a, j->key);
         }
-        const char *const tail[] = {"-y", "-o", f->out, "--size", size, "--hashes", f->hashes,
-                                    "--poster", f->poster, "--progress-fd", "3", "--progress", "off", "--backend", cfg->backend};
+        /* the daemon's workers and segments are its parallelism: a render
+         * splits itself (render --jobs auto) only as the machine's one worker */
+        const char *jobs = cfg->workers == 1 && j->unit.kind != SVC_UNIT_SEGMENT ? "auto" : "1";
+        const char *const tail[] = {"-y", "-o", f->out, "--size", size, "--hashes", f->hashes, "--poster", f->poster,
+                                    "--progress-fd", "3", "--progress", "off", "--backend", cfg->backend, "--jobs", jobs};
         for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
             add(&a, tail[i]);
         if (cfg->render_width) { /* the operator's fixed size; else the job's quality decides */
