@@ -14,13 +14,16 @@ out vec4 o_c;
 
 void main()
 {
-    int w = u_size.x, cw = u_size.x / 2, nc = cw * (u_size.y / 2);
-    int j = (int(gl_FragCoord.y) - u_size.y) * w + int(gl_FragCoord.x);
-    bool cr = j >= nc;
+    // j = y * w + x with w = 2 cw: row j / cw = 2y + (x >= cw), no division
+    // (a software rasteriser has no vector integer divide)
+    int cw = u_size.x / 2, ch = u_size.y / 2;
+    ivec2 q = ivec2(gl_FragCoord.xy) - ivec2(0, u_size.y);
+    bool right = q.x >= cw;
+    int row = 2 * q.y + (right ? 1 : 0);
+    bool cr = row >= ch;
     if (cr)
-        j -= nc;
-    int row = j / cw;
-    ivec2 p = ivec2(j - row * cw, row) * 2;
+        row -= ch;
+    ivec2 p = ivec2(right ? q.x - cw : q.x, row) * 2;
     int dy = 1;
     if (u_flip > 0) { // image rows 2k, 2k+1 are GL rows h-1-2k, h-2-2k
         p.y = u_flip - 1 - p.y;
