@@ -130,6 +130,8 @@ static void run_map(void *u)
     r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
                       .far = ls->focus.range > 0 ? ls->focus.range : R_LSPSM_LIMIT, .uniform = ls->uniform};
     r_lspsm_build(&d, &ls->s);
+    if (f->depth_only) /* a warm-up frame: the focus above is the history; the map only shades */
+        return;
 
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);
     gl.Viewport(0, 0, ls->map, ls->map);
@@ -177,6 +179,16 @@ static void run_buildings(void *u)
     r_game *r = u;
     struct fx_lspsm_state *ls = LSPSM(r);
     r_begin_opaque(r);
+    if (r->f.depth_only) { /* a warm-up frame: their depth, for the focus (r_local.h) */
+        GLuint d = r->prog[P_DEPTH];
+        gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        r_camera_uniforms(r, d);
+        gl.BindVertexArray(ls->city_vao);
+        gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
+        gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        gl.Disable(GL_CULL_FACE);
+        return;
+    }
     GLuint p = r_stage_program(r, R_MAT_BUILDING);
     /* the fighters' blurred silhouette stops short of the buildings: this
      * map casts them there (u_shadows 0 counts its fighter texels) */

@@ -663,6 +663,7 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     frame *f = &r->f;
     memset(f, 0, sizeof *f);
     f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = w, f->h = h, f->out_fbo = out;
+    f->depth_only = skip != 0; /* only r_game_advance skips: a warm-up frame */
     r_frame_setup(r, f);
     r->mask_final = 0;
     r_graph_run_skip(&r->graph, r, skip);

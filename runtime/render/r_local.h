@@ -83,6 +83,10 @@ typedef struct frame {
     bool reset;  /* the sequence broke (first frame, seek, new stage): restart simulations */
     r_mat4 view, proj, view_prev; /* the camera now and at prev->tick (afterimages); vp = proj * view */
     float bones_prev[2][16][16], bones_tick[2][16][16]; /* at prev->tick and cur->tick, not interpolated */
+    /* a warm-up frame (r_game_advance drawing for an effect's history): the
+     * scene's depth is all that history reads (LSPSM's focus), so the
+     * scene passes draw depth alone and the light-space maps are not drawn */
+    bool depth_only;
 } frame;
 
 struct r_game {

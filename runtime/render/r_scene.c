@@ -51,6 +51,19 @@ static void run_scene(void *u)
     if (!r_fx_scene_cleared(r))
         gl.Clear(GL_COLOR_BUFFER_BIT | (prepass ? 0 : GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT));
 
+    if (f->depth_only) { /* a warm-up frame: the depth, with no shading (r_local.h) */
+        GLuint d = r->prog[P_DEPTH];
+        gl.DepthFunc(GL_LEQUAL);
+        gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        r_camera_uniforms(r, d);
+        r_draw_fighters(r, d);
+        gl.DepthFunc(GL_LESS);
+        gl.BindVertexArray(r->ring_vao);
+        if (!r_fx_draw_ring(r))
+            gl.DrawElements(GL_TRIANGLES, r->ring_count, GL_UNSIGNED_INT, NULL);
+        gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        return;
+    }
     /* fighters: over their own z-prepass depth when it ran */
     GLuint p = r->prog[P_FIGHTER];
     gl.DepthFunc(prepass ? GL_LEQUAL : GL_LESS);
