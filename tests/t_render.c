@@ -140,8 +140,12 @@ void t_stage_extremes(r_stage *st)
 }
 
 /* One picture of a demo with its stage file, the way render makes it:
- * the frames of the `history` ticks before it are drawn first, so the
- * stage effects' simulations (docs/effects.md) have that much past. */
+ * the `history` ticks before it are advanced first (r_game_advance: the
+ * stage effects' simulations step, and a frame is drawn only where an
+ * effect needs it, as render's warm-up does), so the simulations
+ * (docs/effects.md) have that much past.  The effect contract makes this
+ * the picture drawing every one of those frames gives (test_fx_history
+ * holds it to that), for a fraction of the time. */
 void t_picture(const char *demo, uint64_t tick, uint64_t history, const r_game_opts *o, int w, int h, uint8_t *px)
 {
     g_state prev, cur;
@@ -155,8 +159,10 @@ void t_picture(const char *demo, uint64_t tick, uint64_t history, const r_game_o
     r_game *r = t_game_opts(o);
     t_fb f;
     t_fb_make(&f, w, h);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, f.fbo);
     for (uint64_t t = first; t < tick; t++) {
-        t_draw_read(r, &f, &prev, &cur, w, h, NULL, true);
+        T_ASSERTF(r_game_advance(r, &prev, &cur, w, h, tick - t, NULL), "advancing tick %llu: %s", (unsigned long long)t,
+                  r_game_error(r));
         prev = cur;
         g_step(&cur, &rp.inputs[2 * t], NULL);
     }

@@ -33,9 +33,10 @@ void t_draw(struct r_game *r, const t_fb *f, const g_state *prev, const g_state 
  * top row first when top_down, else as GL reads them (bottom row first). */
 void t_draw_read(struct r_game *r, const t_fb *f, const g_state *prev, const g_state *cur, int w, int h, uint8_t *px,
                  bool top_down);
-/* One w x h picture of demo at tick the way render makes it: the frames of
- * the `history` ticks before it drawn first (the effects' simulations have
- * that much past), with options o (NULL: default); RGBA top row first. */
+/* One w x h picture of demo at tick the way render makes it: the `history`
+ * ticks before it advanced first (the effects' simulations have that much
+ * past; r_game_advance draws a frame only where an effect needs it), with
+ * options o (NULL: default); RGBA top row first. */
 void t_picture(const char *demo, uint64_t tick, uint64_t history, const struct r_game_opts *o, int w, int h,
                uint8_t *px);
 /* Did the pass run in the frame drawn last (fails the test on a bad name)? */
