@@ -9,6 +9,7 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../runtime/platform/plat.h"
@@ -112,12 +113,14 @@ static int run_inline(void (*fn)(void))
     return jump_code;
 }
 
+/* An argument selects the cases whose names contain it, or with a leading
+ * '=' the case of exactly that name (tests/run.sh's tiers use these). */
 static bool selected(const char *name, int argc, char **argv)
 {
     if (argc < 2)
         return true;
     for (int i = 1; i < argc; i++)
-        if (strstr(name, argv[i]))
+        if (argv[i][0] == '=' ? !strcmp(name, argv[i] + 1) : strstr(name, argv[i]) != NULL)
             return true;
     return false;
 }
@@ -146,6 +149,8 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
         if (!selected(cases[i].name, argc, argv))
             continue;
         fflush(stdout);
+        struct timespec t0, t1;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
         int code;
         const char *why = "";
         char whybuf[64];
@@ -191,15 +196,19 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
             rm_tree(tmpdir);
             tmpdir[0] = 0;
         }
+        /* each verdict line ends with the case's wall time: tests/run.sh
+         * sums them into the slowest-cases table */
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        double secs = (double)(t1.tv_sec - t0.tv_sec) + (double)(t1.tv_nsec - t0.tv_nsec) / 1e9;
         if (code == 0) {
             pass++;
-            printf("ok   %s/%s\n", suite, cases[i].name);
+            printf("ok   %s/%s (%.2f s)\n", suite, cases[i].name, secs);
         } else if (code == T_SKIP_CODE) {
             skip++;
-            printf("skip %s/%s\n", suite, cases[i].name);
+            printf("skip %s/%s (%.2f s)\n", suite, cases[i].name, secs);
         } else {
             fail++;
-            printf("FAIL %s/%s%s\n", suite, cases[i].name, why);
+            printf("FAIL %s/%s%s (%.2f s)\n", suite, cases[i].name, why, secs);
         }
         fflush(stdout);
     }

@@ -5,7 +5,7 @@
  *
  * Each case runs in a forked child (a crash or a hang fails that case only;
  * T_NOFORK=1 runs in-process for gdb).  A binary runs alone:
- *   build/tests/test_shader [NAME-SUBSTRING...]
+ *   build/tests/test_shader [NAME-SUBSTRING... | =EXACT-NAME...]
  * and ends with "N passed, N failed, N skipped"; tests/run.sh sums them. */
 #ifndef T_H
 #define T_H

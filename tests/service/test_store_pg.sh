@@ -32,7 +32,7 @@ t_store_contract() {
         echo "pg_ cases skipped although a server was running"
         return 1
     fi
-    grep -q '^ok .*/pg_roundtrip$' out.txt || { echo "pg_roundtrip did not run"; return 1; }
+    grep -q '^ok .*/pg_roundtrip ' out.txt || { echo "pg_roundtrip did not run"; return 1; }
     return 0
 }
 
