@@ -12,7 +12,7 @@
 
 static void help(void)
 {
-    printf("usage: ringside shaders [--backend egl|osmesa|glfw] [--quiet]\n\n"
+    printf("usage: ringside shaders [--backend egl|osmesa|glfw] [--quiet] [--emit DIR]\n\n"
            "Compiles every .vert, .frag, .geom and .comp file in the shaders directory\n"
            "(found through RINGSIDE_DATA, the source tree or the install prefix) and\n"
            "prints each error as shaders/FILE:LINE: message.  .glsl files are include\n"
@@ -21,7 +21,11 @@ static void help(void)
            "and then '#define B 1' and '#define C 1' ('-' is the variant with none).\n"
            "Exit status 1 if any shader fails.\n\n"
            "  --backend B   GL backend (default egl, falling back to osmesa)\n"
-           "  --quiet       print only failures\n");
+           "  --quiet       print only failures\n"
+           "  --emit DIR    compile nothing: write each variant's whole source, as the\n"
+           "                driver is given it (includes and defines in place), to\n"
+           "                DIR/NAME.VARIANT.EXT, for another compiler (the tests run\n"
+           "                the Khronos reference compiler, glslangValidator, on them)\n");
 }
 
 static int by_name(const void *a, const void *b)
@@ -29,14 +33,54 @@ static int by_name(const void *a, const void *b)
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
+/* --emit: every variant's source, expanded, to dir/NAME.VARIANT.EXT; frees names */
+static int emit_all(const char *root, char **names, int n, const char *dir, bool quiet)
+{
+    int failed = 0, written = 0;
+    for (int i = 0; i < n; i++) {
+        char *vars = r_shader_variants(root, names[i]);
+        const char *v = vars ? vars : "-";
+        char defs[512], var[128];
+        const char *dot = strrchr(names[i], '.');
+        int base = dot ? (int)(dot - names[i]) : (int)strlen(names[i]);
+        while (r_shader_next_variant(&v, defs, sizeof defs, var, sizeof var)) {
+            char path[1400];
+            snprintf(path, sizeof path, "%s/%.*s.%s%s", dir, base, names[i], strcmp(var, "-") ? var : "default",
+                     dot ? dot : "");
+            r_src src = {0};
+            rs_err err = {0};
+            FILE *f = NULL;
+            bool ok = r_src_build(&src, root, names[i], defs[0] ? defs : NULL, &err) && (f = fopen(path, "w")) &&
+                      fwrite(src.text, 1, src.len, f) == src.len;
+            if (f && fclose(f) != 0)
+                ok = false;
+            if (!ok) {
+                failed++;
+                printf("FAILED  %s: %s\n", path, err.msg[0] ? err.msg : "cannot write");
+            } else {
+                written++;
+                if (!quiet)
+                    printf("wrote   %s\n", path);
+            }
+            r_src_free(&src);
+        }
+        free(vars);
+        free(names[i]);
+    }
+    printf("%d shader files, %d variants written to %s, %d failed\n", n, written, dir, failed);
+    return failed ? RS_EXIT_FAIL : RS_EXIT_OK;
+}
+
 int cmd_shaders(int argc, char **argv)
 {
     static const struct option opts[] = {{"backend", required_argument, 0, 'b'},
                                          {"quiet", no_argument, 0, 'q'},
                                          {"help", no_argument, 0, 'h'},
+                                         {"emit", required_argument, 0, 'e'},
                                          {0}};
     plat_desc d = {.hidden = true};
     bool quiet = false;
+    const char *emit = NULL;
     int c;
     optind = 1;
     opterr = 0;
@@ -44,6 +88,7 @@ int cmd_shaders(int argc, char **argv)
         switch (c) {
         case 'b': d.backend = optarg; break;
         case 'q': quiet = true; break;
+        case 'e': emit = optarg; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("shaders", argv);
         }
@@ -82,6 +127,8 @@ int cmd_shaders(int argc, char **argv)
     }
     closedir(dp);
     qsort(names, (size_t)n, sizeof names[0], by_name);
+    if (emit)
+        return emit_all(root, names, n, emit, quiet);
 
     plat *p = plat_create(&d, &err);
     if (!p) {

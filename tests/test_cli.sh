@@ -104,6 +104,28 @@ t_shader_variants_all_compile() {
     grep -q "shaders/light_depth.frag:[0-9]*: error" sh.txt || { cat sh.txt; return 1; }
 }
 
+# every variant as the Khronos reference compiler sees it: GLSL that llvmpipe
+# tolerates and a stricter driver (NVIDIA's) would refuse fails here first
+t_shaders_valid_for_glslang() {
+    command -v glslangValidator >/dev/null 2>&1 || t_skip_case "glslangValidator not installed (glslang-tools; tools/deps.sh test)"
+    mkdir emit
+    "$RS_BIN" shaders --emit emit --quiet >sh.txt 2>&1 || { cat sh.txt; return 1; }
+    grep -q "variants written to emit, 0 failed" sh.txt || { cat sh.txt; return 1; }
+    n=0
+    for f in emit/*; do
+        glslangValidator "$f" >v.txt 2>&1 || { echo "$f:"; cat v.txt; return 1; }
+        n=$((n + 1))
+    done
+    [ "$n" -ge 70 ] || { echo "only $n variants written"; ls emit; return 1; }
+    # and an error in one variant only is found there
+    data_copy
+    sed 's/^#ifdef SILHOUETTE$/#ifdef SILHOUETTE\nint broken = ;/' "$SRC/shaders/light_depth.frag" >data/shaders/light_depth.frag
+    rm -rf emit && mkdir emit
+    "$RS_BIN" shaders --emit emit --quiet >sh.txt 2>&1 || { cat sh.txt; return 1; }
+    glslangValidator emit/light_depth.default.frag >v.txt 2>&1 || { cat v.txt; return 1; }
+    ! glslangValidator emit/light_depth.SILHOUETTE.frag >v.txt 2>&1 || { echo "the broken variant passed"; return 1; }
+}
+
 t_wrong_picture_is_caught() {
     data_copy
     sed 's/o_color = u_color;/o_color = u_color.bgra;/' "$SRC/shaders/smoke.frag" >data/shaders/smoke.frag
@@ -122,7 +144,7 @@ t_bench_platform() {
     expect_fail 2 "unknown benchmark 'gpu'" "$RS_BIN" bench gpu || return 1
 }
 
-t_run help usage_errors shader_variants_all_compile info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
+t_run help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
     smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
     bench_platform
 t_done

@@ -23,8 +23,9 @@ group_pkgs() {
     # presses keys in that window to prove a person can play; ffprobe (in
     # ffmpeg) is the independent player that checks our videos; xz packs the
     # GPU bundle (tools/gpu-bundle.sh, tests/test_gpu_bundle.sh); sox measures
-    # and compares the soundtracks in the audio tests
-    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox" ;;
+    # and compares the soundtracks in the audio tests; glslangValidator (the
+    # Khronos reference compiler) checks every shader variant
+    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox glslang-tools" ;;
     # make test-service: a real PostgreSQL server for the two-daemon test,
     # Debian's Chromium for the dashboard test (driven by playwright-core from npm)
     service) echo "postgresql chromium" ;;
