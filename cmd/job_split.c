@@ -410,7 +410,11 @@ int job_split_run(const job_split_desc *d, rs_err *err)
         goto done;
     }
     if (stopped) {
-        rs_fail(err, 1, "%s: interrupted; the partial output was removed", d->out);
+        uint64_t done = 0;
+        for (int i = 0; i < started; i++)
+            done += cs[i].done;
+        rs_fail(err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed", d->out, done,
+                total);
         goto done;
     }
     if (failed < started) {

@@ -72,7 +72,7 @@ t_interrupted() {
     wait $pid
     rc=$?
     [ "$rc" = 1 ] || { echo "exit $rc"; cat err.txt; return 1; }
-    grep -q 'x.mp4: interrupted; the partial output was removed' err.txt || { cat err.txt; return 1; }
+    grep -q 'x.mp4: interrupted at frame [0-9]* of 1200; the partial output was removed' err.txt || { cat err.txt; return 1; }
     sleep 0.5
     [ ! -e x.mp4 ] && nothing_left
 }
