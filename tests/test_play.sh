@@ -6,17 +6,19 @@ here=$(cd "$(dirname "$0")" && pwd)
 SRC=$(cd "$here/.." && pwd)
 
 t_watch_headless() {
-    "$RS_BIN" play --headless --replay "$SRC/demos/harbor.rsr" --size 160x90 --screenshot s.png 2>e.txt ||
+    # a 10 s match of the CPU players, watched to its end
+    "$RS_BIN" record --ai --seconds 10 --seed 4 --quiet -o w.rsr 2>/dev/null || return 1
+    "$RS_BIN" play --headless --replay w.rsr --size 160x90 --screenshot s.png 2>e.txt ||
         { cat e.txt; return 1; }
-    ticks=$("$RS_BIN" replay info "$SRC/demos/harbor.rsr" | sed -n 's/^duration *\([0-9]*\) ticks.*/\1/p')
+    ticks=$("$RS_BIN" replay info w.rsr | sed -n 's/^duration *\([0-9]*\) ticks.*/\1/p')
     grep -q "^ringside play: $ticks ticks .* $ticks frames, 0 late ticks" e.txt || { cat e.txt; return 1; }
     [ -s s.png ] || return 1
 }
 
 t_play_records_what_record_records() {
     # the CPU players of play and of record are the same program: same file
-    "$RS_BIN" play --headless --p1 cpu --p2 cpu --seconds 20 --seed 9 --size 64x36 --record p.rsr -q || return 1
-    "$RS_BIN" record --ai --seconds 20 --seed 9 --quiet -o r.rsr 2>/dev/null || return 1
+    "$RS_BIN" play --headless --p1 cpu --p2 cpu --seconds 8 --seed 9 --size 64x36 --record p.rsr -q || return 1
+    "$RS_BIN" record --ai --seconds 8 --seed 9 --quiet -o r.rsr 2>/dev/null || return 1
     cmp p.rsr r.rsr || { echo "play --record and record differ"; return 1; }
     "$RS_BIN" replay verify --quiet p.rsr 2>/dev/null || return 1
 }

@@ -29,10 +29,15 @@ same() {
     }
 }
 
+# draft: the history is the same code at any quality, for less fixed cost a
+# frame.  Only plaza needs to start past tick 228 (LSPSM's window, so its
+# warm-up starts mid-replay); the others' history runs from tick 0 or not at
+# all, which tick 60 shows as well as 240
 t_every_demo_from_a_mid_tick() {
-    for demo in dojo harbor temple shallows snowfield mistvale plaza quarry; do
-        same "$demo" "$A" "$B" --size 160x90 --render-size 160x90 || return 1
+    for demo in dojo harbor temple shallows snowfield mistvale quarry; do
+        same "$demo" 60 63 --size 160x90 --render-size 160x90 --quality draft || return 1
     done
+    same plaza "$A" "$B" --size 160x90 --render-size 160x90 --quality draft
 }
 
 # another size, a downscale, the sequential capture (CPU downscale)
