@@ -4,7 +4,8 @@
 #   make test       build and run every test; ends with "N passed, N failed, N skipped"
 #   make test-service  the service end to end (PostgreSQL, Chromium; docs/service.md)
 #   make check-layers  fail if a lower layer includes a higher one (make test runs it too)
-#   make asan       the test suite again under AddressSanitizer + UBSan (build-asan/)
+#   make asan       the suites and cases of tests/asan.tier under AddressSanitizer +
+#                   UBSan (build-asan/; docs/testing.md); make asan-all: every suite
 #   make debug      -O0 build with GL error checks in build-debug/
 #   make demo       the main job on the bundled default (see README)
 #   make bench      benchmarks
@@ -95,7 +96,7 @@ MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 check-layers:
 	@tools/check-layers.sh
 
-.PHONY: check-layers all test test-service asan debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
+.PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -176,14 +177,18 @@ $(BUILD)/tests/simhash-clang: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/rep
 
 # --- tests ---
 test: $(STAMPS)/test $(STAMPS)/man $(BUILD)/ringside $(TEST_BIN) $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2 $(SIMHASH_CLANG)
-	@tests/run.sh $(BUILD) $(T)
+	@$(if $(TIER),RS_TIER=$(TIER) )tests/run.sh $(BUILD) $(T)
 
 # the service end to end: real HTTP, SQLite, a PostgreSQL server started by
 # the tests, headless Chromium on the dashboard (docs/service.md)
 test-service: $(STAMPS)/test $(STAMPS)/service $(BUILD)/ringside $(BUILD)/tests/test_svc_store $(BUILD)/tests/simhash-O2
 	@RS_SUITE=service tests/run.sh $(BUILD) $(T)
 
+# the sanitizers on what finds our memory bugs (tests/asan.tier, docs/testing.md);
+# asan-all: on every suite
 asan:
+	@$(MAKE) --no-print-directory BUILD=build-asan SAN=1 TIER=asan test
+asan-all:
 	@$(MAKE) --no-print-directory BUILD=build-asan SAN=1 test
 
 debug:
