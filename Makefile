@@ -70,12 +70,13 @@ $(shell mkdir -p $(BUILD) && (echo '$(FLAGS_SIG)' | cmp -s - $(BUILD)/flags || e
 endif
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(CONF_CFLAGS) $(EXTRA_CFLAGS)
-# the one C++ file: OpenImageIO's C face (runtime/util/rs_oiio.cpp)
+# the one C++ file: OpenImageIO's plugin (runtime/util/rs_oiio_plugin.cpp),
+# BUILD/ringside-oiio.so, loaded when an image file is first read or written
 CXX     ?= g++
 SAN_CXX := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP $(OPT) $(CONF_CFLAGS) $(if $(filter 1,$(WERROR)),-Werror) \
+CXXFLAGS = -std=c++17 -Wall -Wextra -g -MMD -MP -fPIC $(OPT) $(CONF_CFLAGS) $(if $(filter 1,$(WERROR)),-Werror) \
            $(if $(filter 1,$(SAN)),$(SAN_CXX))
-LDLIBS  = $(CONF_LIBS) -lstdc++ -lm -lpthread -ldl
+LDLIBS  = $(CONF_LIBS) -lm -lpthread -ldl
 LDFLAGS += $(LDFLAGS_SAN)
 
 LIB_SRC := $(wildcard runtime/*.c runtime/*/*.c capture/*.c player/*.c service/*.c) \
@@ -84,8 +85,8 @@ MAIN_SRC := cmd/main.c
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
-LIB_CXX  := $(wildcard runtime/util/*.cpp)
-LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX))
+LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+OIIO_PLUGIN := $(if $(filter oiio,$(CONF_BACKENDS)),$(BUILD)/ringside-oiio.so)
 # the announcer's clips, embedded in the binary (runtime/audio/au_voice_data.S)
 VOICE_OBJ := $(BUILD)/obj/runtime/audio/au_voice_data.o
 LIB_OBJ  += $(VOICE_OBJ)
@@ -101,7 +102,7 @@ check-layers:
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
 
-all: $(BUILD)/ringside
+all: $(BUILD)/ringside $(OIIO_PLUGIN)
 
 # --- dependencies: stamped per group, so a second run is a file compare ---
 $(STAMPS)/build: tools/deps.sh
@@ -135,14 +136,18 @@ $(BUILD)/libringside.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(BUILD)/ringside: $(MAIN_OBJ) $(BUILD)/libringside.a
+# the plugin is order-only: whatever runs the program finds it built
+$(BUILD)/ringside: $(MAIN_OBJ) $(BUILD)/libringside.a | $(OIIO_PLUGIN)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/ringside-oiio.so: $(BUILD)/obj/runtime/util/rs_oiio_plugin.o
+	$(CXX) -shared $(LDFLAGS) -o $@ $^ $(CONF_OIIO_LIBS)
 
 $(BUILD)/obj/tests/%.o: tests/%.c $(BUILD)/config.mk $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -DRS_SOURCE_DIR='"$(CURDIR)"' -c $< -o $@
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(BUILD)/obj/tests/t.o $(BUILD)/obj/tests/t_render.o $(BUILD)/libringside.a
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(BUILD)/obj/tests/t.o $(BUILD)/obj/tests/t_render.o $(BUILD)/libringside.a | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
@@ -239,7 +244,8 @@ $(BUILD)/dist/ringside.conf.example: $(BUILD)/ringside tools/example-conf.sh
 
 # --- install ---
 # Where the files go under PREFIX (and DESTDIR, for packagers):
-#   bin/ringside; share/ringside/{shaders,demos,stages,service}: what it reads at run time
+#   bin/ringside; lib/ringside/ringside-oiio.so (OpenImageIO, loaded when used);
+#   share/ringside/{shaders,demos,stages,service}: what it reads at run time
 #   share/man/man1, man5; share/bash-completion/completions/ringside
 #   lib/systemd/system/ringside.service (SYSTEMD_UNIT_DIR: /lib/systemd/system for PREFIX=/usr)
 #   share/doc/ringside: README.md, docs/, ringside.conf.example
@@ -258,6 +264,7 @@ install: $(BUILD)/ringside man
 	    $(MAN_DIR)/man1 $(MAN_DIR)/man5 $(COMPL_DIR) $(DESTDIR)$(SYSTEMD_UNIT_DIR) $(DOC_DIR)/docs \
 	    $(DESTDIR)$(SYSCONFDIR)/ringside
 	install -m 755 $(BUILD)/ringside $(DESTDIR)$(PREFIX)/bin/ringside
+	$(if $(OIIO_PLUGIN),install -d $(DESTDIR)$(PREFIX)/lib/ringside && install -m 644 $(OIIO_PLUGIN) $(DESTDIR)$(PREFIX)/lib/ringside/)
 	install -m 644 shaders/* $(DATA_DIR)/shaders/
 	install -m 644 demos/*.rsr $(DATA_DIR)/demos/
 	install -m 644 stages/*.stage $(DATA_DIR)/stages/
@@ -275,6 +282,7 @@ install: $(BUILD)/ringside man
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/ringside
+	rm -rf $(DESTDIR)$(PREFIX)/lib/ringside
 	rm -rf $(DESTDIR)$(PREFIX)/share/ringside $(DESTDIR)$(PREFIX)/share/doc/ringside
 	rm -f $(MAN_DIR)/man1/ringside.1 $(MAN_DIR)/man1/ringside-*.1 $(MAN_DIR)/man5/ringside.conf.5
 	rm -f $(COMPL_DIR)/ringside $(DESTDIR)$(SYSTEMD_UNIT_DIR)/ringside.service

@@ -59,6 +59,9 @@ static bool img_open(cap_sink *s, rs_err *err)
         if (*c >= 'A' && *c <= 'Z')
             *c = (char)(*c - 'A' + 'a');
     s->impl = q;
+    rs_err oerr = {0};
+    if (!rs_oiio_ready(&oerr)) /* OpenImageIO is loaded when first used: here, before any frame */
+        return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: %s", s->path, oerr.msg);
     char first[1100];
     frame_path(s, 0, first, sizeof first);
     /* the folder must exist, as for every output kind (rs_out.h); whether

@@ -45,6 +45,8 @@ static void usage(FILE *f)
                "                         $XDG_CACHE_HOME/ringside or ~/.cache/ringside; off: no cache)\n"
                "  RINGSIDE_GL_DEBUG=1    GL debug messages on stderr\n"
                "  RINGSIDE_EGL_DEVICE=N  the EGL device to use (default: the first that works)\n"
+               "  RINGSIDE_OIIO_PLUGIN   OpenImageIO's plugin, loaded for image files (default:\n"
+               "                         ringside-oiio.so beside the binary or in ../lib/ringside)\n"
                "\nexit status: 0 success, 1 failure, 2 bad usage (join: 3, a bad segment)\n"
                "docs: 'man ringside-COMMAND'; README.md and docs/ (installed in share/doc/ringside)\n",
             plat_built_backends());

@@ -10,9 +10,12 @@
 #                                         PREFIX.suites and PREFIX.cases
 set -u
 # One X server for the whole run, so the GLFW backend is tested too; tests
-# that need "no display" unset DISPLAY themselves.
+# that need "no display" unset DISPLAY themselves.  xvfb-run -a takes the
+# first free display from RS_XVFB_FROM (99): two runs started at once (CI's
+# asan and service phases) look from different numbers, or both may take
+# the same one.
 if [ -z "${DISPLAY:-}" ] && [ -z "${RS_IN_XVFB:-}" ] && command -v xvfb-run >/dev/null 2>&1; then
-    RS_IN_XVFB=1 exec xvfb-run -a -s "-screen 0 1280x1024x24 -nolisten tcp" sh "$0" "$@"
+    RS_IN_XVFB=1 exec xvfb-run -n "${RS_XVFB_FROM:-99}" -a -s "-screen 0 1280x1024x24 -nolisten tcp" sh "$0" "$@"
 fi
 build=${1:-build}
 only=${2:-}
@@ -56,7 +59,8 @@ for t in "$@"; do
     # a tier: the suite's line of the tier file ("SUITE all" or "SUITE CASE..."), or not at all
     cases=all
     if [ -n "$tier" ]; then
-        cases=$(awk -v s="$(basename "$t")" '$1 == s { $1 = ""; sub(/^ +/, ""); print; found = 1 } END { if (!found) print "-" }' "$tier")
+        cases=$(awk -v s="$(basename "$t")" '{ sub(/#.*/, "") } $1 == s { $1 = ""; sub(/^ +/, ""); sub(/ +$/, ""); print; found = 1 }
+            END { if (!found) print "-" }' "$tier")
         if [ "$cases" = "-" ]; then
             left_out="$left_out $(basename "$t")"
             continue
@@ -83,9 +87,12 @@ for t in "$@"; do
     secs=$(awk -v a="$t0" -v b="$(date +%s%N)" 'BEGIN { printf "%.1f", (b - a) / 1e9 }')
     echo "$secs $(basename "$t") $(grep -cE '^(ok  |skip|FAIL) ' "$log")" >>"$times/suites"
     sed -n 's/^\(ok  \|skip\|FAIL\) *\([^ ]*\).* (\([0-9.]*\) s)$/\3 \2/p' "$log" >>"$times/cases"
-    [ "$rc" = 124 ] && echo "FAIL $name: timed out after 20 minutes" >>"$log"
+    # 124: timed out; 137: killed when it would not stop
+    timed_out=0
+    [ "$rc" = 124 ] || [ "$rc" = 137 ] && timed_out=1
+    [ "$timed_out" = 0 ] || echo "FAIL $name: timed out after 20 minutes" >>"$log"
     # a tier that names a case the suite no longer has must not pass quietly
-    if [ "$cases" != all ] && [ "$rc" != 124 ]; then
+    if [ "$cases" != all ] && [ "$timed_out" = 0 ]; then
         n_ran=$(grep -cE '^(ok  |skip|FAIL) ' "$log")
         n_named=$(echo "$cases" | wc -w)
         [ "$n_ran" = "$n_named" ] || {
@@ -113,6 +120,13 @@ done
 if [ "$ran" = 0 ]; then
     echo "FAIL: no test matched '${only}' (tests are named test_<module>)"
     fail=$((fail + 1))
+fi
+# a tier that names a suite there is not must not pass quietly either
+if [ -n "$tier" ] && [ -z "$only" ]; then
+    for s in $(sed 's/#.*//' "$tier" | awk 'NF { print $1 }'); do
+        [ -e "$here/$s" ] || [ -e "$build/tests/$s" ] ||
+            { echo "FAIL: tests/$RS_TIER.tier names $s, which is no suite"; fail=$((fail + 1)); }
+    done
 fi
 [ -z "$left_out" ] || echo "not in the $RS_TIER tier (tests/$RS_TIER.tier; they run in make test):$left_out"
 # the tables: every suite by time, then the slowest cases

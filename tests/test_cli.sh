@@ -144,7 +144,34 @@ t_bench_platform() {
     expect_fail 2 "unknown benchmark 'gpu'" "$RS_BIN" bench gpu || return 1
 }
 
-t_run help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
+# OpenImageIO is a plugin (runtime/util/rs_oiio.h): its ~260 libraries are
+# not loaded until an image file is read or written; without the plugin an
+# image sequence is refused before its first frame, saying where to put it,
+# and a video still renders
+t_oiio_loaded_when_used() {
+    [ -f "$(dirname "$RS_BIN")/ringside-oiio.so" ] || t_skip_case "this build has no OpenImageIO plugin"
+    if ldd "$RS_BIN" | grep OpenImageIO; then echo "ringside links OpenImageIO"; return 1; fi
+    LD_DEBUG=files "$RS_BIN" render --help >/dev/null 2>ld.txt || return 1
+    if grep -m1 "file=libOpenImageIO" ld.txt; then echo "render --help loaded OpenImageIO"; return 1; fi
+    r="$SRC/demos/dojo.rsr --ticks 0:2 --size 64x36 --render-size 64x36 --quiet"
+    # shellcheck disable=SC2086
+    LD_DEBUG=files "$RS_BIN" render $r -o "f%02d.png" 2>ld.txt || { grep -v "^ *[0-9]*:" ld.txt; return 1; }
+    [ -s f00.png ] && [ -s f01.png ] || { echo "no frames"; return 1; }
+    grep -q "file=libOpenImageIO" ld.txt || { echo "an image sequence without OpenImageIO loaded?"; return 1; }
+    # shellcheck disable=SC2086
+    RINGSIDE_OIIO_PLUGIN=$PWD/none.so expect_fail 1 "g%02d.png: OpenImageIO: RINGSIDE_OIIO_PLUGIN=$PWD/none.so: no such file" \
+        "$RS_BIN" render $r -o "g%02d.png" || return 1
+    if ls g* 2>/dev/null; then echo "frames left"; return 1; fi
+    # shellcheck disable=SC2086
+    RINGSIDE_OIIO_PLUGIN=$PWD/none.so "$RS_BIN" render $r -o v.y4m || return 1
+    # a file that is no plugin of ours
+    cp "$RS_BIN" notaplugin.so
+    # shellcheck disable=SC2086
+    RINGSIDE_OIIO_PLUGIN=$PWD/notaplugin.so expect_fail 1 "OpenImageIO: RINGSIDE_OIIO_PLUGIN=$PWD/notaplugin.so: " \
+        "$RS_BIN" render $r -o "h%02d.png" || return 1
+}
+
+t_run oiio_loaded_when_used help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
     smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
     bench_platform
 t_done

@@ -46,6 +46,13 @@ t_install_and_uninstall() {
     env -u RINGSIDE_DATA "$p/bin/ringside" smoke --size 32x32 -o i.png 2>/dev/null || return 1
     env -u RINGSIDE_DATA "$p/bin/ringside" render "$p/share/ringside/demos/temple.rsr" --ticks 60:62 \
         --size 64x36 --render-size 128x72 -q -o r.y4m >o.txt 2>&1 || { cat o.txt; return 1; }
+    # and OpenImageIO's plugin in lib/ringside (image sequences), when this build has one
+    if [ -f "$(dirname "$RS_BIN")/ringside-oiio.so" ]; then
+        [ -s "$p/lib/ringside/ringside-oiio.so" ] || { echo "not installed: lib/ringside/ringside-oiio.so"; return 1; }
+        mkdir seq && env -u RINGSIDE_OIIO_PLUGIN "$p/bin/ringside" render "$p/share/ringside/demos/temple.rsr" \
+            --ticks 60:62 --size 64x36 --render-size 64x36 -q -o seq/f%02d.png >o.txt 2>&1 || { cat o.txt; return 1; }
+        [ -s seq/f61.png ] || { echo "no PNG frames from the installed binary:"; ls seq; return 1; } # frames by tick
+    fi
     if command -v man >/dev/null; then
         MANPATH="$p/share/man" man -w ringside-render | grep -qx "$p/share/man/man1/ringside-render.1" || return 1
     fi

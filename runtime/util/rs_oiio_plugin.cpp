@@ -1,6 +1,16 @@
-// OpenImageIO behind a C interface (see rs_oiio.h).  Kept to what ringside
-// needs: a reference resize, image files for sequences, and float images
-// for image-based lighting (runtime/render/r_ibl.c).
+// OpenImageIO behind a C interface, built as a plugin of its own
+// (BUILD/ringside-oiio.so) that runtime/util/rs_oiio_load.c loads the first time
+// an image file is read or written.  OpenImageIO and the ~260 libraries it
+// brings (codecs of every image format, DICOM, OpenVDB...) cost every
+// ringside process about 0.25 s of dynamic linking at start when linked
+// in; most processes (every video render, every --help) never touch them.
+// Kept to what ringside needs: a reference resize, image files for
+// sequences, and float images for image-based lighting.
+//
+// The plugin calls nothing of the program's: errors come back in an rs_err
+// it fills itself (a plain C struct), so it links against OpenImageIO and
+// libpng only.  The entry points are rs_oiio_plugin_*; RS_OIIO_PLUGIN_ABI
+// (rs_oiio.h) changes whenever one of them does.
 extern "C" { /* rs_err.h and rs_img.h are C headers without their own extern "C" */
 #include "rs_err.h"
 #include "rs_img.h"
@@ -19,14 +29,15 @@ extern "C" { /* rs_err.h and rs_img.h are C headers without their own extern "C"
 
 using namespace OIIO;
 
-/* rs_fail folds the multi-line messages OpenImageIO gives into one line */
+/* the loader's rs_fail folds the multi-line messages OpenImageIO gives into one line */
 static bool fail(rs_err *err, rs_oiio_error code, const char *what, const std::string &why)
 {
-    rs_fail(err, code, "%s: %s", what, why.c_str());
+    err->code = code;
+    std::snprintf(err->msg, sizeof err->msg, "%s: %s", what, why.c_str());
     return false;
 }
 
-extern "C" bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err)
+extern "C" bool rs_oiio_plugin_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err)
 {
     ImageSpec in_spec(sw, sh, 4, TypeDesc::UINT8);
     ImageBuf src(in_spec, const_cast<uint8_t *>(rgba));
@@ -41,7 +52,7 @@ extern "C" bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, 
     return true;
 }
 
-extern "C" bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
+extern "C" bool rs_oiio_plugin_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
 {
     auto o = ImageOutput::create(ext + 1); /* by format name: path may end in .part */
     if (!o)
@@ -65,7 +76,7 @@ extern "C" bool rs_oiio_write(const char *path, const char *ext, int w, int h, c
     return ok ? true : fail(err, RS_OIIO_ERR_WRITE, path, e.empty() ? "write failed" : e);
 }
 
-extern "C" bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)
+extern "C" bool rs_oiio_plugin_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)
 {
     *rgb = nullptr;
     auto in = ImageInput::open(path);
@@ -102,45 +113,16 @@ extern "C" bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb
     return true;
 }
 
-extern "C" const char *rs_oiio_version(void)
+extern "C" int rs_oiio_plugin_abi(void)
+{
+    return RS_OIIO_PLUGIN_ABI;
+}
+
+extern "C" const char *rs_oiio_plugin_version(void)
 {
     static char v[64];
     std::snprintf(v, sizeof v, "OpenImageIO %s", OIIO_VERSION_STRING);
     return v;
 }
 
-#endif
-
-extern "C" const char *rs_oiio_error_text(rs_oiio_error e)
-{
-    static const char *const text[] = {
-#define X(id, t) t,
-        RS_OIIO_ERRORS(X)
-#undef X
-    };
-    return (unsigned)e < RS_OIIO_ERR_COUNT ? text[e] : "unknown OpenImageIO error";
-}
-
-#ifndef RS_HAVE_OIIO
-extern "C" bool rs_oiio_resize(const uint8_t *, int, int, float *, int, int, rs_err *err)
-{
-    rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "this build has no OpenImageIO (install libopenimageio-dev and rebuild)");
-    return false;
-}
-extern "C" bool rs_oiio_write(const char *path, const char *, int, int, const uint8_t *, rs_err *err)
-{
-    rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "%s: this build has no OpenImageIO, so no image sequences", path);
-    return false;
-}
-extern "C" bool rs_oiio_read_float(const char *path, int *, int *, float **rgb, rs_err *err)
-{
-    *rgb = nullptr;
-    rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "%s: built without OpenImageIO, so no image environments (install "
-                                             "libopenimageio-dev and rebuild)", path);
-    return false;
-}
-extern "C" const char *rs_oiio_version(void)
-{
-    return "no OpenImageIO in this build";
-}
 #endif

@@ -1,0 +1,187 @@
+/* rs_oiio: OpenImageIO, loaded when first used (rs_oiio.h says why).
+ *
+ * DESIGN: one pthread_once loads the plugin and resolves its five entry
+ * points; a failure is remembered with its message and every later call
+ * returns it (one dlopen attempt a process).  The plugin's errors come back
+ * in an rs_err it filled; rs_fail copies them here, folding OpenImageIO's
+ * multi-line messages into one line.  The handle is never closed, so a
+ * leak inside OpenImageIO keeps its library's name for tests/lsan.supp. */
+#include "rs_oiio.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef RS_HAVE_OIIO
+#include <dlfcn.h>
+#include <limits.h>
+#include <pthread.h>
+#include <unistd.h>
+
+#define PLUGIN "ringside-oiio.so"
+
+static struct {
+    pthread_once_t once;
+    bool ok;
+    char why[600];
+    char version[64];
+    int (*abi)(void);
+    bool (*resize)(const uint8_t *, int, int, float *, int, int, rs_err *);
+    bool (*write)(const char *, const char *, int, int, const uint8_t *, rs_err *);
+    bool (*read_float)(const char *, int *, int *, float **, rs_err *);
+    const char *(*version_of)(void);
+} P = {.once = PTHREAD_ONCE_INIT};
+
+static void *try_open(const char *path)
+{
+    return access(path, F_OK) == 0 ? dlopen(path, RTLD_NOW | RTLD_LOCAL) : NULL;
+}
+
+static void load(void)
+{
+    char exe[PATH_MAX], cand[PATH_MAX + 64], tried[3 * (PATH_MAX + 64)] = "";
+    void *h = NULL;
+    const char *env = getenv("RINGSIDE_OIIO_PLUGIN");
+    if (env && *env) {
+        if (!(h = try_open(env))) {
+            const char *e = access(env, F_OK) == 0 ? dlerror() : "no such file";
+            snprintf(P.why, sizeof P.why, "RINGSIDE_OIIO_PLUGIN=%s: %s", env, e ? e : "cannot load");
+            return;
+        }
+    } else {
+        ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+        if (n <= 0) {
+            snprintf(P.why, sizeof P.why, "cannot find the program's folder (/proc/self/exe) to look for %s", PLUGIN);
+            return;
+        }
+        exe[n] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash)
+            *slash = 0;
+        /* beside the program (BUILD/), make install's lib/ringside, one up (BUILD/tests/) */
+        const char *where[] = {"%s/" PLUGIN, "%s/../lib/ringside/" PLUGIN, "%s/../" PLUGIN};
+        for (size_t i = 0; i < sizeof where / sizeof *where && !h; i++) {
+            snprintf(cand, sizeof cand, where[i], exe);
+            if (access(cand, F_OK) != 0) {
+                size_t len = strlen(tried);
+                snprintf(tried + len, sizeof tried - len, "%s%s", len ? ", " : "", cand);
+                continue;
+            }
+            if (!(h = try_open(cand))) {
+                const char *e = dlerror();
+                snprintf(P.why, sizeof P.why, "%s: %s", cand, e ? e : "cannot load");
+                return;
+            }
+        }
+        if (!h) {
+            snprintf(P.why, sizeof P.why, "%s not found (looked at %s; RINGSIDE_OIIO_PLUGIN names it)", PLUGIN, tried);
+            return;
+        }
+    }
+    *(void **)&P.abi = dlsym(h, "rs_oiio_plugin_abi");
+    *(void **)&P.resize = dlsym(h, "rs_oiio_plugin_resize");
+    *(void **)&P.write = dlsym(h, "rs_oiio_plugin_write");
+    *(void **)&P.read_float = dlsym(h, "rs_oiio_plugin_read_float");
+    *(void **)&P.version_of = dlsym(h, "rs_oiio_plugin_version");
+    if (!P.abi || !P.resize || !P.write || !P.read_float || !P.version_of) {
+        snprintf(P.why, sizeof P.why, "%s is not ringside's OpenImageIO plugin (an entry point is missing)", PLUGIN);
+        return;
+    }
+    if (P.abi() != RS_OIIO_PLUGIN_ABI) {
+        snprintf(P.why, sizeof P.why, "%s has interface %d, this program needs %d (a plugin of another build?)",
+                 PLUGIN, P.abi(), RS_OIIO_PLUGIN_ABI);
+        return;
+    }
+    snprintf(P.version, sizeof P.version, "%s", P.version_of());
+    P.ok = true;
+}
+
+static bool loaded(rs_err *err)
+{
+    pthread_once(&P.once, load);
+    if (!P.ok && err)
+        rs_fail(err, RS_OIIO_ERR_NO_PLUGIN, "OpenImageIO: %s", P.why);
+    return P.ok;
+}
+
+/* the plugin's message, through rs_fail (one line) */
+static bool pass_on(bool ok, const rs_err *e, rs_err *err)
+{
+    if (!ok)
+        rs_fail(err, e->code ? e->code : RS_OIIO_ERR_READ, "%s", e->msg);
+    return ok;
+}
+
+bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err)
+{
+    rs_err e = {0};
+    return loaded(err) && pass_on(P.resize(rgba, sw, sh, out, w, h, &e), &e, err);
+}
+
+bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
+{
+    rs_err e = {0};
+    return loaded(err) && pass_on(P.write(path, ext, w, h, rgba, &e), &e, err);
+}
+
+bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)
+{
+    rs_err e = {0};
+    *rgb = NULL;
+    return loaded(err) && pass_on(P.read_float(path, w, h, rgb, &e), &e, err);
+}
+
+bool rs_oiio_ready(rs_err *err)
+{
+    return loaded(err);
+}
+
+const char *rs_oiio_version(void)
+{
+    return loaded(NULL) ? P.version : P.why;
+}
+
+#else
+
+bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err)
+{
+    (void)rgba, (void)sw, (void)sh, (void)out, (void)w, (void)h;
+    return rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "this build has no OpenImageIO (install libopenimageio-dev and rebuild)");
+}
+
+bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
+{
+    (void)ext, (void)w, (void)h, (void)rgba;
+    return rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "%s: this build has no OpenImageIO, so no image sequences", path);
+}
+
+bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)
+{
+    (void)w, (void)h;
+    *rgb = NULL;
+    return rs_fail(err, RS_OIIO_ERR_NOT_BUILT,
+                   "%s: built without OpenImageIO, so no image environments (install libopenimageio-dev and rebuild)",
+                   path);
+}
+
+bool rs_oiio_ready(rs_err *err)
+{
+    return rs_fail(err, RS_OIIO_ERR_NOT_BUILT, "this build has no OpenImageIO (install libopenimageio-dev and rebuild)");
+}
+
+const char *rs_oiio_version(void)
+{
+    return "no OpenImageIO in this build";
+}
+
+#endif
+
+const char *rs_oiio_error_text(rs_oiio_error e)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        RS_OIIO_ERRORS(X)
+#undef X
+    };
+    return (unsigned)e < RS_OIIO_ERR_COUNT ? text[e] : "unknown OpenImageIO error";
+}
