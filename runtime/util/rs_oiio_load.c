@@ -32,51 +32,55 @@ static struct {
     const char *(*version_of)(void);
 } P = {.once = PTHREAD_ONCE_INIT};
 
-static void *try_open(const char *path)
+/* The plugin's path: RINGSIDE_OIIO_PLUGIN, or the first that exists of
+ * beside the program (BUILD/), make install's lib/ringside and one folder
+ * up (BUILD/tests/).  *label is how messages name it.  NULL with P.why set
+ * when there is none. */
+static const char *find(char *path, size_t n, const char **label)
 {
-    return access(path, F_OK) == 0 ? dlopen(path, RTLD_NOW | RTLD_LOCAL) : NULL;
+    const char *env = getenv("RINGSIDE_OIIO_PLUGIN");
+    if (env && *env) {
+        *label = "RINGSIDE_OIIO_PLUGIN=";
+        snprintf(path, n, "%s", env);
+        if (access(path, F_OK) == 0)
+            return path;
+        snprintf(P.why, sizeof P.why, "RINGSIDE_OIIO_PLUGIN=%s: no such file", env);
+        return NULL;
+    }
+    *label = "";
+    char exe[PATH_MAX], tried[3 * (PATH_MAX + 64)] = "";
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0) {
+        snprintf(P.why, sizeof P.why, "cannot find the program's folder (/proc/self/exe) to look for %s", PLUGIN);
+        return NULL;
+    }
+    exe[len] = 0;
+    char *slash = strrchr(exe, '/');
+    if (slash)
+        *slash = 0;
+    const char *where[] = {"%s/" PLUGIN, "%s/../lib/ringside/" PLUGIN, "%s/../" PLUGIN};
+    for (size_t i = 0; i < sizeof where / sizeof *where; i++) {
+        snprintf(path, n, where[i], exe);
+        if (access(path, F_OK) == 0)
+            return path;
+        size_t t = strlen(tried);
+        snprintf(tried + t, sizeof tried - t, "%s%s", t ? ", " : "", path);
+    }
+    snprintf(P.why, sizeof P.why, "%s not found (looked at %s; RINGSIDE_OIIO_PLUGIN names it)", PLUGIN, tried);
+    return NULL;
 }
 
 static void load(void)
 {
-    char exe[PATH_MAX], cand[PATH_MAX + 64], tried[3 * (PATH_MAX + 64)] = "";
-    void *h = NULL;
-    const char *env = getenv("RINGSIDE_OIIO_PLUGIN");
-    if (env && *env) {
-        if (!(h = try_open(env))) {
-            const char *e = access(env, F_OK) == 0 ? dlerror() : "no such file";
-            snprintf(P.why, sizeof P.why, "RINGSIDE_OIIO_PLUGIN=%s: %s", env, e ? e : "cannot load");
-            return;
-        }
-    } else {
-        ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-        if (n <= 0) {
-            snprintf(P.why, sizeof P.why, "cannot find the program's folder (/proc/self/exe) to look for %s", PLUGIN);
-            return;
-        }
-        exe[n] = 0;
-        char *slash = strrchr(exe, '/');
-        if (slash)
-            *slash = 0;
-        /* beside the program (BUILD/), make install's lib/ringside, one up (BUILD/tests/) */
-        const char *where[] = {"%s/" PLUGIN, "%s/../lib/ringside/" PLUGIN, "%s/../" PLUGIN};
-        for (size_t i = 0; i < sizeof where / sizeof *where && !h; i++) {
-            snprintf(cand, sizeof cand, where[i], exe);
-            if (access(cand, F_OK) != 0) {
-                size_t len = strlen(tried);
-                snprintf(tried + len, sizeof tried - len, "%s%s", len ? ", " : "", cand);
-                continue;
-            }
-            if (!(h = try_open(cand))) {
-                const char *e = dlerror();
-                snprintf(P.why, sizeof P.why, "%s: %s", cand, e ? e : "cannot load");
-                return;
-            }
-        }
-        if (!h) {
-            snprintf(P.why, sizeof P.why, "%s not found (looked at %s; RINGSIDE_OIIO_PLUGIN names it)", PLUGIN, tried);
-            return;
-        }
+    char path[PATH_MAX + 64];
+    const char *label;
+    if (!find(path, sizeof path, &label))
+        return;
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *e = dlerror();
+        snprintf(P.why, sizeof P.why, "%s%s: %s", label, path, e ? e : "cannot load");
+        return;
     }
     *(void **)&P.abi = dlsym(h, "rs_oiio_plugin_abi");
     *(void **)&P.resize = dlsym(h, "rs_oiio_plugin_resize");
@@ -84,12 +88,12 @@ static void load(void)
     *(void **)&P.read_float = dlsym(h, "rs_oiio_plugin_read_float");
     *(void **)&P.version_of = dlsym(h, "rs_oiio_plugin_version");
     if (!P.abi || !P.resize || !P.write || !P.read_float || !P.version_of) {
-        snprintf(P.why, sizeof P.why, "%s is not ringside's OpenImageIO plugin (an entry point is missing)", PLUGIN);
+        snprintf(P.why, sizeof P.why, "%s is not ringside's OpenImageIO plugin (an entry point is missing)", path);
         return;
     }
     if (P.abi() != RS_OIIO_PLUGIN_ABI) {
         snprintf(P.why, sizeof P.why, "%s has interface %d, this program needs %d (a plugin of another build?)",
-                 PLUGIN, P.abi(), RS_OIIO_PLUGIN_ABI);
+                 path, P.abi(), RS_OIIO_PLUGIN_ABI);
         return;
     }
     snprintf(P.version, sizeof P.version, "%s", P.version_of());
