@@ -171,12 +171,10 @@ fuzz-run: build/fuzz/fuzz_replay
 	cp demos/*.rsr tests/golden/dojo-format1.rsr build/fuzz/corpus/
 	build/fuzz/fuzz_replay -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -print_final_stats=1 build/fuzz/corpus
 
-# the same with clang, where it is installed: a second compiler must agree too
-HAVE_CLANG := $(shell command -v clang >/dev/null 2>&1 && echo 1)
-ifeq ($(HAVE_CLANG),1)
+# the same with clang (tools/deps.sh test installs it, before this is built):
+# a second compiler must agree too
 SIMHASH_CLANG := $(BUILD)/tests/simhash-clang
-endif
-$(BUILD)/tests/simhash-clang: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/replay/*.h)
+$(BUILD)/tests/simhash-clang: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/replay/*.h) | $(STAMPS)/test
 	@mkdir -p $(dir $@)
 	clang -std=c11 -D_POSIX_C_SOURCE=200809L -O2 -ffp-contract=off -o $@ $(SIM_SRC) -lm
 

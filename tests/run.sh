@@ -101,6 +101,7 @@ for t in "$@"; do
         }
     fi
     cat "$log"
+    grep '^skip ' "$log" >>"$times/skips"
     line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$log" | tail -1)
     rm -f "$log"
     if [ -z "$line" ]; then
@@ -136,6 +137,12 @@ if [ -s "$times/suites" ]; then
     echo "slowest 15 cases:"
     sort -rn "$times/cases" | head -15 | awk '{ printf "  %8.2f s  %s\n", $1, $2 }'
     [ -z "${RS_TIMES:-}" ] || { sort -rn "$times/suites" >"$RS_TIMES.suites"; sort -rn "$times/cases" >"$RS_TIMES.cases"; }
+fi
+# what did not run, and why (docs/testing.md, "Skips"): "missing install"
+# fails under CI=true, so on CI this lists the machine's reasons alone
+if [ -s "$times/skips" ]; then
+    echo "skipped cases, by reason:"
+    awk -v prefix="  " -f "$here/skips.awk" "$times/skips"
 fi
 echo "tests took $(( $(date +%s) - start )) s"
 echo "$pass passed, $fail failed, $skip skipped"

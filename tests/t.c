@@ -18,7 +18,8 @@
 #include <sanitizer/lsan_interface.h>
 #endif
 
-#define T_SKIP_CODE 77
+#define T_SKIP_CODE 77         /* environment (tests/lib.sh: the same codes) */
+#define T_SKIP_INSTALL_CODE 78 /* missing install */
 #define T_TIMEOUT_S 300
 
 static bool nofork;
@@ -42,20 +43,46 @@ _Noreturn void t_fail(const char *file, int line, const char *fmt, ...)
     _exit(1);
 }
 
-_Noreturn void t_skip(const char *fmt, ...)
+/* The reason goes to stderr and to a file in the case's directory, where
+ * the runner reads it for the verdict line. */
+_Noreturn void t_skip(int install, const char *fmt, ...)
 {
+    char why[400];
     va_list ap;
-    fprintf(stderr, "    skip: ");
     va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
+    vsnprintf(why, sizeof why, fmt, ap);
     va_end(ap);
-    fputc('\n', stderr);
+    const char *kind = install ? "missing install" : "environment";
+    fprintf(stderr, "    skip (%s): %s\n", kind, why);
     fflush(stderr);
+    char path[300];
+    snprintf(path, sizeof path, "%s/.t-skip", t_tmpdir());
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fprintf(f, "%s: %s", kind, why);
+        fclose(f);
+    }
+    int code = install ? T_SKIP_INSTALL_CODE : T_SKIP_CODE;
     if (nofork) {
-        jump_code = T_SKIP_CODE;
+        jump_code = code;
         longjmp(jump, 1);
     }
-    _exit(T_SKIP_CODE);
+    _exit(code);
+}
+
+/* The reason a case skipped, from its directory ("KIND: WHY"). */
+static void skip_reason(char *out, size_t n)
+{
+    char path[300];
+    snprintf(path, sizeof path, "%s/.t-skip", tmpdir);
+    snprintf(out, n, "no reason given");
+    FILE *f = tmpdir[0] ? fopen(path, "r") : NULL;
+    if (!f)
+        return;
+    if (!fgets(out, (int)n, f))
+        snprintf(out, n, "no reason given");
+    fclose(f);
+    out[strcspn(out, "\n")] = 0;
 }
 
 const char *t_tmpdir(void)
@@ -86,7 +113,7 @@ void t_write(const char *dir, const char *name, const char *text)
 struct plat *t_context(const char *backend)
 {
     if (!plat_backend_built(backend))
-        t_skip("backend %s not built in (built: %s)", backend, plat_built_backends());
+        t_skip(1, "backend %s not built in (built: %s)", backend, plat_built_backends());
     rs_err err = {0};
     plat *p = plat_create(&(plat_desc){.backend = backend, .hidden = true, .debug = true}, &err);
     if (!p)
@@ -145,6 +172,7 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
         }
     }
     int pass = 0, fail = 0, skip = 0;
+    bool ci = getenv("CI") && !strcmp(getenv("CI"), "true");
     for (size_t i = 0; i < n; i++) {
         if (!selected(cases[i].name, argc, argv))
             continue;
@@ -153,9 +181,11 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
         clock_gettime(CLOCK_MONOTONIC, &t0);
         int code;
         const char *why = "";
-        char whybuf[64];
+        char whybuf[64], skipbuf[420] = "";
         if (nofork) {
             code = run_inline(cases[i].fn);
+            if (code == T_SKIP_CODE || code == T_SKIP_INSTALL_CODE)
+                skip_reason(skipbuf, sizeof skipbuf);
             rm_tree(tmpdir);
             tmpdir[0] = 0;
         } else {
@@ -193,6 +223,8 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
                          WTERMSIG(st) == SIGALRM ? T_TIMEOUT_S : WTERMSIG(st));
                 why = whybuf;
             }
+            if (code == T_SKIP_CODE || code == T_SKIP_INSTALL_CODE)
+                skip_reason(skipbuf, sizeof skipbuf);
             rm_tree(tmpdir);
             tmpdir[0] = 0;
         }
@@ -203,9 +235,13 @@ int t_main(int argc, char **argv, const t_case *cases, size_t n)
         if (code == 0) {
             pass++;
             printf("ok   %s/%s (%.2f s)\n", suite, cases[i].name, secs);
-        } else if (code == T_SKIP_CODE) {
+        } else if (code == T_SKIP_INSTALL_CODE && ci) {
+            /* a CI machine must have everything tools/deps.sh installs */
+            fail++;
+            printf("FAIL %s/%s (CI=true, and a %s) (%.2f s)\n", suite, cases[i].name, skipbuf, secs);
+        } else if (code == T_SKIP_CODE || code == T_SKIP_INSTALL_CODE) {
             skip++;
-            printf("skip %s/%s (%.2f s)\n", suite, cases[i].name, secs);
+            printf("skip %s/%s (%s) (%.2f s)\n", suite, cases[i].name, skipbuf, secs);
         } else {
             fail++;
             printf("FAIL %s/%s%s (%.2f s)\n", suite, cases[i].name, why, secs);

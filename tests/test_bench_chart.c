@@ -50,13 +50,13 @@ static void t_png_and_svg(void)
              "assert \"frames per second (fps)\" in d and \"render-only: 178.2 fps\" in d, d' '%s' '%s'",
              svg, chart.title);
     if (system("command -v python3 >/dev/null 2>&1") != 0)
-        T_SKIP("no python3 to parse the SVG");
+        T_SKIP_INSTALL("no python3 to parse the SVG");
     T_ASSERTF(system(cmd) == 0, "%s: not the chart's SVG", svg);
 
     int w = 0, h = 0;
     float *rgb = NULL;
     if (!rs_oiio_read_float(png, &w, &h, &rgb, &e))
-        T_SKIP("%s", e.msg); /* no OpenImageIO to read it back */
+        T_SKIP_INSTALL("%s", e.msg); /* no OpenImageIO to read it back */
     T_EQ(w, 880);
     T_EQ(h, 108 + 26 * 3);
     int grey, n;

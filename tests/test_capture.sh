@@ -28,7 +28,7 @@ t_async_equals_sequential() {
 }
 
 t_y4m_plays() {
-    command -v ffprobe >/dev/null || t_skip_case "ffprobe not installed"
+    command -v ffprobe >/dev/null || t_skip_install "ffprobe not installed"
     short_replay || return 1
     "$RS_BIN" render short.rsr -o v.y4m $SIZES --quiet || return 1
     set -- $(probe v.y4m)
@@ -37,8 +37,8 @@ t_y4m_plays() {
 }
 
 t_mp4_exact_timing() {
-    command -v ffprobe >/dev/null || t_skip_case "ffprobe not installed"
-    "$RS_BIN" render --help | grep -q "\.mp4" || t_skip_case "this build has no FFmpeg"
+    command -v ffprobe >/dev/null || t_skip_install "ffprobe not installed"
+    "$RS_BIN" render --help | grep -q "\.mp4" || t_skip_install "this build has no FFmpeg"
     short_replay || return 1
     "$RS_BIN" render short.rsr -o v.mp4 $SIZES --quiet 2>e.txt || { cat e.txt; return 1; }
     [ ! -s e.txt ] || { echo "noise on stderr with --quiet:"; cat e.txt; return 1; }
@@ -167,7 +167,7 @@ t_bench_quality_small() {
 t_bench_accuracy_small() {
     "$RS_BIN" bench accuracy --frames 1 --render-size 320x180 --size 160x90 --ibl-sizes 4,8,16 --ibl-reference 32 \
         --csv a.csv >a.txt 2>&1 ||
-        { grep -q "no OpenImageIO" a.txt && t_skip_case "no OpenImageIO in this build"; cat a.txt; return 1; }
+        { grep -q "no OpenImageIO" a.txt && t_skip_install "no OpenImageIO in this build"; cat a.txt; return 1; }
     for f in box bilinear nearest lanczos3 "cpu box"; do
         grep -Eq "^$f +[0-9]+\.[0-9]+ +[0-9]+\.[0-9]+" a.txt || { echo "no row $f"; cat a.txt; return 1; }
     done
@@ -193,7 +193,7 @@ t_bench_accuracy_small() {
 }
 
 t_image_sequences() {
-    "$RS_BIN" render --help | grep -q "%06d.png" || t_skip_case "this build has no OpenImageIO"
+    "$RS_BIN" render --help | grep -q "%06d.png" || t_skip_install "this build has no OpenImageIO"
     short_replay || return 1
     mkdir png exr && "$RS_BIN" render short.rsr -o png/f%04d.png $SIZES --quiet || return 1
     [ "$(ls png | wc -l)" = 120 ] && [ -s png/f0000.png ] && [ -s png/f0119.png ] || { ls png | head; return 1; }

@@ -46,7 +46,7 @@ t_info_osmesa() { info_reports_core osmesa env -u DISPLAY -u WAYLAND_DISPLAY; }
 
 t_info_glfw_xvfb() {
     if [ -n "${DISPLAY:-}" ]; then info_reports_core glfw; return; fi
-    command -v xvfb-run >/dev/null || t_skip_case "no DISPLAY and xvfb-run not installed"
+    command -v xvfb-run >/dev/null || t_skip_install "no DISPLAY and xvfb-run not installed"
     info_reports_core glfw xvfb-run -a
 }
 
@@ -107,7 +107,7 @@ t_shader_variants_all_compile() {
 # every variant as the Khronos reference compiler sees it: GLSL that llvmpipe
 # tolerates and a stricter driver (NVIDIA's) would refuse fails here first
 t_shaders_valid_for_glslang() {
-    command -v glslangValidator >/dev/null 2>&1 || t_skip_case "glslangValidator not installed (glslang-tools; tools/deps.sh test)"
+    command -v glslangValidator >/dev/null 2>&1 || t_skip_install "glslangValidator not installed (glslang-tools; tools/deps.sh test)"
     mkdir emit
     "$RS_BIN" shaders --emit emit --quiet >sh.txt 2>&1 || { cat sh.txt; return 1; }
     grep -q "variants written to emit, 0 failed" sh.txt || { cat sh.txt; return 1; }
@@ -149,7 +149,7 @@ t_bench_platform() {
 # image sequence is refused before its first frame, saying where to put it,
 # and a video still renders
 t_oiio_loaded_when_used() {
-    [ -f "$(dirname "$RS_BIN")/ringside-oiio.so" ] || t_skip_case "this build has no OpenImageIO plugin"
+    [ -f "$(dirname "$RS_BIN")/ringside-oiio.so" ] || t_skip_install "this build has no OpenImageIO plugin"
     if ldd "$RS_BIN" | grep OpenImageIO; then echo "ringside links OpenImageIO"; return 1; fi
     LD_DEBUG=files "$RS_BIN" render --help >/dev/null 2>ld.txt || return 1
     if grep -m1 "file=libOpenImageIO" ld.txt; then echo "render --help loaded OpenImageIO"; return 1; fi

@@ -14,7 +14,7 @@ replay() { # 60 ticks on the dojo
 }
 
 need_ffprobe() {
-    command -v ffprobe >/dev/null 2>&1 || t_skip_case "no ffprobe"
+    command -v ffprobe >/dev/null 2>&1 || t_skip_install "no ffprobe"
 }
 
 # frames FORMAT FILE: the frames ffprobe decodes, and the codec ("h264 12")

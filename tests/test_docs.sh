@@ -51,7 +51,7 @@ page_words() {
 }
 
 t_man_pages_match_help() {
-    command -v man >/dev/null && command -v groff >/dev/null || t_skip_case "man/groff not installed (make man installs groff-base)"
+    command -v man >/dev/null && command -v groff >/dev/null || t_skip_install "man/groff not installed (make man installs groff-base)"
     make -s -C "$SRC" man BUILD="$(dirname "$RS_BIN")" >make.txt 2>&1 || { cat make.txt; return 1; }
     man=$(dirname "$RS_BIN")/man
     # a page for every command

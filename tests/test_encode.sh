@@ -114,7 +114,7 @@ t_bad_settings_refused() {
 }
 
 t_hw_without_devices() {
-    no_hw_nodes || t_skip_case "this machine has a GPU device node: the fallback is not what runs"
+    no_hw_nodes || t_skip_env "this machine has a GPU device node: the fallback is not what runs"
     expect_fail 1 "x.mp4: --hw nvenc: no device /dev/nvidia0" render --ticks 0:2 $TINY --hw nvenc -o x.mp4 || return 1
     expect_fail 1 "x.mp4: --hw vaapi: no device /dev/dri/renderD" render --ticks 0:2 $TINY --hw vaapi --codec hevc -o x.mp4 || return 1
     expect_fail 1 "--hw nvenc: NVENC has no vp9 encoder" render --ticks 0:2 $TINY --hw nvenc -o x.webm || return 1

@@ -67,7 +67,7 @@ t_bundle_builds() {
 
 t_runs_with_system_libraries_hidden() {
     build_bundle || return 1
-    unshare -m true 2>/dev/null || t_skip_case "no mount namespaces here (unshare -m): cannot hide the system's libraries"
+    unshare -m true 2>/dev/null || t_skip_env "no mount namespaces here (unshare -m): cannot hide the system's libraries"
     make_driver_dir "$T_TMP/drv" || return 1
     export RINGSIDE_BUNDLE_CACHE="$T_TMP/cache"
     "$B/run" version >ver.txt 2>err.txt || { cat err.txt; return 1; } # unpacks, outside the namespace

@@ -777,7 +777,7 @@ static void t_cache_dir_env(void)
 #ifdef RS_HAVE_OIIO
 #define NEED_OIIO()
 #else
-#define NEED_OIIO() T_SKIP("built without OpenImageIO")
+#define NEED_OIIO() T_SKIP_INSTALL("built without OpenImageIO")
 #endif
 
 /* Radiance .hdr, flat (uncompressed) RGBE scanlines. */

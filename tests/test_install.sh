@@ -93,7 +93,7 @@ t_unit_file() {
     # stop: the daemon's grace (30 s) + 10 s for a render that ignores SIGTERM
     t=$(sed -n 's/^TimeoutStopSec=//p' "$u")
     [ "${t:-0}" -gt 40 ] || { echo "TimeoutStopSec=$t is not above grace + 10 s"; return 1; }
-    command -v systemd-analyze >/dev/null || t_skip_case "keys checked; systemd-analyze not installed"
+    command -v systemd-analyze >/dev/null || t_skip_install "keys checked; systemd-analyze not installed (tools/deps.sh test installs systemd)"
     install_to "$PWD/prefix" || return 1
     MANPATH="$PWD/prefix/share/man" systemd-analyze verify "$PWD/prefix/lib/systemd/system/ringside.service" \
         >v.txt 2>&1 || { cat v.txt; return 1; }
@@ -115,7 +115,7 @@ want() { # WHAT EXPECTED...: COMPREPLY (sorted) is exactly EXPECTED
 }
 
 t_bash_completion() {
-    command -v bash >/dev/null || t_skip_case "no bash"
+    command -v bash >/dev/null || t_skip_install "no bash"
     make -s -C "$SRC" man BUILD="$BUILD_DIR" >m.txt 2>&1 || { cat m.txt; return 1; }
     COMPL=$BUILD_DIR/dist/ringside.bash
     bash -n "$COMPL" || return 1

@@ -5,7 +5,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 . "$here/lib.sh"
 SRC=$(cd "$here/.." && pwd)
 
-need_ffmpeg() { command -v ffmpeg >/dev/null || t_skip_case "no ffmpeg command line (tools/deps.sh test)"; }
+need_ffmpeg() { command -v ffmpeg >/dev/null || t_skip_install "no ffmpeg command line (tools/deps.sh test)"; }
 
 # clip OUT RATE FRAMES SIZE [ffmpeg output options...]
 clip() {
@@ -142,7 +142,7 @@ t_attract_usage() {
 # a key press starts a match, and the idle timeout brings the loop back.
 t_attract_window_xvfb() {
     need_ffmpeg
-    command -v xdotool >/dev/null && command -v Xvfb >/dev/null || t_skip_case "needs Xvfb and xdotool"
+    command -v xdotool >/dev/null && command -v Xvfb >/dev/null || t_skip_install "needs Xvfb and xdotool"
     clip m.mp4 30 60 320x192 -pix_fmt yuv420p -c:v libx264 -preset ultrafast || return 1
     disp=:$((140 + $$ % 50))
     Xvfb "$disp" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &

@@ -10,7 +10,7 @@ SRC=$(cd "$here/.." && pwd)
 XCORR=$T_TMP/au_xcorr
 
 need_tools() {
-    command -v ffmpeg >/dev/null && command -v soxi >/dev/null || t_skip_case "needs ffmpeg and sox (tools/deps.sh test)"
+    command -v ffmpeg >/dev/null && command -v soxi >/dev/null || t_skip_install "needs ffmpeg and sox (tools/deps.sh test)"
     [ -x "$XCORR" ] || ${CC:-cc} -O2 -o "$XCORR" "$SRC/tests/au_xcorr.c" -lm || { echo "cannot build au_xcorr"; return 1; }
 }
 
@@ -180,7 +180,7 @@ t_movie_audio_shorter_and_longer() {
 # of step, so noise would differ after the damage whatever its timing.
 t_movie_broken_audio_packets() {
     need_tools || return 1
-    command -v python3 >/dev/null || t_skip_case "needs python3"
+    command -v python3 >/dev/null || t_skip_install "needs python3"
     mkmovie good.mkv 3 "aevalsrc=0.3*sin(2*PI*440*t)+0.2*sin(2*PI*277*t):s=44100:d=3" -c:a aac -ac 2 || return 1
     ffprobe -v error -select_streams a -show_entries packet=size,pos -of csv=p=0 good.mkv >pk.txt || return 1
     python3 - <<'EOF' || return 1
@@ -218,7 +218,7 @@ t_movie_sound_options() {
     expect_fail 1 "--audio-out full.wav: exists" "$RS_BIN" movie m.mkv --headless --audio-out full.wav || return 1
     expect_fail 1 "--audio-out nodir/x.wav" "$RS_BIN" movie m.mkv --headless --audio-out nodir/x.wav || return 1
     # in a window with no such audio device: one warning line, and it plays silent
-    command -v Xvfb >/dev/null || t_skip_case "needs Xvfb for the window case"
+    command -v Xvfb >/dev/null || t_skip_install "needs Xvfb for the window case"
     disp=:$((190 + $$ % 50))
     Xvfb "$disp" -screen 0 640x480x24 -nolisten tcp >/dev/null 2>&1 &
     xpid=$!

@@ -24,7 +24,7 @@ static bool have_ffmpeg(void)
 static void need_ffmpeg(void)
 {
     if (!have_ffmpeg())
-        T_SKIP("no ffmpeg/ffprobe command line (tools/deps.sh test installs them)");
+        T_SKIP_INSTALL("no ffmpeg/ffprobe command line (tools/deps.sh test installs them)");
 }
 
 static void sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

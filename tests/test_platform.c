@@ -31,7 +31,7 @@ static void t_osmesa_core(void) { check_core_33("osmesa"); }
 static void t_auto_prefers_egl(void)
 {
     if (!plat_backend_built("egl"))
-        T_SKIP("egl not built in");
+        T_SKIP_INSTALL("egl not built in");
     rs_err e = {0};
     plat *p = plat_create(NULL, &e);
     T_ASSERTF(p, "%s", e.msg);
@@ -43,7 +43,7 @@ static void t_auto_prefers_egl(void)
 static void t_auto_falls_back_to_osmesa(void)
 {
     if (!plat_backend_built("egl") || !plat_backend_built("osmesa"))
-        T_SKIP("needs egl and osmesa");
+        T_SKIP_INSTALL("needs egl and osmesa");
     /* libglvnd finds no EGL vendor: EGL cannot give a context */
     setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/vendor.json", 1);
     setenv("__EGL_VENDOR_LIBRARY_DIRS", "/nonexistent", 1);
@@ -59,7 +59,7 @@ static void t_auto_falls_back_to_osmesa(void)
 static void t_egl_forced_failure_is_one_line(void)
 {
     if (!plat_backend_built("egl"))
-        T_SKIP("egl not built in");
+        T_SKIP_INSTALL("egl not built in");
     setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/vendor.json", 1);
     setenv("__EGL_VENDOR_LIBRARY_DIRS", "/nonexistent", 1);
     rs_err e = {0};
@@ -72,7 +72,7 @@ static void t_egl_forced_failure_is_one_line(void)
 static void t_bad_device_index(void)
 {
     if (!plat_backend_built("egl"))
-        T_SKIP("egl not built in");
+        T_SKIP_INSTALL("egl not built in");
     setenv("RINGSIDE_EGL_DEVICE", "99", 1);
     rs_err e = {0};
     T_ASSERT(!plat_create(&(plat_desc){.backend = "egl"}, &e));
@@ -92,7 +92,7 @@ static void t_unknown_backend(void)
 static void t_glfw_without_display(void)
 {
     if (!plat_backend_built("glfw"))
-        T_SKIP("glfw not built in");
+        T_SKIP_INSTALL("glfw not built in");
     unsetenv("DISPLAY");
     unsetenv("WAYLAND_DISPLAY");
     rs_err e = {0};
@@ -106,7 +106,7 @@ static void t_glfw_without_display(void)
 static void t_glfw_window(void)
 {
     if (!getenv("DISPLAY") || !*getenv("DISPLAY"))
-        T_SKIP("no DISPLAY (tests/test_cli.sh covers glfw under xvfb-run)");
+        T_SKIP_ENV("no DISPLAY (tests/test_cli.sh covers glfw under xvfb-run)");
     plat *p = t_context("glfw");
     int w, h;
     plat_size(p, &w, &h);
@@ -137,7 +137,7 @@ static void t_debug_callback_counts_errors(void)
 {
     plat *p = t_context("egl");
     if (!glcaps.khr_debug)
-        T_SKIP("no KHR_debug");
+        T_SKIP_ENV("no KHR_debug");
     rgl_error_reset();
     gl.BindTexture(0xdead, 0); /* GL_INVALID_ENUM */
     T_ASSERTF(rgl_error_count() >= 1, "the debug callback saw no error");
@@ -147,7 +147,7 @@ static void t_debug_callback_counts_errors(void)
 static void t_check_counts_without_callback(void)
 {
     if (!plat_backend_built("osmesa"))
-        T_SKIP("osmesa not built in");
+        T_SKIP_INSTALL("osmesa not built in");
     rs_err e = {0};
     plat *p = plat_create(&(plat_desc){.backend = "osmesa"}, &e);
     T_ASSERTF(p, "%s", e.msg);
@@ -176,7 +176,7 @@ static void t_two_backends_in_turn(void)
 {
     /* the loader is refilled for each context: EGL, then OSMesa, then EGL */
     if (!plat_backend_built("osmesa"))
-        T_SKIP("osmesa not built in");
+        T_SKIP_INSTALL("osmesa not built in");
     const char *order[] = {"egl", "osmesa", "egl"};
     for (int i = 0; i < 3; i++) {
         plat *p = t_context(order[i]);

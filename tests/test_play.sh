@@ -24,7 +24,7 @@ t_play_records_what_record_records() {
 }
 
 t_window_under_xvfb() {
-    command -v xvfb-run >/dev/null || t_skip_case "xvfb-run not installed"
+    command -v xvfb-run >/dev/null || t_skip_install "xvfb-run not installed"
     xvfb-run -a -s "-screen 0 1280x1024x24" "$RS_BIN" play --p1 cpu --p2 cpu --seconds 3 --size 640x360 \
         --screenshot w.ppm 2>e.txt || { cat e.txt; return 1; }
     grep -q "^ringside play: 180 ticks" e.txt || { cat e.txt; return 1; }
@@ -34,7 +34,7 @@ t_window_under_xvfb() {
 }
 
 t_keys_reach_the_game() {
-    command -v xdotool >/dev/null && command -v Xvfb >/dev/null || t_skip_case "needs Xvfb and xdotool"
+    command -v xdotool >/dev/null && command -v Xvfb >/dev/null || t_skip_install "needs Xvfb and xdotool"
     disp=:$((90 + $$ % 50))
     Xvfb "$disp" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
     xpid=$!

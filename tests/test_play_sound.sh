@@ -12,7 +12,7 @@ REPLAY=$SRC/demos/harbor.rsr
 wav_frames() { soxi -s "$1"; }
 wav_rms() { sox "$1" -n stat 2>&1 | sed -n 's/^RMS *amplitude: *//p'; }
 
-need_sox() { command -v sox >/dev/null || t_skip_case "sox not installed (tools/deps.sh test)"; }
+need_sox() { command -v sox >/dev/null || t_skip_install "sox not installed (tools/deps.sh test)"; }
 
 t_headless_wav_length() {
     need_sox
@@ -77,7 +77,7 @@ t_unwritable_audio_out() {
 }
 
 need_display() {
-    [ -n "${DISPLAY:-}" ] || t_skip_case "no X display (tests/run.sh starts Xvfb)"
+    [ -n "${DISPLAY:-}" ] || t_skip_env "no X display (tests/run.sh starts Xvfb)"
 }
 
 # no audio device: one warning line, and the game runs silent to its end.

@@ -315,7 +315,7 @@ static double bil(const uint8_t *p, int w, int h, double x, double y)
 static void check_case(const ccase *cc)
 {
     if (!have_ffmpeg())
-        T_SKIP("no ffmpeg command line (tools/deps.sh test installs it)");
+        T_SKIP_INSTALL("no ffmpeg command line (tools/deps.sh test installs it)");
     const char *dir = t_tmpdir();
     char clip[512], ref[512], planes[512], cmd[4096];
     const char *ext = !strcmp(cc->codec, "y4m") ? "y4m" : !strcmp(cc->codec, "vp9") ? "webm" : "mp4";

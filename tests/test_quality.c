@@ -246,7 +246,7 @@ static void t_fxaa_pass_in_graph(void)
 static void t_fxaa_cost(void)
 {
     if (!getenv("T_AA_COST"))
-        T_SKIP("T_AA_COST not set");
+        T_SKIP_ENV("T_AA_COST not set");
     plat *p = t_context("egl");
     g_state prev, cur;
     t_state_at("temple", 900, &prev, &cur);

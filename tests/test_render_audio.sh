@@ -7,8 +7,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 SIZES="--render-size 128x72 --size 64x36"
 
 need_ffmpeg() {
-    command -v ffprobe >/dev/null && command -v ffmpeg >/dev/null || t_skip_case "ffmpeg/ffprobe not installed"
-    command -v python3 >/dev/null || t_skip_case "python3 not installed"
+    command -v ffprobe >/dev/null && command -v ffmpeg >/dev/null || t_skip_install "ffmpeg/ffprobe not installed"
+    command -v python3 >/dev/null || t_skip_install "python3 not installed"
 }
 
 replay6() { # 360 ticks: the intro and the start of round 1, with hits

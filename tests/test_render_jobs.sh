@@ -81,7 +81,7 @@ t_interrupted() {
 t_auto() {
     "$RS_BIN" render "$SRC/demos/temple.rsr" --ticks 0:1200 --size 64x36 --quality draft --audio off -o a.mp4 2>err.txt ||
         { cat err.txt; return 1; }
-    "$RS_BIN" info 2>&1 | grep -q llvmpipe || t_skip_case "not llvmpipe: auto renders in one process"
+    "$RS_BIN" info 2>&1 | grep -q llvmpipe || t_skip_env "not llvmpipe: auto renders in one process"
     if [ "$(nproc)" -ge 2 ]; then
         grep -q '2 segments at once (--jobs 2)' err.txt || { cat err.txt; return 1; }
     else

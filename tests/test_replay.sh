@@ -60,7 +60,7 @@ t_hashes_same_at_O0_O2_and_in_ringside() {
 }
 
 t_hashes_same_with_clang() {
-    [ -x "$BIN_DIR/tests/simhash-clang" ] || t_skip_case "clang not installed"
+    [ -x "$BIN_DIR/tests/simhash-clang" ] || t_skip_install "no $BIN_DIR/tests/simhash-clang: clang not installed (tools/deps.sh test installs it)"
     for d in dojo harbor temple shallows snowfield mistvale plaza quarry; do
         "$BIN_DIR/tests/simhash-clang" "$SRC/demos/$d.rsr" >c.txt || { echo "clang build fails $d"; return 1; }
         "$BIN_DIR/tests/simhash-O2" "$SRC/demos/$d.rsr" >g.txt || return 1

@@ -6,7 +6,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 . "$here/lib.sh"
 
 t_png_1280x720_compressed() {
-    command -v ffmpeg >/dev/null 2>&1 || t_skip_case "no ffmpeg (tools/deps.sh test)"
+    command -v ffmpeg >/dev/null 2>&1 || t_skip_install "no ffmpeg (tools/deps.sh test)"
     "$RS_BIN" smoke --size 1280x720 -o x.png 2>e.txt || { cat e.txt; return 1; }
     "$RS_BIN" smoke --size 1280x720 -o x.ppm 2>e.txt || { cat e.txt; return 1; }
     size=$(wc -c <x.png)

@@ -37,7 +37,7 @@ static char spec_buf[1200];
 static const char *sqlite_spec(void)
 {
 #if !defined(RS_HAVE_SQLITE)
-    T_SKIP("built without SQLite (install libsqlite3-dev and rebuild)");
+    T_SKIP_INSTALL("built without SQLite (install libsqlite3-dev and rebuild)");
 #endif
     snprintf(spec_buf, sizeof spec_buf, "sqlite:%s/queue.db", t_tmpdir());
     return spec_buf;
@@ -47,10 +47,10 @@ static const char *pg_uri(void)
 {
     const char *uri = getenv("RINGSIDE_TEST_PG");
     if (!uri || !*uri)
-        T_SKIP("RINGSIDE_TEST_PG is not set: give it a conninfo URI (postgresql://USER@HOST:PORT/DB) or run "
-               "tests/service/test_store_pg.sh, which starts a throwaway server");
+        T_SKIP_ENV("no PostgreSQL server given (RINGSIDE_TEST_PG, a conninfo URI postgresql://USER@HOST:PORT/DB); "
+                   "make test-service runs these cases against a throwaway one (tests/service/test_store_pg.sh)");
 #if !defined(RS_HAVE_PQ)
-    T_SKIP("RINGSIDE_TEST_PG is set but this ringside was built without libpq (install libpq-dev and rebuild)");
+    T_SKIP_INSTALL("RINGSIDE_TEST_PG is set but this ringside was built without libpq (install libpq-dev and rebuild)");
 #endif
     return uri;
 }
@@ -74,7 +74,7 @@ static long long pg_admin(const char *sql)
 static long long pg_admin(const char *sql)
 {
     (void)sql;
-    T_SKIP("built without libpq");
+    T_SKIP_INSTALL("built without libpq");
 }
 #endif
 

@@ -69,7 +69,7 @@ static void t_read_file_limits(void)
 static uint8_t *ffmpeg_decode(const char *path, const char *pix_fmt, size_t n)
 {
     if (system("command -v ffmpeg >/dev/null 2>&1") != 0)
-        T_SKIP("no ffmpeg to read the PNG back (tools/deps.sh test)");
+        T_SKIP_INSTALL("no ffmpeg to read the PNG back (tools/deps.sh test)");
     char cmd[1200];
     snprintf(cmd, sizeof cmd, "ffmpeg -v error -i '%s' -f rawvideo -pix_fmt %s - 2>/dev/null", path, pix_fmt);
     FILE *p = popen(cmd, "r");
@@ -295,6 +295,18 @@ static void t_oiio_errors(void)
     T_ASSERT(!strcmp(rs_oiio_error_text(RS_OIIO_ERR_COUNT), "unknown OpenImageIO error"));
 }
 
+/* The runner's two kinds of skip, driven by tests/test_harness.sh:
+ * T_SKIP_PROBE=env or =install makes this case skip with that kind;
+ * without it the case passes. */
+static void t_harness_skip_probe(void)
+{
+    const char *k = getenv("T_SKIP_PROBE");
+    if (k && !strcmp(k, "env"))
+        T_SKIP_ENV("probe: the machine has no such thing");
+    if (k && !strcmp(k, "install"))
+        T_SKIP_INSTALL("probe: a tool is not installed");
+}
+
 T_MAIN({"err_one_line", t_err_one_line}, {"err_modules", t_err_modules},
        {"read_file_limits", t_read_file_limits},
        {"png_roundtrip", t_png_roundtrip}, {"png_compressed", t_png_compressed},
@@ -302,4 +314,5 @@ T_MAIN({"err_one_line", t_err_one_line}, {"err_modules", t_err_modules},
        {"png_disk_full", t_png_disk_full},
        {"pnm_roundtrip", t_pnm_roundtrip}, {"pnm_bad_input", t_pnm_bad_input},
        {"pnm_random_corruption", t_pnm_random_corruption}, {"flip_rows", t_flip_rows},
-       {"hash_vectors", t_hash_vectors}, {"oiio_errors", t_oiio_errors})
+       {"hash_vectors", t_hash_vectors}, {"oiio_errors", t_oiio_errors},
+       {"harness_skip_probe", t_harness_skip_probe})

@@ -24,11 +24,15 @@ group_pkgs() {
     # ffmpeg) is the independent player that checks our videos; xz packs the
     # GPU bundle (tools/gpu-bundle.sh, tests/test_gpu_bundle.sh); sox measures
     # and compares the soundtracks in the audio tests; glslangValidator (the
-    # Khronos reference compiler) checks every shader variant
-    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox glslang-tools" ;;
+    # Khronos reference compiler) checks every shader variant; clang builds
+    # the simulation a second time (its state hashes must equal gcc's);
+    # systemd's systemd-analyze verifies the unit file make install writes;
+    # python3 parses SVG, WAV and HTTP in the checks (not in a minimal image)
+    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox glslang-tools clang systemd python3" ;;
     # make test-service: a real PostgreSQL server for the two-daemon test,
-    # Debian's Chromium for the dashboard test (driven by playwright-core from npm)
-    service) echo "postgresql chromium" ;;
+    # Debian's Chromium for the dashboard test, driven by playwright-core,
+    # which npm fetches and Node.js runs
+    service) echo "postgresql chromium nodejs npm" ;;
     # make man checks every page it writes with groff -ww; the docs test
     # renders them with man -l
     man) echo "groff-base man-db" ;;
@@ -61,6 +65,9 @@ fi
 missing=""
 for g in $todo; do
     for p in $(group_pkgs "$g"); do
+        # Node.js from its own packages (nodesource) carries npm and
+        # conflicts with Debian's npm: any npm on PATH will do
+        [ "$p" != npm ] || ! command -v npm >/dev/null 2>&1 || continue
         st=$(dpkg-query -W -f='${db:Status-Abbrev}' "$p" 2>/dev/null || true)
         case "$st" in ii*) ;; *) missing="$missing $p" ;; esac
     done

@@ -144,6 +144,6 @@ svc_pg_case() {
     trap svc_cleanup EXIT
     pg_start "$pgdir"
     rc=$?
-    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
+    [ "$rc" = 77 ] && t_skip_install "PostgreSQL is not installed (tools/deps.sh service installs it)"
     [ "$rc" = 0 ] || return 1
 }

@@ -13,7 +13,7 @@ port_of() { echo "${SVC_URL##*:}"; }
 # enough descriptors for 1,000 client sockets in this shell (and the daemon's)
 need_fds() {
     [ "$(ulimit -n)" -ge 1500 ] || ulimit -n "$(ulimit -Hn)" 2>/dev/null
-    [ "$(ulimit -n)" -ge 1500 ] || t_skip_case "ulimit -n is $(ulimit -n) (hard $(ulimit -Hn)): 1,000 connections need more"
+    [ "$(ulimit -n)" -ge 1500 ] || t_skip_env "ulimit -n is $(ulimit -n) (hard $(ulimit -Hn)): 1,000 connections need more"
 }
 
 # /healthz from ADDR: the median of 10 tries must be under 100 ms, none failing

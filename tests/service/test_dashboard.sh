@@ -13,8 +13,8 @@ trap 'exit 143' TERM INT HUP
 
 # node, Chromium and playwright-core, or the case is skipped (sets chromium)
 need_browser() {
-    command -v node >/dev/null 2>&1 || t_skip_case "node is not installed (the browser test runs playwright-core on Node.js)"
-    chromium=$(command -v chromium) || t_skip_case "chromium is not installed (tools/deps.sh service installs it)"
+    command -v node >/dev/null 2>&1 || t_skip_install "node is not installed (the browser test runs playwright-core on Node.js)"
+    chromium=$(command -v chromium) || t_skip_install "chromium is not installed (tools/deps.sh service installs it)"
     if [ ! -d "$here/service/node_modules/playwright-core" ]; then
         (cd "$here/service" && npm ci --no-audit --no-fund --loglevel=error) >npm.log 2>&1 ||
             { cat npm.log; echo "npm ci failed (the npm registry must be reachable)"; return 1; }

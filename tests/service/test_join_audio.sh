@@ -11,7 +11,7 @@
 pcm_of() { ffmpeg -v error -y -i "$1" -map 0:a:0 -ac 1 -f f32le "$2" && echo $(($(wc -c <"$2") / 4)); }
 
 t_joined_job_has_audio() {
-    command -v ffmpeg >/dev/null || t_skip_case "ffmpeg not installed"
+    command -v ffmpeg >/dev/null || t_skip_install "ffmpeg not installed"
     "$RS_BIN" record --ai --quiet --stage dojo --seconds 3 --seed 5 -o three.rsr || return 1
     svc_start d $SVC_FAST --workers 2 --segment-seconds 1 || return 1
     id=$(svc_submit three.rsr) || return 1
@@ -34,7 +34,7 @@ t_joined_job_has_audio() {
 }
 
 t_whole_job_has_audio() {
-    command -v ffmpeg >/dev/null || t_skip_case "ffmpeg not installed"
+    command -v ffmpeg >/dev/null || t_skip_install "ffmpeg not installed"
     "$RS_BIN" record --ai --quiet --stage dojo --seconds 2 --seed 6 -o two.rsr || return 1
     svc_start d $SVC_FAST --workers 1 || return 1
     id=$(svc_submit two.rsr) || return 1
@@ -47,7 +47,7 @@ t_whole_job_has_audio() {
 
 # audio=off (query or form field): no sound in the segments' join or a whole render; the job JSON says so
 t_audio_off() {
-    command -v ffprobe >/dev/null || t_skip_case "ffprobe not installed"
+    command -v ffprobe >/dev/null || t_skip_install "ffprobe not installed"
     "$RS_BIN" record --ai --quiet --stage dojo --seconds 2 --seed 7 -o two.rsr || return 1
     svc_start d $SVC_FAST --workers 2 --segment-seconds 1 || return 1
     code=$(curl -s -o bad.json -w '%{http_code}' -X POST --data-binary @two.rsr "$SVC_URL/jobs?audio=maybe")

@@ -203,7 +203,7 @@ t_join_rejects_bad_and_foreign_segments() {
 t_join_disk_full_requeues() {
     mnt=$T_TMP/join_disk_full/out
     mkdir -p "$mnt"
-    mount -t tmpfs -o size=64m tmpfs "$mnt" 2>/dev/null || t_skip_case "cannot mount a tmpfs (not root?)"
+    mount -t tmpfs -o size=64m tmpfs "$mnt" 2>/dev/null || t_skip_env "cannot mount a tmpfs (not root?)"
     SVC_ON_EXIT="umount -l $mnt"
     SPLIT_OUT=$mnt
     dojo 4 17 four.rsr || return 1

@@ -22,7 +22,7 @@ t_store_contract() {
     trap 'exit 143' TERM INT HUP
     pg_start "$pgdir"
     rc=$?
-    [ "$rc" = 77 ] && t_skip_case "PostgreSQL is not installed (tools/deps.sh service installs it)"
+    [ "$rc" = 77 ] && t_skip_install "PostgreSQL is not installed (tools/deps.sh service installs it)"
     [ "$rc" = 0 ] || return 1
     RINGSIDE_TEST_PG=$PG_URI "$bin" pg_ >out.txt 2>&1
     rc=$?
