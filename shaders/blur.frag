@@ -1,10 +1,23 @@
 #version 330 core
+// variants: - GLOW GLOW+LEVEL2 GLOW+FLARE GLOW+LEVEL2+FLARE
 // Separable Gaussian (9 taps, sigma 2 texels, as 5 bilinear fetches) along
 // u_dir (one texel of the source in uv units).  Used by the shadow mask,
 // the silhouette mip chain and bloom.  The output has the source's size.
+// GLOW: bloom's last blur also makes the one image the tone map adds (the
+// glow, r_post.c): u_bloom x (this blur + the second level, LEVEL2) + the
+// sun's flare (FLARE), so the tone map taps one texture a pixel, not three.
 uniform sampler2D u_src;
 uniform vec2 u_dir;
 uniform float u_lod;
+#ifdef GLOW
+uniform float u_bloom;
+#ifdef LEVEL2
+uniform sampler2D u_level2; // the second level, half this size
+#endif
+#ifdef FLARE
+uniform sampler2D u_flare_img; // the flare pass's image (quarter of the render, HDR)
+#endif
+#endif
 out vec4 o_color;
 void main()
 {
@@ -16,4 +29,15 @@ void main()
     c += (textureLod(u_src, uv + u_dir * o1, u_lod) + textureLod(u_src, uv - u_dir * o1, u_lod)) * w1;
     c += (textureLod(u_src, uv + u_dir * o2, u_lod) + textureLod(u_src, uv - u_dir * o2, u_lod)) * w2;
     o_color = c;
+#ifdef GLOW
+    vec3 g = c.rgb;
+#ifdef LEVEL2
+    g += texture(u_level2, uv).rgb;
+#endif
+    g *= u_bloom;
+#ifdef FLARE
+    g += texture(u_flare_img, uv).rgb;
+#endif
+    o_color = vec4(min(g, vec3(65504.0)), 1.0);
+#endif
 }

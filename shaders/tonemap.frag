@@ -1,12 +1,14 @@
 #version 330 core
-// variants: - BLOOM FLARE BLOOM+FLARE AA BLOOM+FLARE+AA
+// variants: - GLOW AA GLOW+AA
 // Tone map (techniques A3), one full-screen pass:
 //   1. RGB -> Y, Cb, Cr (CbCr unnormalised: B - Y and R - Y)
 //   2. Y' from the curve ((1 - exp(-x^2))^1.5)^(1/gamma) in a float table
 //   3. CbCr scaled by Y'/Y (guarded near 0) and by the saturation
 //   4. back to RGB
-// Bloom (BLOOM) and the sun flare (FLARE) are added in HDR before step 1;
-// those variants exist only when their passes ran this frame.  With the
+// Bloom and the sun flare are added in HDR before step 1 (GLOW): one image
+// at bloom's size that bloom's last blur makes (u_bloom x its levels + the
+// flare, blur.frag), or the flare pass's own when bloom did not run; the
+// variant exists only when one of them ran this frame.  With the
 // AA pass after it (AA), it writes the image's luma beside it, as the AA
 // pass's early out reads it (fxaa.frag).
 uniform sampler2D u_hdr;
@@ -16,13 +18,8 @@ uniform float u_lut_inv_power; // 1 / r_tone_index_power(gamma): 0.5 up to gamma
 uniform float u_exposure;
 uniform float u_saturation;
 uniform int u_write_mask; // alpha = the fighters' mask, else 1
-#ifdef BLOOM
-uniform sampler2D u_bloom0, u_bloom1;
-uniform float u_bloom;
-uniform float u_bloom1_on; // 0: the quality knob's one level (r_quality.bloom_levels 1)
-#endif
-#ifdef FLARE
-uniform sampler2D u_flare_img; // the flare pass's image (quarter size, HDR)
+#ifdef GLOW
+uniform sampler2D u_glow; // bloom and flare, already scaled (HDR)
 #endif
 layout(location = 0) out vec4 o_color;
 #ifdef AA
@@ -48,11 +45,8 @@ void main()
     vec4 hdr = texelFetch(u_hdr, p, 0);
     vec3 c = hdr.rgb * u_exposure;
     vec2 uv = (gl_FragCoord.xy) / vec2(textureSize(u_hdr, 0));
-#ifdef BLOOM
-    c += u_bloom * (texture(u_bloom0, uv).rgb + u_bloom1_on * texture(u_bloom1, uv).rgb);
-#endif
-#ifdef FLARE
-    c += texture(u_flare_img, uv).rgb;
+#ifdef GLOW
+    c += texture(u_glow, uv).rgb;
 #endif
     c = mix(clamp(c, vec3(0.0), vec3(65504.0)), vec3(0.0), isnan(c));
     float y = dot(c, LUMA);

@@ -228,10 +228,12 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_HUD, "hud.vert", "hud.frag", NULL},
         {P_FXAA, "cap_fullscreen.vert", "fxaa.frag", NULL},
         {P_FXAA_MARK, "cap_fullscreen.vert", "fxaa.frag", "#define MARK 1\n"},
+        {P_GLOW, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n"},
+        {P_GLOW + 1, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define LEVEL2 1\n"},
+        {P_GLOW + 2, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define FLARE 1\n"},
+        {P_GLOW + 3, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define LEVEL2 1\n#define FLARE 1\n"},
         {P_TONE, "cap_fullscreen.vert", "tonemap.frag", NULL},
-        {P_TONE + 1, "cap_fullscreen.vert", "tonemap.frag", "#define BLOOM 1\n"},
-        {P_TONE + 2, "cap_fullscreen.vert", "tonemap.frag", "#define FLARE 1\n"},
-        {P_TONE + 3, "cap_fullscreen.vert", "tonemap.frag", "#define BLOOM 1\n#define FLARE 1\n"},
+        {P_TONE + 1, "cap_fullscreen.vert", "tonemap.frag", "#define GLOW 1\n"},
     };
     /* with the AA pass, the tone map writes the luma too (r_aa.c), and the
      * pass's early out gathers it where the GL can (else five fetches) */

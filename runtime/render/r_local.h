@@ -59,8 +59,9 @@ typedef struct prog {
  * without them). */
 enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK_END,
        P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA, P_FXAA_MARK,
-       P_TONE, /* + 4 variants: bloom x flare */
-       P_COUNT = P_TONE + 4 };
+       P_GLOW, /* + 4 variants: bloom's last blur with its second level x the flare (r_post.c) */
+       P_TONE = P_GLOW + 4, /* + 1 variant: with the glow */
+       P_COUNT = P_TONE + 2 };
 /* scene.frag's materials (MATERIAL): what the stage programs draw */
 enum { R_MAT_PLANKS, R_MAT_PAVED, R_MAT_BUILDING, R_MAT_HOLE };
 

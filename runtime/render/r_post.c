@@ -67,9 +67,19 @@ static void run_bloom_bright(void *u)
     r_down_into(r, bloom_step_fbo(r, 1), r->hdr_tex, 0, w, h, r->stage.bloom_threshold, r->f.exposure);
 }
 
+/* The levels, then the glow: the one image the tone map adds.  The first
+ * level is blurred across, the second level is made from that (down, then
+ * blurred both ways), and the first level's blur down the columns writes
+ * the glow: u_bloom x (itself + the second level) + the flare when it
+ * ran (blur.frag's GLOW).  The tone map then taps one texture a pixel
+ * where it tapped three: at 640x360 on llvmpipe each full-size tap costs
+ * about 1 ms, the glow's two extra taps at bloom's size a quarter of
+ * that.  The second level is made from the first blurred across only, not
+ * both ways as before (a slightly narrower glow down the columns). */
 static void run_bloom_blur(void *u)
 {
     r_game *r = u;
+    frame *f = &r->f;
     int w, h;
     for (int k = 2; k <= r->bloom_steps; k++) {
         bloom_step_size(r, k, &w, &h);
@@ -77,12 +87,26 @@ static void run_bloom_blur(void *u)
     }
     int w4 = r->b4_w, h4 = BLOOM_ROWS, w8 = r->b8_w, h8 = BLOOM_ROWS / 2;
     r_blur_into(r, r->b4_fbo[1], r->b4_tex[0], 0, w4, h4, 1, 0);
-    r_blur_into(r, r->b4_fbo[0], r->b4_tex[1], 0, w4, h4, 0, 1);
-    if (r->opts.q.bloom_levels == 1) /* the quality knob: the BLOOM_ROWS level alone */
-        return;
-    r_down_into(r, r->b8_fbo[0], r->b4_tex[0], 0, w8, h8, -1, 1);
-    r_blur_into(r, r->b8_fbo[1], r->b8_tex[0], 0, w8, h8, 1, 0);
-    r_blur_into(r, r->b8_fbo[0], r->b8_tex[1], 0, w8, h8, 0, 1);
+    /* the quality knob r_quality.bloom_levels 1: the BLOOM_ROWS level alone */
+    bool level2 = r->opts.q.bloom_levels != 1, flare = r_ran(f, r, "flare");
+    if (level2) {
+        r_down_into(r, r->b8_fbo[0], r->b4_tex[1], 0, w8, h8, -1, 1);
+        r_blur_into(r, r->b8_fbo[1], r->b8_tex[0], 0, w8, h8, 1, 0);
+        r_blur_into(r, r->b8_fbo[0], r->b8_tex[1], 0, w8, h8, 0, 1);
+    }
+    GLuint p = r->prog[P_GLOW + (level2 ? 1 : 0) + (flare ? 2 : 0)];
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r->b4_fbo[0]);
+    gl.Viewport(0, 0, w4, h4);
+    gl.UseProgram(p);
+    r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, r->b4_tex[1]);
+    gl.Uniform2f(r_loc(p, "u_dir"), 0.0f, 1.0f / (float)h4);
+    gl.Uniform1f(r_loc(p, "u_lod"), 0.0f);
+    gl.Uniform1f(r_loc(p, "u_bloom"), r->stage.bloom);
+    if (level2)
+        r_bind_tex(p, "u_level2", 1, GL_TEXTURE_2D, r->b8_tex[0]);
+    if (flare)
+        r_bind_tex(p, "u_flare_img", 2, GL_TEXTURE_2D, r->fl_tex);
+    r_fullscreen(r);
 }
 
 static void run_sun_visibility(void *u)
@@ -103,8 +127,10 @@ static void run_tonemap(void *u)
 {
     r_game *r = u;
     frame *f = &r->f;
+    /* the glow: bloom's (with the flare in it), else the flare's own */
     bool bloom = r_ran(f, r, "bloom_blur"), flare = r_ran(f, r, "flare");
-    GLuint p = r->prog[P_TONE + (bloom ? 1 : 0) + (flare ? 2 : 0)];
+    GLuint glow = bloom ? r->b4_tex[0] : flare ? r->fl_tex : 0;
+    GLuint p = r->prog[P_TONE + (glow ? 1 : 0)];
     /* with anti-aliasing the AA pass (r_aa.c) writes the output from ldr_tex */
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->opts.q.aa ? r->ldr_fbo : (GLuint)f->out_fbo);
     gl.Viewport(0, 0, f->w, f->h);
@@ -118,14 +144,8 @@ static void run_tonemap(void *u)
     gl.Uniform1f(r_loc(p, "u_exposure"), f->exposure);
     gl.Uniform1f(r_loc(p, "u_saturation"), f->saturation);
     gl.Uniform1i(r_loc(p, "u_write_mask"), r->opts.mask);
-    if (bloom) {
-        r_bind_tex(p, "u_bloom0", 2, GL_TEXTURE_2D, r->b4_tex[0]);
-        r_bind_tex(p, "u_bloom1", 3, GL_TEXTURE_2D, r->b8_tex[0]);
-        gl.Uniform1f(r_loc(p, "u_bloom"), r->stage.bloom);
-        gl.Uniform1f(r_loc(p, "u_bloom1_on"), r->opts.q.bloom_levels == 1 ? 0.0f : 1.0f);
-    }
-    if (flare)
-        r_bind_tex(p, "u_flare_img", 4, GL_TEXTURE_2D, r->fl_tex);
+    if (glow)
+        r_bind_tex(p, "u_glow", 2, GL_TEXTURE_2D, glow);
     r_fullscreen(r);
 }
 
@@ -170,10 +190,11 @@ void r_update_lut(r_game *r)
 }
 
 
+/* the flare first: bloom's last blur adds it to the glow */
 const r_pass r_post_passes[R_POST_NPASS] = {
-    {"bloom_bright", RES_HDR, RES_BLOOM, need_bloom, run_bloom_bright, 0},
-    {"bloom_blur", RES_BLOOM, RES_BLOOM, need_bloom, run_bloom_blur, 0},
     {"sun_visibility", RES_DEPTH, RES_SUNVIS, need_sun, run_sun_visibility, 0},
     {"flare", RES_SUNVIS, RES_FLARE, need_sun, run_flare, 0},
+    {"bloom_bright", RES_HDR, RES_BLOOM, need_bloom, run_bloom_bright, 0},
+    {"bloom_blur", RES_BLOOM, RES_BLOOM, need_bloom, run_bloom_blur, RES_FLARE},
     {"tonemap", RES_HDR | RES_ENV, RES_OUT, need_always, run_tonemap, RES_BLOOM | RES_FLARE},
 };
