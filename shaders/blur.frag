@@ -28,8 +28,9 @@ void main()
     vec4 c = textureLod(u_src, uv, u_lod) * w0;
     c += (textureLod(u_src, uv + u_dir * o1, u_lod) + textureLod(u_src, uv - u_dir * o1, u_lod)) * w1;
     c += (textureLod(u_src, uv + u_dir * o2, u_lod) + textureLod(u_src, uv - u_dir * o2, u_lod)) * w2;
+#ifndef GLOW
     o_color = c;
-#ifdef GLOW
+#else
     vec3 g = c.rgb;
 #ifdef LEVEL2
     g += texture(u_level2, uv).rgb;

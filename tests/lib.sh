@@ -24,8 +24,15 @@ trap 'rm -rf "$T_TMP"' EXIT
 # The reason goes on the verdict line ("skip SUITE/CASE (KIND: WHY) (N s)"),
 # which tests/run.sh and .ci/run list at the end.
 T_SKIP_ENV=77 T_SKIP_INSTALL=78
-t_skip_env() { echo "    skip (environment): $*" >&2; [ -z "${T_CASE_DIR:-}" ] || printf 'environment: %s\n' "$*" >"$T_CASE_DIR.skip"; exit $T_SKIP_ENV; }
-t_skip_install() { echo "    skip (missing install): $*" >&2; [ -z "${T_CASE_DIR:-}" ] || printf 'missing install: %s\n' "$*" >"$T_CASE_DIR.skip"; exit $T_SKIP_INSTALL; }
+t_skip_as() { # CODE KIND WHY...
+    code=$1 kind=$2
+    shift 2
+    echo "    skip ($kind): $*" >&2
+    [ -z "${T_CASE_DIR:-}" ] || printf '%s: %s\n' "$kind" "$*" >"$T_CASE_DIR.skip"
+    exit "$code"
+}
+t_skip_env() { t_skip_as "$T_SKIP_ENV" environment "$@"; }
+t_skip_install() { t_skip_as "$T_SKIP_INSTALL" "missing install" "$@"; }
 
 # T_CASES="a b": run only the cases of those exact names (tests/run.sh's tiers)
 t_run() {

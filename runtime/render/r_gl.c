@@ -127,15 +127,19 @@ int r_half(int v, int k)
     return v > 0 ? v : 1;
 }
 
-void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy)
+void r_blur_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy)
 {
-    GLuint p = r->prog[P_BLUR];
     gl.BindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
     gl.Viewport(0, 0, w, h);
     gl.UseProgram(p);
     r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, src_tex);
     gl.Uniform2f(r_loc(p, "u_dir"), dx / (float)w, dy / (float)h);
     gl.Uniform1f(r_loc(p, "u_lod"), (float)lod);
+}
+
+void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy)
+{
+    r_blur_setup(r->prog[P_BLUR], dst_fbo, src_tex, lod, w, h, dx, dy);
     r_fullscreen(r);
 }
 

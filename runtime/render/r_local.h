@@ -177,6 +177,9 @@ void r_bind_ibl(r_game *r, GLuint p); /* units 8..13 */
 void r_fullscreen(r_game *r);      /* one triangle: cap_fullscreen.vert */
 int r_half(int v, int k);          /* v >> k, at least 1 */
 void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
+/* r_blur_into's state with program p (blur.frag or a variant), not drawn:
+ * the caller sets the variant's uniforms, then r_fullscreen */
+void r_blur_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
 /* The bloom pyramid for a w x h render: *steps down from the HDR image
  * to the BLOOM_ROWS level (halvings, the last a resample), *w4 its width. */

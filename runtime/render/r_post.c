@@ -95,12 +95,7 @@ static void run_bloom_blur(void *u)
         r_blur_into(r, r->b8_fbo[0], r->b8_tex[1], 0, w8, h8, 0, 1);
     }
     GLuint p = r->prog[P_GLOW + (level2 ? 1 : 0) + (flare ? 2 : 0)];
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->b4_fbo[0]);
-    gl.Viewport(0, 0, w4, h4);
-    gl.UseProgram(p);
-    r_bind_tex(p, "u_src", 0, GL_TEXTURE_2D, r->b4_tex[1]);
-    gl.Uniform2f(r_loc(p, "u_dir"), 0.0f, 1.0f / (float)h4);
-    gl.Uniform1f(r_loc(p, "u_lod"), 0.0f);
+    r_blur_setup(p, r->b4_fbo[0], r->b4_tex[1], 0, w4, h4, 0, 1);
     gl.Uniform1f(r_loc(p, "u_bloom"), r->stage.bloom);
     if (level2)
         r_bind_tex(p, "u_level2", 1, GL_TEXTURE_2D, r->b8_tex[0]);
