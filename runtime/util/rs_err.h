@@ -32,7 +32,10 @@
     X(MV, "movie")                     \
     X(SVC_STORE, "queue store")        \
     X(SVC, "service")                  \
-    X(AU, "audio")
+    X(AU, "audio")                     \
+    X(R, "render")                     \
+    X(JOB, "job")                      \
+    X(SVC_CONFIG, "service config")
 
 typedef enum rs_err_module {
 #define X(id, name) RS_ERR_MOD_##id,
