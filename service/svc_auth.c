@@ -19,6 +19,7 @@
 
 #include "svc.h"
 #include "svc_auth.h"
+#include "svc_local.h"
 #include "svc_store.h"
 #include "../runtime/util/rs_file.h"
 
@@ -97,7 +98,7 @@ bool svc_token_make(char *out, rs_err *err)
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0)
-            return rs_fail(err, 1, "cannot make a token: getrandom: %s", strerror(errno));
+            return rs_fail(err, SVC_ERR_SYSTEM, "cannot make a token: getrandom: %s", strerror(errno));
         got += (size_t)n;
     }
     size_t k = strlen(SVC_TOKEN_PREFIX);
@@ -203,7 +204,7 @@ bool svc_token_add(const svc_config *cfg, const char *name, bool is_operator, in
     int r = s->ops->token_add(s, &t, hash, err);
     s->ops->close(s);
     if (r == 0)
-        return rs_fail(err, 1, "a token named '%s' exists already (revoked ones keep their names)", name);
+        return rs_fail(err, SVC_ERR_TOKEN_EXISTS, "a token named '%s' exists already (revoked ones keep their names)", name);
     if (r < 0)
         return false;
     printf("%s\n", token);
@@ -231,7 +232,7 @@ bool svc_token_list(const svc_config *cfg, rs_err *err)
     int n = t ? s->ops->token_list(s, t, MAX, err) : -1;
     s->ops->close(s);
     if (!t)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, SVC_ERR_NOMEM, "out of memory");
     if (n < 0) {
         free(t);
         return false;
@@ -261,7 +262,7 @@ bool svc_token_revoke(const svc_config *cfg, const char *which, rs_err *err)
     if (r < 0)
         return false;
     if (r == 0)
-        return rs_fail(err, 1, "no token named '%s' or with that id ('ringside serve token list' shows them)", which);
+        return rs_fail(err, SVC_ERR_TOKEN_UNKNOWN, "no token named '%s' or with that id ('ringside serve token list' shows them)", which);
     fprintf(stderr, "ringside serve token: token %lld '%s' %s\n", (long long)t.id, t.name,
             r == 2 ? "was revoked already" : "revoked: it stops working at its next request");
     return true;

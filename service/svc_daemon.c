@@ -212,7 +212,7 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
         w->units = calloc((size_t)j->segments + 1, sizeof *w->units);
         w->bad = calloc((size_t)j->segments + 1, sizeof *w->bad);
         if (!w->units || !w->bad)
-            return rs_fail(err, 1, "out of memory");
+            return rs_fail(err, SVC_ERR_NOMEM, "out of memory");
         w->nunits = d->store->ops->units(d->store, j->id, w->units, j->segments + 1, err);
         if (w->nunits < 0)
             return false;
@@ -229,19 +229,19 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
     int prog[2], errp[2];
     if (pipe2(prog, O_CLOEXEC) != 0) {
         svc_argv_free(argv);
-        return rs_fail(err, 1, "pipe: %s", strerror(errno));
+        return rs_fail(err, SVC_ERR_SYSTEM, "pipe: %s", strerror(errno));
     }
     if (pipe2(errp, O_CLOEXEC) != 0) {
         close(prog[0]), close(prog[1]);
         svc_argv_free(argv);
-        return rs_fail(err, 1, "pipe: %s", strerror(errno));
+        return rs_fail(err, SVC_ERR_SYSTEM, "pipe: %s", strerror(errno));
     }
     pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         close(prog[0]), close(prog[1]), close(errp[0]), close(errp[1]);
         svc_argv_free(argv);
-        return rs_fail(err, 1, "fork: %s", strerror(errno));
+        return rs_fail(err, SVC_ERR_SYSTEM, "fork: %s", strerror(errno));
     }
     if (pid == 0) {
         /* the child: only async-signal-safe calls until exec */

@@ -156,7 +156,7 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
                 continue;
             if (units[i].index != k || units[i].state != SVC_DONE || units[i].done_attempt <= 0) {
                 svc_argv_free(a.v);
-                rs_fail(err, 1, "job %" PRId64 ": segment %d is not done (%s): nothing to join yet", j->id, k,
+                rs_fail(err, SVC_ERR_SEGMENTS, "job %" PRId64 ": segment %d is not done (%s): nothing to join yet", j->id, k,
                         svc_state_name(units[i].state));
                 return NULL;
             }
@@ -167,7 +167,7 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
         }
         if (k != j->segments) {
             svc_argv_free(a.v);
-            rs_fail(err, 1, "job %" PRId64 ": %d of %d segments found", j->id, k, j->segments);
+            rs_fail(err, SVC_ERR_SEGMENTS, "job %" PRId64 ": %d of %d segments found", j->id, k, j->segments);
             return NULL;
         }
     } else {
@@ -200,7 +200,7 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
     }
     if (a.oom) {
         svc_argv_free(a.v);
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, SVC_ERR_NOMEM, "out of memory");
         return NULL;
     }
     return a.v;

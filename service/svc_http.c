@@ -36,31 +36,22 @@
 const char *svc_error_text(int code)
 {
     static const char *const text[] = {
-#define X(id, t) t,
+#define X(id, status, t) t,
         SVC_ERRORS(X)
 #undef X
     };
     return rs_err_text_of(code, RS_ERR_MOD_SVC, text, (int)(sizeof text / sizeof text[0]));
 }
 
-/* The one place where an error becomes an HTTP status. */
-static const struct {
-    int id;
-    unsigned short status;
-} http_status[] = {
-    {SVC_ERR_EMPTY, 400},     {SVC_ERR_TOO_LARGE, 413}, {SVC_ERR_TOO_LONG, 400}, {SVC_ERR_REPLAY, 400},
-    {SVC_ERR_BAD_BODY, 400},  {SVC_ERR_BAD_PARAM, 400}, {SVC_ERR_NOT_FOUND, 404}, {SVC_ERR_CONFLICT, 409},
-    {SVC_ERR_GONE, 410},      {SVC_ERR_RANGE, 416},     {SVC_ERR_METHOD, 405},   {SVC_ERR_DRAINING, 503},
-    {SVC_ERR_NOMEM, 500},     {SVC_ERR_AUTH, 401},      {SVC_ERR_QUOTA, 429},     {SVC_ERR_BAD_REQUEST, 400},
-    {SVC_ERR_HOST, 421},      {SVC_ERR_ORIGIN, 403},    {SVC_ERR_CODING, 501},    {SVC_ERR_BUSY, 503},
-    {SVC_ERR_DESYNC, 400},    {SVC_ERR_GAME_VERSION, 400},
-};
-
 unsigned svc_http_status(int code)
 {
-    for (size_t i = 0; i < sizeof http_status / sizeof http_status[0]; i++)
-        if (http_status[i].id == code)
-            return http_status[i].status;
+    switch (code) {
+#define X(id, status, t)                                                                                               \
+    case SVC_ERR_##id:                                                                                                 \
+        return status;
+        SVC_ERRORS(X)
+#undef X
+    }
     return RS_ERR_MODULE(code) == RS_ERR_MOD_SVC_STORE ? 503 : 500;
 }
 
@@ -1810,12 +1801,12 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
     struct addrinfo *ai = NULL;
     int gr = getaddrinfo(*h ? h : NULL, port, &hints, &ai);
     if (gr != 0) {
-        rs_fail(err, 1, "listen %s: %s", d->cfg.listen, gai_strerror(gr));
+        rs_fail(err, SVC_ERR_LISTEN, "listen %s: %s", d->cfg.listen, gai_strerror(gr));
         return NULL;
     }
     if (!(d->net = net_new(d))) {
         freeaddrinfo(ai);
-        rs_fail(err, 1, "out of memory starting the HTTP server");
+        rs_fail(err, SVC_ERR_NOMEM, "out of memory starting the HTTP server");
         return NULL;
     }
     /* epoll: no FD_SETSIZE limit, and thousands of idle connections cost
@@ -1836,7 +1827,7 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
     if (!mhd) {
         net_free(d->net);
         d->net = NULL;
-        rs_fail(err, 1, "cannot listen on %s (in use, or not an address of this machine?)", d->cfg.listen);
+        rs_fail(err, SVC_ERR_LISTEN, "cannot listen on %s (in use, or not an address of this machine?)", d->cfg.listen);
         return NULL;
     }
     if (pthread_create(&d->net->reaper, NULL, reaper, d->net) == 0)
@@ -1861,7 +1852,7 @@ void svc_http_stop(svc_daemon *d, struct MHD_Daemon *h)
 struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
 {
     (void)d;
-    rs_fail(err, 1, "this ringside was built without libmicrohttpd (install libmicrohttpd-dev and rebuild)");
+    rs_fail(err, SVC_ERR_NO_HTTP, "this ringside was built without libmicrohttpd (install libmicrohttpd-dev and rebuild)");
     return NULL;
 }
 

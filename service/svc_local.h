@@ -62,42 +62,53 @@ typedef struct svc_daemon {
 } svc_daemon;
 
 /* svc_http.c */
-/* Error ids (rs_err.h) of refused uploads and requests.  Each becomes an
- * HTTP status in one table, svc_http_status, never through rs_err.code. */
-#define SVC_ERRORS(X)                                                           \
-    X(EMPTY, "empty upload")                                                    \
-    X(TOO_LARGE, "the upload is over max_upload")                               \
-    X(TOO_LONG, "the replay lasts longer than max_seconds")                     \
-    X(REPLAY, "the upload is not a replay this service can render")             \
-    X(DESYNC, "the replay's inputs do not reproduce its recorded state hashes")  \
-    X(GAME_VERSION, "the replay was recorded by another version of the game")   \
-    X(BAD_BODY, "a malformed request body")                                     \
-    X(BAD_PARAM, "a bad request parameter (size, format, limit, before)")       \
-    X(NOT_FOUND, "no such job or resource, or the file does not exist yet")     \
-    X(CONFLICT, "the job is already over")                                      \
-    X(GONE, "a finished job's file is missing on this server")                  \
-    X(RANGE, "the byte range asked for is outside the file")                    \
-    X(METHOD, "the resource does not take that method")                         \
-    X(DRAINING, "the daemon is shutting down and takes no new jobs")            \
-    X(AUTH, "no API token, or an unknown or revoked one")                       \
-    X(QUOTA, "the API token's quota is used up for now")                        \
-    X(NOMEM, "out of memory")                                                   \
-    X(BAD_REQUEST, "a malformed request (control characters, header syntax)")   \
-    X(HOST, "the Host header names no host this daemon serves")                 \
-    X(ORIGIN, "a state-changing request from a foreign web page (Origin)")      \
-    X(CODING, "a transfer coding the daemon does not understand")               \
-    X(BUSY, "uploads in progress hold all of upload_memory")
+/* Error ids (rs_err.h) of the service, each with the HTTP status a request
+ * that fails with it gets and its text: one list, so an id cannot lack a
+ * status (svc_http_status reads the middle column). */
+#define SVC_ERRORS(X)                                                                          \
+    X(EMPTY, 400, "empty upload")                                                              \
+    X(TOO_LARGE, 413, "the upload is over max_upload")                                         \
+    X(TOO_LONG, 400, "the replay lasts longer than max_seconds")                               \
+    X(REPLAY, 400, "the upload is not a replay this service can render")                       \
+    X(DESYNC, 400, "the replay's inputs do not reproduce its recorded state hashes")           \
+    X(GAME_VERSION, 400, "the replay was recorded by another version of the game")             \
+    X(BAD_BODY, 400, "a malformed request body")                                               \
+    X(BAD_PARAM, 400, "a bad request parameter (size, format, limit, before)")                 \
+    X(NOT_FOUND, 404, "no such job or resource, or the file does not exist yet")               \
+    X(CONFLICT, 409, "the job is already over")                                                \
+    X(GONE, 410, "a finished job's file is missing on this server")                            \
+    X(RANGE, 416, "the byte range asked for is outside the file")                              \
+    X(METHOD, 405, "the resource does not take that method")                                   \
+    X(DRAINING, 503, "the daemon is shutting down and takes no new jobs")                      \
+    X(AUTH, 401, "no API token, or an unknown or revoked one")                                 \
+    X(QUOTA, 429, "the API token's quota is used up for now")                                  \
+    X(NOMEM, 500, "out of memory")                                                             \
+    X(BAD_REQUEST, 400, "a malformed request (control characters, header syntax)")             \
+    X(HOST, 421, "the Host header names no host this daemon serves")                           \
+    X(ORIGIN, 403, "a state-changing request from a foreign web page (Origin)")                \
+    X(CODING, 501, "a transfer coding the daemon does not understand")                        \
+    X(BUSY, 503, "uploads in progress hold all of upload_memory")                              \
+    X(SYSTEM, 500, "a system call failed (pipe, fork, random bytes, the lock file)")           \
+    X(DATA_DIR, 500, "the data directory is missing or not writable")                          \
+    X(LOCKED, 500, "another daemon serves this SQLite queue")                                  \
+    X(LISTEN, 500, "the HTTP server cannot listen on the configured address")                  \
+    X(NO_HTTP, 500, "this build has no HTTP server (libmicrohttpd)")                           \
+    X(NO_TOKENS, 500, "the daemon listens beyond this machine and the queue has no API token")    \
+    X(SUPERVISOR, 500, "the daemon's supervisor stopped on an error")                          \
+    X(SEGMENTS, 500, "a job's segments are not all rendered, so it cannot be joined yet")      \
+    X(TOKEN_EXISTS, 409, "an API token with that name exists already")                         \
+    X(TOKEN_UNKNOWN, 404, "no API token with that name or id")
 
 typedef enum svc_error {
     SVC_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC),
-#define X(id, text) SVC_ERR_##id,
+#define X(id, status, text) SVC_ERR_##id,
     SVC_ERRORS(X)
 #undef X
         SVC_ERR_END
 } svc_error;
 
 const char *svc_error_text(int code);
-/* The HTTP status for an error id: SVC ids by the table in svc_http.c,
+/* The HTTP status for an error id: SVC ids by their row of SVC_ERRORS,
  * every queue store id 503 (the queue is unavailable), anything else 500. */
 unsigned svc_http_status(int code);
 

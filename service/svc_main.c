@@ -41,7 +41,7 @@ static int lock_sqlite(const char *db, rs_err *err)
     snprintf(path, sizeof path, "%s.lock", db);
     int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0) {
-        rs_fail(err, 1, "%s: cannot create the lock file: %s", path, strerror(errno));
+        rs_fail(err, SVC_ERR_SYSTEM, "%s: cannot create the lock file: %s", path, strerror(errno));
         return -1;
     }
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
@@ -49,7 +49,7 @@ static int lock_sqlite(const char *db, rs_err *err)
         ssize_t n = pread(fd, other, sizeof other - 1, 0);
         other[n > 0 ? n : 0] = 0;
         other[strcspn(other, "\n")] = 0;
-        rs_fail(err, 1, "%s: another daemon (process %s) uses this queue; an SQLite queue serves one daemon "
+        rs_fail(err, SVC_ERR_LOCKED, "%s: another daemon (process %s) uses this queue; an SQLite queue serves one daemon "
                         "(use PostgreSQL for several)",
                 db, other[0] ? other : "?");
         close(fd);
@@ -71,9 +71,9 @@ static bool mkdir_p(const char *dir, rs_err *err)
         return false;
     struct stat st;
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-        return rs_fail(err, 1, "%s: not a directory", dir);
+        return rs_fail(err, SVC_ERR_DATA_DIR, "%s: not a directory", dir);
     if (access(dir, W_OK) != 0)
-        return rs_fail(err, 1, "%s: not writable", dir);
+        return rs_fail(err, SVC_ERR_DATA_DIR, "%s: not writable", dir);
     return true;
 }
 
@@ -96,7 +96,7 @@ static bool desc_files(svc_daemon *d, const svc_desc *desc, rs_err *err)
     else {
         ssize_t n = readlink("/proc/self/exe", d->exe, sizeof d->exe - 1);
         if (n <= 0)
-            return rs_fail(err, 1, "cannot find this program's path (/proc/self/exe) to run the renderer");
+            return rs_fail(err, SVC_ERR_SYSTEM, "cannot find this program's path (/proc/self/exe) to run the renderer");
         d->exe[n] = 0;
     }
     if (desc->dashboard) {
@@ -125,7 +125,7 @@ static bool check_tokens(svc_daemon *d, rs_err *err)
         return false;
     bool loopback = svc_listen_is_loopback(d->cfg.listen);
     if (!loopback && n == 0)
-        return rs_fail(err, 1,
+        return rs_fail(err, SVC_ERR_NO_TOKENS,
                        "listen %s reaches beyond this machine and the queue has no API token: make one first with "
                        "'ringside serve token add NAME' (with the same --data or --queue), or listen on 127.0.0.1",
                        d->cfg.listen);
@@ -191,7 +191,7 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
     mu = true;
     d.live = calloc((size_t)d.cfg.workers, sizeof *d.live);
     if (!d.live) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, SVC_ERR_NOMEM, "out of memory");
         goto out;
     }
     the_daemon = &d;
@@ -219,7 +219,7 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
             d.cfg.workers == 1 ? "" : "s", d.cfg.output, d.cfg.quality, rsize);
     ok = svc_run(&d) == 0;
     if (!ok)
-        rs_fail(err, 1, "the supervisor stopped on an error (see the log above)");
+        rs_fail(err, SVC_ERR_SUPERVISOR, "the supervisor stopped on an error (see the log above)");
     svc_http_stop(&d, http);
     http = NULL;
     svc_log(SVC_LOG_INFO, -1, "stopped");

@@ -1055,8 +1055,16 @@ static void t_http_status_table(void)
         {SVC_ERR_NOMEM, 500},    {SVC_ERR_BAD_REQUEST, 400}, {SVC_ERR_HOST, 421},   {SVC_ERR_ORIGIN, 403},
         {SVC_ERR_CODING, 501},   {SVC_ERR_BUSY, 503},
         {SVC_ERR_DESYNC, 400},   {SVC_ERR_GAME_VERSION, 400},
+        /* the daemon's own failures (start-up, tokens, joins): server errors or the token's state */
+        {SVC_ERR_SYSTEM, 500},   {SVC_ERR_DATA_DIR, 500},  {SVC_ERR_LOCKED, 500},   {SVC_ERR_LISTEN, 500},
+        {SVC_ERR_NO_HTTP, 500},  {SVC_ERR_NO_TOKENS, 500}, {SVC_ERR_SUPERVISOR, 500}, {SVC_ERR_SEGMENTS, 500},
+        {SVC_ERR_TOKEN_EXISTS, 409}, {SVC_ERR_TOKEN_UNKNOWN, 404},
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
+    /* every id is an error status (its row of SVC_ERRORS has one) */
+    for (int a = SVC_ERR_BASE + 1; a < SVC_ERR_END; a++)
+        T_ASSERTF(svc_http_status(a) >= 400 && svc_http_status(a) <= 599, "%s: status %u", svc_error_text(a),
+                  svc_http_status(a));
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
         T_ASSERTF(svc_http_status(want[i].id) == want[i].status, "%s: %u, want %u", svc_error_text(want[i].id),
                   svc_http_status(want[i].id), want[i].status);
