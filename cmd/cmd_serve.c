@@ -17,7 +17,8 @@ static void help(void)
     printf("usage: ringside serve [--config FILE] [--listen ADDR:PORT] [--workers N] [--data DIR]\n"
            "                      [--queue sqlite:PATH|postgres://...] [--output DIR] [--SETTING VALUE ...]\n"
            "                      [--print-config]\n"
-           "       ringside serve token add|list|revoke ...   (API tokens: 'ringside serve token --help')\n\n"
+           "       ringside serve token add|list|revoke ...   (API tokens: 'ringside serve token --help')\n"
+           "       ringside serve routes                    (the HTTP API's routes, from its route table)\n\n"
            "The replay-to-video service: an HTTP API and dashboard, a durable job queue and\n"
            "worker processes that run 'ringside render'.  Clients upload replays\n"
            "(POST /jobs), watch progress (GET /jobs/ID) and fetch videos (GET /jobs/ID/video);\n"
@@ -246,6 +247,16 @@ int cmd_serve(int argc, char **argv)
 {
     if (argc > 1 && !strcmp(argv[1], "token"))
         return cmd_serve_token(argc - 1, argv + 1);
+    if (argc > 1 && !strcmp(argv[1], "routes")) {
+        if (argc > 2) {
+            cli_error("serve", "routes takes no argument");
+            return cli_usage_error("serve");
+        }
+        if (svc_routes_print(stdout))
+            return RS_EXIT_OK;
+        cli_error("serve", "routes: this ringside was built without libmicrohttpd: it has no HTTP API");
+        return RS_EXIT_FAIL;
+    }
     svc_config cfg;
     bool print = false;
     int rc = read_settings(argc, argv, &cfg, &print, NULL);

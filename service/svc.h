@@ -6,6 +6,7 @@
 #define SVC_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "../runtime/util/rs_err.h"
 #include "svc_config.h"
@@ -37,5 +38,10 @@ bool svc_token_add(const svc_config *cfg, const char *name, bool is_operator, in
                    rs_err *err);
 bool svc_token_list(const svc_config *cfg, rs_err *err);
 bool svc_token_revoke(const svc_config *cfg, const char *which, rs_err *err);
+
+/* `ringside serve routes`: the HTTP API's route table, one row a route
+ * (method, path, whether it needs a token, whether it takes a body, the
+ * query parameters it takes).  False when built without an HTTP server. */
+bool svc_routes_print(FILE *out);
 
 #endif

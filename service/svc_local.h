@@ -41,7 +41,7 @@ typedef struct svc_live {
     char log[SVC_LOG_LINES * SVC_LOG_LINE]; /* the running unit's log so far, one line per '\n' */
 } svc_live;
 
-typedef struct svc_net svc_net; /* svc_http.c: connections, deadlines, upload budget */
+typedef struct svc_net svc_net; /* svc_http_guard.c: connections, deadlines, upload budget */
 
 typedef struct svc_daemon {
     svc_config cfg;
@@ -61,7 +61,7 @@ typedef struct svc_daemon {
     uint64_t uploads_rejected;
 } svc_daemon;
 
-/* svc_http.c */
+/* the HTTP layer (svc_http*.c, svc_upload.c; its files share svc_http_local.h) */
 /* Error ids (rs_err.h) of the service, each with the HTTP status a request
  * that fails with it gets and its text: one list, so an id cannot lack a
  * status (svc_http_status reads the middle column). */
@@ -108,7 +108,7 @@ typedef enum svc_error {
 } svc_error;
 
 const char *svc_error_text(int code);
-/* The HTTP status for an error id: SVC ids by their row of SVC_ERRORS,
+/* The HTTP status for an error id (svc_http_reply.c): SVC ids by their row of SVC_ERRORS,
  * every queue store id 503 (the queue is unavailable), anything else 500. */
 unsigned svc_http_status(int code);
 

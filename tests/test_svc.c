@@ -18,6 +18,10 @@
 #include "../service/svc_encode.h"
 #include "../service/svc_json.h"
 #include "../service/svc_local.h"
+#include "../service/svc_upload.h"
+#if defined(RS_HAVE_MHD)
+#include "../service/svc_http_local.h"
+#endif
 #include "t.h"
 
 /* Fixed-seed xorshift64*: a failing random case fails the same way each run. */
@@ -1134,6 +1138,85 @@ static void t_tokens_and_bearer(void)
     T_ASSERT(!svc_listen_is_loopback("10.0.0.1:80") && !svc_listen_is_loopback("1270.0.0.1:80"));
 }
 
+/* The route table decides routing, 404 against 405, the open routes and
+ * each route's query parameters. */
+static void t_route_table(void)
+{
+#if defined(RS_HAVE_MHD)
+    svc_match m;
+    svc_route_match("/jobs/", "POST", &m); /* a collection answers with a trailing slash */
+    T_ASSERT(m.route && m.route->body && !m.open);
+    T_CONTAINS(m.route->params, "quality");
+    T_CONTAINS(m.route->params, "name");
+    svc_route_match("/jobs/12", "DELETE", &m);
+    T_ASSERT(m.route && m.id == 12 && !m.route->body);
+    svc_route_match("/jobs/12", "POST", &m);
+    T_ASSERT(!m.route && m.known && !strcmp(m.methods, "GET or DELETE"));
+    svc_route_match("/jobs/12/log", "HEAD", &m); /* a GET route answers HEAD */
+    T_ASSERT(m.route && m.id == 12);
+    svc_route_match("/jobs/12/retry", "GET", &m);
+    T_ASSERT(!m.route && m.known && !strcmp(m.methods, "POST"));
+    svc_route_match("/jobs/0", "GET", &m);
+    T_ASSERT(!m.route && !m.known && m.bad_id);
+    svc_route_match("/jobs/x1/video", "GET", &m);
+    T_ASSERT(!m.route && m.bad_id);
+    svc_route_match("/jobs/1234567890123456789", "GET", &m); /* 19 digits: past int64 */
+    T_ASSERT(!m.route && m.bad_id);
+    svc_route_match("/healthz", "GET", &m);
+    T_ASSERT(m.route && m.open);
+    svc_route_match("/healthz/", "GET", &m);
+    T_ASSERT(!m.route && !m.known && !m.bad_id);
+    svc_route_match("/jobs/1/video/", "GET", &m);
+    T_ASSERT(!m.route && !m.known);
+    svc_route_match("/", "POST", &m);
+    T_ASSERT(!m.route && m.known && m.open && !strcmp(m.methods, "GET"));
+    svc_route_match("/metrics", "GET", &m);
+    T_ASSERT(m.route && !m.open && !m.route->params[0]);
+#else
+    T_SKIP_ENV("built without libmicrohttpd");
+#endif
+}
+
+/* An upload without HTTP: the body within the limit, form fields and query
+ * parameters from one list, the job it asks for. */
+static void t_upload_params(void)
+{
+    svc_config cfg;
+    svc_config_defaults(&cfg);
+    svc_upload u = {.limit = 8};
+    T_ASSERT(svc_upload_append(&u, "1234", 4) && u.len == 4);
+    T_ASSERT(svc_upload_append(&u, "56789", 5) && u.too_large && !u.body && u.len == 0);
+    svc_upload_free(&u);
+    u = (svc_upload){.limit = 1 << 20};
+    /* a form field in two pieces; one too long for its room is dropped */
+    T_ASSERT(svc_upload_field(&u, "codec", NULL, "h2", 0, 2) && svc_upload_field(&u, "codec", NULL, "64", 2, 2));
+    T_ASSERT(!strcmp(u.p.codec, "h264"));
+    T_ASSERT(svc_upload_field(&u, "crf", NULL, "123456789", 0, 9) && !u.p.crf[0]);
+    T_ASSERT(svc_upload_field(&u, "replay", "dir/a\x01" "b.rsr", "RS", 0, 2) && u.len == 2);
+    T_ASSERT(!strcmp(u.name, "a_b.rsr"));
+    T_ASSERT(svc_upload_field(&u, "other", NULL, "x", 0, 1) && svc_upload_field(&u, NULL, NULL, "x", 0, 1));
+    /* the query fills what the form left; too long is refused, the form's value stays */
+    rs_err e = {0};
+    T_ASSERT(svc_upload_param(&u, "codec", "vp9", &e) && !strcmp(u.p.codec, "h264"));
+    T_ASSERT(svc_upload_param(&u, "size", "320x180", &e) && !strcmp(u.p.size, "320x180"));
+    T_ASSERT(!svc_upload_param(&u, "format", "mp4mp4mp4mp4mp4mp4", &e) && e.code == SVC_ERR_BAD_PARAM);
+    T_CONTAINS(e.msg, "format: at most 15 characters");
+    T_ASSERT(svc_upload_param(&u, "nosuch", "1", &e));
+    /* the job: the parameters checked before the replay */
+    svc_job j;
+    T_ASSERT(!svc_upload_job(&cfg, &u, &j, &e) && e.code == SVC_ERR_REPLAY);
+    snprintf(u.p.size, sizeof u.p.size, "17x9");
+    T_ASSERT(!svc_upload_job(&cfg, &u, &j, &e) && e.code == SVC_ERR_BAD_PARAM);
+    T_CONTAINS(e.msg, "size 17x9");
+    snprintf(u.p.size, sizeof u.p.size, "320x180");
+    snprintf(u.p.format, sizeof u.p.format, "avi");
+    T_ASSERT(!svc_upload_job(&cfg, &u, &j, &e) && e.code == SVC_ERR_BAD_PARAM);
+    T_CONTAINS(e.msg, "format 'avi'");
+    svc_upload_free(&u);
+    /* the names of the list, as POST /jobs's row of the route table has them */
+    T_ASSERT(!strcmp(SVC_JOB_PARAM_LIST, "size,format,codec,crf,bitrate,preset,pix_fmt,audio,quality,name"));
+}
+
 T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t_tokens_and_bearer},
        {"config_defaults", t_config_defaults}, {"config_data_default", t_config_data_default}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
        {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
@@ -1145,4 +1228,5 @@ T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t
        {"upload_valid", t_upload_valid}, {"upload_truncations", t_upload_truncations},
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"upload_verified", t_upload_verified},
-       {"http_status_table", t_http_status_table}, {"encode_options", t_encode_options})
+       {"http_status_table", t_http_status_table}, {"encode_options", t_encode_options},
+       {"route_table", t_route_table}, {"upload_params", t_upload_params})

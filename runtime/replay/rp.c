@@ -560,3 +560,14 @@ bool rp_check_tick(const rp_replay *rp, const g_state *st, uint64_t done, size_t
     }
     return false;
 }
+
+bool rp_peek_ticks(const uint8_t *buf, size_t len, uint64_t *ticks)
+{
+    enum { TICKS_AT = 20 }; /* magic 4, version 2, flags 2, stage 4, seed 8 */
+    if (len < TICKS_AT + 8 || memcmp(buf, RP_MAGIC, 4) != 0)
+        return false;
+    *ticks = 0;
+    for (int k = 0; k < 8; k++)
+        *ticks |= (uint64_t)buf[TICKS_AT + k] << (8 * k);
+    return true;
+}

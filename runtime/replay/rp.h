@@ -88,6 +88,11 @@ bool rp_rec_save(rp_recorder *r, const char *path, rs_err *err);
 bool rp_encode(const rp_replay *rp, uint8_t **out, size_t *len, rs_err *err);
 /* name is used in messages (a path, or "upload"). */
 bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, rs_err *err);
+/* The tick count a replay's header declares (byte 20), read without
+ * decoding or checking anything else: what a service looks at before it
+ * spends 2 bytes a tick decoding.  False when buf is too short or not a
+ * replay. */
+bool rp_peek_ticks(const uint8_t *buf, size_t len, uint64_t *ticks);
 bool rp_read(const char *path, rp_replay *rp, rs_err *err);
 bool rp_write(const char *path, const rp_replay *rp, rs_err *err);
 void rp_free(rp_replay *rp);
