@@ -24,7 +24,8 @@ static bool host_part(const char *in, size_t in_len, char *out, size_t n)
     size_t len = in_len;
     if (len && *s == '[') {
         const char *e = memchr(s, ']', len);
-        if (!e)
+        /* after the bracket only a port: "[::1].evil" is no IPv6 host */
+        if (!e || (e + 1 < in + in_len && e[1] != ':'))
             return false;
         s++;
         len = (size_t)(e - s);

@@ -158,6 +158,18 @@ t_host_and_origin() {
     want 403 "POST with a foreign Origin" \
         "$(code_of -H 'Origin: http://evil.example' --data-binary @good.rsr "$SVC_URL/jobs")" || return 1
     want 403 "DELETE with a foreign Origin" "$(code_of -X DELETE -H 'Origin: null' "$SVC_URL/jobs/1")" || return 1
+    # lookalikes of our own origin: a suffix, a prefix, userinfo, another port or
+    # scheme, a trailing slash or dot; each is a foreign page
+    hp=${SVC_URL#http://}
+    for o in "http://$hp.evil.example" "http://evil.$hp" "http://user@$hp" "http://${hp%:*}:1" "https://$hp" \
+        "http://$hp/" "http://$hp." "http://$hp http://evil.example"; do
+        want 403 "POST with Origin '$o'" "$(code_of -H "Origin: $o" --data-binary @good.rsr "$SVC_URL/jobs")" || return 1
+    done
+    # lookalikes of the hosts we serve
+    for h in localhost.evil.example evil.localhost 127.0.0.1.nip.io localhost. 127.0.0.2 '[::2]' '[::1].evil' \
+        '127.0.0.1 evil.example'; do
+        want 421 "Host: '$h'" "$(code_of -H "Host: $h" "$SVC_URL/healthz")" || return 1
+    done
     # a foreign page may not change anything, but reading is the browser's business (no CORS headers)
     want 200 "GET with a foreign Origin" "$(code_of -D h.txt -H 'Origin: http://evil.example' "$SVC_URL/jobs")" || return 1
     ! grep -qi '^Access-Control' h.txt || { cat h.txt; return 1; }
@@ -190,6 +202,13 @@ t_cors_when_configured() {
     want 403 "POST from another origin" "$(code_of -D other.txt -H 'Origin: http://evil.example' \
         --data-binary @good.rsr "$SVC_URL/jobs")" || return 1
     ! grep -qi '^Access-Control-Allow-Origin' other.txt || { cat other.txt; return 1; }
+    # lookalikes of the listed origin get neither the right to post nor CORS headers
+    for o in http://app.example.evil http://evil-app.example http://app.example:8080 https://app.example \
+        http://user@app.example 'http://app.example, http://evil.example'; do
+        want 403 "POST from '$o'" "$(code_of -D other.txt -H "Origin: $o" --data-binary @good.rsr "$SVC_URL/jobs")" ||
+            return 1
+        ! grep -qi '^Access-Control-Allow-Origin' other.txt || { cat other.txt; return 1; }
+    done
     want 200 "GET from another origin" "$(code_of -D get.txt -H 'Origin: http://evil.example' "$SVC_URL/jobs")" || return 1
     ! grep -qi '^Access-Control-Allow-Origin' get.txt && grep -qi '^Vary: Origin' get.txt || { cat get.txt; return 1; }
 }

@@ -77,8 +77,13 @@ t_every_route_wants_a_token() {
     [ "$(code POST /jobs --data-binary @big.bin)" = 401 ] || return 1
     # open: the dashboard and /healthz
     [ "$(code GET /)" = 200 ] && [ "$(code GET /healthz)" = 200 ] || { echo "/ or /healthz not open"; return 1; }
-    # the token works; revoked, it stops at the next request
+    # the token works; lookalikes do not: one character changed, one missing, one more
     [ "$(code GET "/jobs/$id" -H "Authorization: Bearer $a")" = 200 ] || { cat body.txt; return 1; }
+    last=$(printf '%s' "$a" | tail -c 1)
+    other=$( [ "$last" = A ] && echo B || echo A)
+    for t in "${a%?}$other" "${a%?}" "${a}A" "$(printf '%s' "$a" | tr a-z A-Z)" "$a $a"; do
+        [ "$(code GET "/jobs/$id" -H "Authorization: Bearer $t")" = 401 ] || { echo "token lookalike '$t' accepted"; return 1; }
+    done
     "$RS_BIN" serve token revoke alice --data d 2>/dev/null || return 1
     [ "$(code GET "/jobs/$id" -H "Authorization: Bearer $a")" = 401 ] || { cat body.txt; return 1; }
     grep -q "token 'alice' was revoked" body.txt || { cat body.txt; return 1; }
