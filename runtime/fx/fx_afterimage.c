@@ -33,7 +33,7 @@ static bool create(r_game *r, rs_err *err)
 {
     fx_afterimage_state *a = calloc(1, sizeof *a);
     if (!a)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory");
     r_fx_set_state(r, &fx_afterimage_module, a);
     a->prog = r_program(&(r_program_desc){.vs = "afterimage.vert", .fs = "afterimage.frag"}, err);
     if (!a->prog)
@@ -41,7 +41,7 @@ static bool create(r_game *r, rs_err *err)
     r_mesh_data m = {0};
     if (!r_mesh_fighter(&m)) {
         r_mesh_free(&m);
-        return rs_fail(err, 1, "out of memory for the fighter mesh");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the fighter mesh");
     }
     for (size_t i = 0; i < m.nv; i++) {
         int b = (int)(m.v[i].bone + 0.5f);

@@ -90,7 +90,7 @@ static bool make_map(struct fx_fog_state *fg, int size, rs_err *err)
     fg->size = size;
     if (st != GL_FRAMEBUFFER_COMPLETE) {
         free_map(fg);
-        return rs_fail(err, 1, "fog map: %dx%d R16F target incomplete (%s)", size, size, rgl_enum_name(st));
+        return rs_fail(err, R_ERR_TARGET, "fog map: %dx%d R16F target incomplete (%s)", size, size, rgl_enum_name(st));
     }
     return true;
 }
@@ -289,17 +289,17 @@ static bool fog_create(r_game *r, rs_err *err)
 {
     struct fx_fog_state *fg = calloc(1, sizeof *fg);
     if (!fg)
-        return rs_fail(err, 1, "fog: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "fog: out of memory");
     r_fx_set_state(r, &fx_fog_module, fg);
     fg->look = default_look;
     if (!fx_fog_sim_init(&fg->sim, NULL)) {
         fog_destroy(r);
-        return rs_fail(err, 1, "fog: out of memory for the mist");
+        return rs_fail(err, R_ERR_NOMEM, "fog: out of memory for the mist");
     }
     fg->cap = 4 * fg->sim.n; /* at most four copies each (a corner) */
     if (!(fg->inst = malloc((size_t)fg->cap * 3 * sizeof(float)))) {
         fog_destroy(r);
-        return rs_fail(err, 1, "fog: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "fog: out of memory");
     }
     if (!(fg->prog = r_program(&(r_program_desc){.vs = "fog_splat.vert", .fs = "fog_splat.frag"}, err))) {
         fog_destroy(r);
@@ -422,7 +422,7 @@ bool fx_fog_accuracy_rows(FILE *out, rs_err *err)
     bool ok = false;
     if (!r || !ref || !map) {
         if (r)
-            rs_fail(err, 1, "fog accuracy: out of memory");
+            rs_fail(err, R_ERR_NOMEM, "fog accuracy: out of memory");
         goto done;
     }
     struct fx_fog_state *fg = FOG(r);

@@ -168,14 +168,14 @@ static bool holes_create(r_game *r, rs_err *err)
 {
     struct fx_holes *hs = calloc(1, sizeof *hs);
     if (!hs)
-        return rs_fail(err, 1, "holes: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     r_fx_set_state(r, &fx_holes_module, hs);
     /* the unit sphere (a capsule of length 0) on bone 0: u_bones[0] places it */
     r_mesh_data m = {0};
     if (!r_mesh_capsule(&m, 0.0f, 1.0f, 0, SPHERE_SEG, SPHERE_RINGS)) {
         r_mesh_free(&m);
         holes_destroy(r);
-        return rs_fail(err, 1, "holes: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     }
     r_upload_mesh(&m, &hs->vao, &hs->vbo, &hs->ibo);
     hs->count = (GLsizei)m.ni;

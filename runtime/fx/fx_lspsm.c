@@ -305,7 +305,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
 {
     struct fx_lspsm_state *ls = calloc(1, sizeof *ls);
     if (!ls)
-        return rs_fail(err, 1, "lspsm: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "lspsm: out of memory");
     r_fx_set_state(r, &fx_lspsm_module, ls);
     if (!(ls->prog_map = r_program(&(r_program_desc){.vs = "scene.vert", .fs = "light_depth.frag",
                                                      .defines = "#define LIGHT_VIEW 1\n#define LSPSM 1\n"},
@@ -342,7 +342,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE || st2 != GL_FRAMEBUFFER_COMPLETE) {
         lspsm_destroy(r);
-        return rs_fail(err, 1, "lspsm: shadow map target incomplete (%s)",
+        return rs_fail(err, R_ERR_TARGET, "lspsm: shadow map target incomplete (%s)",
                        rgl_enum_name(st != GL_FRAMEBUFFER_COMPLETE ? st : st2));
     }
     RGL_CHECK("lspsm create");
@@ -382,7 +382,7 @@ static bool lspsm_load(r_game *r, rs_err *err)
     r_mesh_free(&proxy);
     if (!ok) {
         free_city(ls);
-        return rs_fail(err, 1, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
+        return rs_fail(err, R_ERR_NOMEM, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
     }
     return true;
 }

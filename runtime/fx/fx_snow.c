@@ -175,7 +175,7 @@ static bool snow_create(r_game *r, rs_err *err)
 {
     struct fx_snow_state *s = calloc(1, sizeof *s);
     if (!s)
-        return rs_fail(err, 1, "out of memory for the snow");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     r_fx_set_state(r, &fx_snow_module, s);
     char stamps[64];
     snprintf(stamps, sizeof stamps, "#define MAX_STAMPS %d\n", MAX_STAMPS);
@@ -211,14 +211,14 @@ static bool snow_create(r_game *r, rs_err *err)
     uint8_t *px = malloc((size_t)R_SNOW_TEX * R_SNOW_TEX * 4);
     if (!px || !build_grid(s)) {
         free(px);
-        return rs_fail(err, 1, "out of memory for the snow");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     }
     s->color_tex = color_tex(fx_snow_tex_colors, px, GL_RG8, GL_RG);
     s->detail_tex = color_tex(fx_snow_tex_detail_normals, px, GL_RGBA8, GL_RGBA);
     free(px);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st_map != GL_FRAMEBUFFER_COMPLETE || st_light != GL_FRAMEBUFFER_COMPLETE)
-        return rs_fail(err, 1, "snow: the R32F height map (%s) or the RGBA16F light target (%s) cannot be drawn into",
+        return rs_fail(err, R_ERR_TARGET, "snow: the R32F height map (%s) or the RGBA16F light target (%s) cannot be drawn into",
                        rgl_enum_name(st_map), rgl_enum_name(st_light));
     RGL_CHECK("snow_create");
     return true;
@@ -230,7 +230,7 @@ static bool make_heights(struct fx_snow_state *s, float half, rs_err *err)
     const int n = R_SNOW_MAP;
     float *h = malloc((size_t)n * n * sizeof *h);
     if (!h)
-        return rs_fail(err, 1, "out of memory for the snow");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     fx_snow_tex_untouched(h, n, half);
     gl.BindTexture(GL_TEXTURE_2D, s->untouched_tex);
     gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, n, n, GL_RED, GL_FLOAT, h);

@@ -228,7 +228,7 @@ static bool build(fx_water_state *w, rs_err *err)
         w->sim_tex[k] = r_tex2d(GL_RGBA32F, R_WATER_N, R_WATER_N, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         w->sim_fbo[k] = r_fbo_for(w->sim_tex[k], 0, 0);
         if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-            rs_fail(err, 1, "water: the %dx%d RGBA32F simulation target is not renderable on this driver", R_WATER_N,
+            rs_fail(err, R_ERR_TARGET, "water: the %dx%d RGBA32F simulation target is not renderable on this driver", R_WATER_N,
                     R_WATER_N);
             goto fail;
         }
@@ -247,7 +247,7 @@ static bool build(fx_water_state *w, rs_err *err)
     uint8_t *px = malloc((size_t)COLOR_SIZE * COLOR_SIZE * 4);
     if (!px || !build_mesh(w)) {
         free(px);
-        rs_fail(err, 1, "out of memory for the water");
+        rs_fail(err, R_ERR_NOMEM, "out of memory for the water");
         goto fail;
     }
     w->shallow_tex = color_tex(px, false);
@@ -268,7 +268,7 @@ static bool create(r_game *r, rs_err *err)
 {
     fx_water_state *w = calloc(1, sizeof *w);
     if (!w)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory");
     r_fx_set_state(r, &fx_water_module, w);
     fx_water_sim_params_fix(&w->prm);
     w->mesh_n = r->opts.q.water_grid > 0 ? r->opts.q.water_grid : MESH_N; /* range checked by r_game_create_opts */

@@ -147,7 +147,6 @@ struct r_game {
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
     bool have_last;
     frame f;
-    char error[768];
 };
 
 
