@@ -1,5 +1,5 @@
 #version 330 core
-// Afterimage motion blur (techniques B): the translucent copy, lit by the
+// Afterimage motion blur (docs/effects.md, "Afterimage motion blur"): the translucent copy, lit by the
 // diffuse IBL only (a smear has no highlights), premultiplied alpha over
 // the HDR buffer; the destination alpha (the mask) is kept by the blend.
 #include "ibl_common.glsl"

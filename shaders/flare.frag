@@ -1,5 +1,5 @@
 #version 330 core
-// The sun flare (techniques A3) at quarter size: a glow round the sun and
+// The sun flare (docs/renderer.md, "Tone map, bloom, flare") at quarter size: a glow round the sun and
 // ghosts along the axis from the sun through the screen centre, each a tap
 // of the flare texture, scaled by how much of the sun is visible.  Runs
 // only when the sun is on screen; the tone map adds the result in HDR.

@@ -1,6 +1,6 @@
 #version 330 core
 // variants: - FX_FOG
-// A fighter's visor: a low-alpha glass lens in HDR (techniques A1).  The
+// A fighter's visor: a low-alpha glass lens in HDR (docs/renderer.md, "HDR, materials, mask").  The
 // blend is premultiplied (ONE, ONE_MINUS_SRC_ALPHA): the tint is scaled by
 // alpha, the reflection is not, so a lens of alpha 0.15 still shows the sun
 // at full HDR strength.  The blend leaves the destination alpha (the mask)

@@ -1,6 +1,6 @@
 #ifndef LSPSM_COMMON_GLSL
 #define LSPSM_COMMON_GLSL
-// Light space perspective shadow maps (techniques C): one 1024x1024 depth
+// Light space perspective shadow maps (docs/effects.md, "Shadows in a large world"): one 1024x1024 depth
 // map of the key light, warped so texels crowd near the camera, drawn each
 // frame by the lspsm_map pass (r_fx_lspsm.c) from the buildings' low-poly
 // proxies and the fighters.  A second R8 map beside it marks the texels

@@ -1,6 +1,6 @@
 #version 330 core
 // variants: FIGHTER STAGE FIGHTER+SHADOWS+FX_FOG+FX_LSPSM STAGE+SHADOWS+FX_FOG+FX_LSPSM STAGE+MATERIAL=1 STAGE+MATERIAL=2+SHADOWS+FX_LSPSM STAGE+MATERIAL=3+SHADOWS
-// The HDR scene pass (techniques A1, A2, A5): image-based lighting only,
+// The HDR scene pass (docs/renderer.md: "HDR, materials, mask", "Image-based lighting", "Shadows"): image-based lighting only,
 // no ambient term.  Every surface blends its key-on and key-off IBL
 // results by its shadow factor: the filtered screen-space mask for the
 // fighters (SSFSM), the blurred silhouette mip chain for the stage.

@@ -1,4 +1,4 @@
-/* Afterimage motion blur (techniques B), on every stage: fast limbs leave
+/* Afterimage motion blur (docs/effects.md, "Afterimage motion blur"), on every stage: fast limbs leave
  * a stretched, translucent copy of themselves along their path.
  *
  * The technique draws each moving model twice, first the stretched copy

@@ -1,4 +1,4 @@
-/* Fog map (techniques A8, issue 8): mist particles laid over the stage,
+/* Fog map (docs/effects.md, "Fog map"): mist particles laid over the stage,
  * moved by a global wind plus the local wind that fast limbs stir up
  * (fx_fog_sim.c, once per game tick), are drawn each frame as soft
  * sprites into a top-down density map; the scene's vertex shaders read it

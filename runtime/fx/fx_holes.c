@@ -1,4 +1,4 @@
-/* Destruction holes with stencil (techniques D, issue 8).
+/* Destruction holes with stencil (docs/effects.md, "Destruction holes").
  *
  * The game places the craters (g_holes.c: heavy hits on a destructible
  * stage; part of the game state, so replays reproduce them).  The ring

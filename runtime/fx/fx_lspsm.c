@@ -1,4 +1,4 @@
-/* Shadows in a large world (techniques C, issue 8): light space
+/* Shadows in a large world (docs/effects.md, "Shadows in a large world"): light space
  * perspective shadow maps over a stage with buildings.
  *
  * The mathematics is r_lspsm.c (tested without GL); this module gives it

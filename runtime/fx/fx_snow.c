@@ -1,4 +1,4 @@
-/* Snow (techniques A7, issue 8): fresh snow over the ring top that keeps
+/* Snow (docs/effects.md, "Snow"): fresh snow over the ring top that keeps
  * the fighters' footprints for the match.
  *
  *   snow_map         (PRE)      the displacement map, R_SNOW_MAP^2 R32F over

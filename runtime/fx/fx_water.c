@@ -1,4 +1,4 @@
-/* Water (techniques A6, issue 8): the stage effect of `water = yes`.
+/* Water (docs/effects.md, "Water"): the stage effect of `water = yes`.
  *
  *   water_sim      (R_FX_PRE)  contacts -> splats on the CPU; per game tick
  *                              one automaton step on the 256x256 RGBA32F

@@ -1,4 +1,4 @@
-/* Destruction holes (techniques D) as game state: where heavy hits leave
+/* Destruction holes (docs/effects.md, "Destruction holes") as game state: where heavy hits leave
  * craters in the ring floor of a destructible stage.  The renderer draws
  * them with stencil (runtime/fx/fx_holes.c); here they are only
  * placed, kept from overlapping and capped, in fixed point, so a replay

@@ -1,4 +1,4 @@
-/* The stage-effect contract (issue 8; techniques A6-A8, B, C, D; issue 17).
+/* The stage-effect contract (docs/effects.md, "The effect contract").
  *
  * An effect is a module in runtime/fx/ (fx_<name>.c): one r_fx_module row
  * in the table runtime/fx/fx_table.c lists.  The render core calls it only

@@ -1,5 +1,5 @@
 /* The game renderer (renderer core, docs/renderer.md): the Virtua
- * Fighter 5 look of techniques A1-A3 and A5 on a pass graph.
+ * Fighter 5 look (docs/renderer.md) on a pass graph.
  *
  *   shadow_map, silhouette, silhouette_mips   from the key light
  *   z_prepass, shadow_mask, mask_filter        SSFSM for the fighters

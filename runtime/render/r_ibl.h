@@ -1,4 +1,4 @@
-/* Image-based lighting (techniques A2): a stage's HDR environment and its
+/* Image-based lighting (docs/renderer.md, "Image-based lighting"): a stage's HDR environment and its
  * six prefiltered cube maps, computed on the CPU by straightforward
  * spherical integration and cached on disk.
  *

@@ -1,6 +1,6 @@
 /* Light Space Perspective Shadow Maps: the light's matrices, the fallback to
  * uniform shadow mapping, the depth auto-focus, the fade and the fighters'
- * box-exit lookup (techniques C).  Pure arithmetic, no GL: the matrices are
+ * box-exit lookup (docs/effects.md, "Shadows in a large world").  Pure arithmetic, no GL: the matrices are
  * built in double and handed over as floats.
  *
  * The light frame: z towards the light, y = the view direction with its
