@@ -412,12 +412,7 @@ static void run_surface(void *u)
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     /* the fighters' blurred silhouette falls on the snow as on the ring (run_scene) */
     gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "silhouette_mips"));
-    gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
-    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
-    float waist[6] = {f->waist[0].x, f->waist[0].y, f->waist[0].z, f->waist[1].x, f->waist[1].y, f->waist[1].z};
-    gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
-    gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
-    gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
+    r_light_uniforms(p, f);
     gl.Uniform1f(r_loc(p, "u_sil_top"), SIL_LEVELS - 1);
     gl.BindVertexArray(s->grid_vao);
     gl.DrawElements(GL_TRIANGLES, s->grid_count, GL_UNSIGNED_INT, NULL);

@@ -464,13 +464,7 @@ static void run_reflect(void *u)
     r_mat4 inv = r_invert(vp);
     gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, inv.m);
     r_bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r->sky_tex);
-    float rad = st->sun_size_deg * 0.5f * 3.14159265f / 180.0f;
-    double omega = 2 * 3.14159265358979 * (1 - cos(rad));
-    float L = st->sun ? (float)fmin(st->sun_intensity / omega, R_HALF_MAX) : 0.0f;
-    gl.Uniform3f(r_loc(p, "u_sun_dir"), st->sun_dir[0], st->sun_dir[1], st->sun_dir[2]);
-    gl.Uniform3f(r_loc(p, "u_sun_radiance"), fminf(L * st->sun_color[0], R_HALF_MAX),
-                 fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
-    gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
+    r_sun_uniforms(p, st);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     r_fullscreen(r);
     /* the simple model: the fighters above the water, mirrored */

@@ -197,6 +197,15 @@ void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
  * (paved ground on a look with buildings). */
 GLuint r_stage_program(r_game *r, int material);
 int r_ring_material(const r_game *r);
+/* The key light's uniforms (u_light_proj, u_light_dir), the fighters'
+ * waists (u_waist) and the silhouette's LOD range (u_lod_start,
+ * u_lod_scale): what a program that looks up the fighters' shadows
+ * needs of the frame; p in use. */
+void r_light_uniforms(GLuint p, const frame *f);
+/* The sun disc of the sky program (sky.frag), p in use: u_sun_dir,
+ * u_sun_radiance (the stage's intensity spread over the disc's solid
+ * angle, each channel kept below fp16's largest) and u_sun_cos. */
+void r_sun_uniforms(GLuint p, const r_stage *st);
 /* Opaque drawing into the HDR target: its FBO and the frame's viewport,
  * depth test (less) and writes, back faces culled, no blending. */
 void r_begin_opaque(r_game *r);
