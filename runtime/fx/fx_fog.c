@@ -8,9 +8,9 @@
  *
  * One pass, "fog_map" (phase R_FX_PRE, writes RES_FOGMAP), on stages with
  * `fog = yes` only:
- *   1. the simulation follows the game: restart on r->f.reset, stir with
- *      the bone capsules' end points (r->f.caps against r->f.caps_prev),
- *      then r->f.steps ticks;
+ *   1. the simulation follows the game: restart on frame.reset, stir with
+ *      the bone capsules' end points (frame.caps against frame.caps_prev),
+ *      then frame.steps ticks;
  *   2. the particles (and the copies of those that cross the map's edge:
  *      the mist wraps round) are drawn additively into an R16F map of
  *      size x size texels over x, z in +-half metres, normalised so that
@@ -157,10 +157,10 @@ static int draw_map(r_game *r, struct fx_fog_state *fg)
 static bool need_fog(void *u)
 {
     r_game *r = u;
-    return r->stage.fog && FOG(r);
+    return r_fx_stage(r)->fog && FOG(r);
 }
 
-/* Both fighters' bone end points now and a tick ago (r->f.caps*). */
+/* Both fighters' bone end points now and a tick ago (frame.caps*). */
 static int limb_points(const frame *f, float cur[][3], float prev[][3])
 {
     int n = 0;
@@ -178,7 +178,7 @@ static int limb_points(const frame *f, float cur[][3], float prev[][3])
 static void sim_follow(r_game *r)
 {
     struct fx_fog_state *fg = FOG(r);
-    const frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     /* step 1: the mist follows the game's ticks, never the frame rate */
     float cur[4 * G_BONES][3], prev[4 * G_BONES][3];
     int n = limb_points(f, cur, prev);
@@ -227,15 +227,16 @@ static void fog_bind(r_game *r, GLuint p, int unit, int what)
 {
     (void)what;
     struct fx_fog_state *fg = FOG(r);
-    bool on = fg && r->stage.fog && r_ran(&r->f, r, "fog_map");
+    bool on = fg && r_fx_stage(r)->fog && r_ran(r_fx_frame(r), r, "fog_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_fog_on"), on);
     r_bind_tex(p, "u_fog_map", unit, GL_TEXTURE_2D, on ? fg->tex : 0);
     if (!on)
         return;
     const fog_look *lk = &fg->look;
-    const r_stage *st = &r->stage;
-    gl.Uniform3f(r_loc(p, "u_fog_eye"), r->f.eye.x, r->f.eye.y, r->f.eye.z);
+    const r_stage *st = r_fx_stage(r);
+    const frame *f = r_fx_frame(r);
+    gl.Uniform3f(r_loc(p, "u_fog_eye"), f->eye.x, f->eye.y, f->eye.z);
     gl.Uniform1f(r_loc(p, "u_fog_half"), fg->sim.d.half);
     gl.Uniform1f(r_loc(p, "u_fog_density"), lk->density);
     gl.Uniform1f(r_loc(p, "u_fog_base"), lk->base);
@@ -248,7 +249,7 @@ static void fog_bind(r_game *r, GLuint p, int unit, int what)
     const r_paint_light *key = &st->key;
     double omega = 2 * 3.14159265358979 * (1 - cos(key->size_deg * 3.14159265358979 / 180));
     for (int k = 0; k < 3; k++) {
-        c[k] = half_clamp(st->sky_horizon[k] * lk->brightness + r->f.flash * flash[k] * lk->albedo);
+        c[k] = half_clamp(st->sky_horizon[k] * lk->brightness + f->flash * flash[k] * lk->albedo);
         if (st->sun) /* its irradiance */
             e[k] = half_clamp(st->sun_intensity * st->sun_color[k] * lk->albedo);
         else /* a painted disc of radiance intensity x (1 - smoothstep): 0.3 of it over its solid angle */
@@ -316,7 +317,7 @@ static bool fog_create(r_game *r, rs_err *err)
     gl.BindVertexArray(0);
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
     /* the quality knob (r_quality.fog_size, range checked at create) or the look's */
-    if (!make_map(fg, r->opts.q.fog_size > 0 ? r->opts.q.fog_size : fg->look.map_size, err)) {
+    if (!make_map(fg, r_fx_quality(r)->fog_size > 0 ? r_fx_quality(r)->fog_size : fg->look.map_size, err)) {
         fog_destroy(r);
         return false;
     }
@@ -329,7 +330,7 @@ static bool fog_create(r_game *r, rs_err *err)
  * counts.  fog_advance is the pass's step 1 without the map. */
 static const char *fog_define(const r_game *r)
 {
-    return r->stage.fog ? "FX_FOG" : NULL;
+    return r_fx_stage(r)->fog ? "FX_FOG" : NULL;
 }
 
 const r_fx_module fx_fog_module = {
