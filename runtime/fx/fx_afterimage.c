@@ -1,5 +1,6 @@
-/* Afterimage motion blur (docs/effects.md, "Afterimage motion blur"), on every stage: fast limbs leave
- * a stretched, translucent copy of themselves along their path.
+/* Afterimage motion blur (docs/effects.md, "Afterimage motion blur"), on
+ * every stage: fast limbs leave a stretched, translucent copy of themselves
+ * along their path.
  *
  * The technique draws each moving model twice, first the stretched copy
  * (depth test on, depth write off), then the model.  Here the models are

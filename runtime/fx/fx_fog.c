@@ -32,7 +32,7 @@
 extern const r_fx_module fx_fog_module;
 #define FOG(r) ((struct fx_fog_state *)r_fx_state((r), &fx_fog_module))
 
-/* What the fog looks like (A8 gives no numbers; these suit mistvale). */
+/* What the fog looks like (no reference numbers; these suit mistvale). */
 typedef struct fog_look {
     int map_size;     /* the map's edge, texels */
     float sprite_m;   /* a particle's sprite radius, m (at most half the map's half edge) */

@@ -26,7 +26,7 @@
  * (pushed along the normal); the fighters look it up where the ray towards
  * the light leaves their own box (no self-shadow, others' shadows received)
  * and keep u_lspsm_keep of the key light in full shadow, so they keep their
- * directional shading.  When the stage's A5 shadows run (the blurred
+ * directional shading.  When the stage's fighter shadows run (the blurred
  * silhouette on the stage, the screen-space mask on the fighters), those
  * already cast the fighters, and every receiver ignores the
  * fighter-flagged texels; without them this map casts the fighters too.
