@@ -496,10 +496,8 @@ static void draw(attract *a, float alpha, int w, int h)
     if (a->mode == MODE_LOOP && a->mp) {
         mv_player_draw(a->mp, w, h);
     } else if (a->mode == MODE_MATCH || a->demo_loaded || a->cpu_demo) {
-        if (!r_game_draw(a->r, &a->prev, &a->st, alpha, w, h)) {
-            rs_fail(&a->err, 1, "%s", r_game_error(a->r));
+        if (!r_game_draw(a->r, &a->prev, &a->st, alpha, w, h, &a->err))
             a->failed = true;
-        }
     } else {
         gl.Viewport(0, 0, w, h);
         gl.ClearColor(0, 0, 0, 1);

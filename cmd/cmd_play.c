@@ -175,8 +175,8 @@ static bool draw_frame(play *s, GLuint fbo, float alpha, int w, int h)
         return false;
     const r_target *top = s->nss ? &s->ss[0] : NULL;
     gl.BindFramebuffer(GL_FRAMEBUFFER, top ? top->fbo : fbo);
-    if (!r_game_draw(s->r, &s->prev, &s->cur, alpha, top ? top->w : w, top ? top->h : h))
-        return rs_fail(&s->err, 1, "%s", r_game_error(s->r));
+    if (!r_game_draw(s->r, &s->prev, &s->cur, alpha, top ? top->w : w, top ? top->h : h, &s->err))
+        return false;
     for (int i = 0; i < s->nss; i++) {
         const r_target *src = &s->ss[i];
         int dw = i + 1 < s->nss ? s->ss[i + 1].w : w, dh = i + 1 < s->nss ? s->ss[i + 1].h : h;

@@ -51,8 +51,9 @@ bool job_render_begin(job_render *j, const job_render_desc *desc, rs_err *err)
         if (!(ok = step(j, err)))
             break;
         bool drew = false;
-        if (!(ok = r_game_advance(d->game, &j->prev, &j->cur, d->target->w, d->target->h, d->first - j->tick + 1, &drew)))
-            rs_fail(err, 1, "warming up for tick %" PRIu64 ": %s", d->first, r_game_error(d->game));
+        if (!(ok = r_game_advance(d->game, &j->prev, &j->cur, d->target->w, d->target->h, d->first - j->tick + 1, &drew,
+                                  err)))
+            rs_err_prefix(err, "warming up for tick %" PRIu64, d->first);
         j->warm_drawn += drew;
     }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -74,12 +75,12 @@ int job_render_next(job_render *j, rs_err *err)
     if (!step(j, err))
         return -1;
     gl.BindFramebuffer(GL_FRAMEBUFFER, d->target->fbo);
-    bool ok = r_game_draw(d->game, &j->prev, &j->cur, 1.0f, d->target->w, d->target->h);
+    bool ok = r_game_draw(d->game, &j->prev, &j->cur, 1.0f, d->target->w, d->target->h, err);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     j->ms_draw += (rs_now() - t0) * 1e3;
     j->frames++;
     if (!ok) {
-        rs_fail(err, 1, "frame %" PRIu64 ": %s", at, r_game_error(d->game));
+        rs_err_prefix(err, "frame %" PRIu64, at);
         return -1;
     }
     if (d->cap && !cap_frame(d->cap, d->target->tex, err))

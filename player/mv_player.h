@@ -9,7 +9,7 @@
  *
  * Each tick (mv_player_tick) the player makes the textures hold that frame.
  * In PBO mode it also copies the *next* tick's frame into the idle buffer
- * (the techniques' ping-pong), so the textures are defined from a buffer
+ * (the ping-pong), so the textures are defined from a buffer
  * filled a tick earlier.  A frame the decoder has not delivered in time is
  * counted late and the previous frame stays on screen; in `wait` mode
  * (headless, exact output) the player waits for it instead. */

@@ -2,7 +2,7 @@
  * converts them to RGB.
  *
  * Three ways to get a packed frame (mv.h) onto the textures:
- *   PBO         the techniques' default: two GL_PIXEL_UNPACK_BUFFERs in
+ *   PBO         the default: two GL_PIXEL_UNPACK_BUFFERs in
  *               ping-pong.  mv_up_stage copies the next frame into one
  *               (map with invalidate, memcpy, unmap: the transfer can start)
  *               while the other, filled the tick before, defines the

@@ -1,7 +1,8 @@
 #version 330 core
-// Afterimage motion blur (techniques B): the translucent copy, lit by the
-// diffuse IBL only (a smear has no highlights), premultiplied alpha over
-// the HDR buffer; the destination alpha (the mask) is kept by the blend.
+// Afterimage motion blur (docs/effects.md, "Afterimage motion blur"): the
+// translucent copy, lit by the diffuse IBL only (a smear has no highlights),
+// premultiplied alpha over the HDR buffer; the destination alpha (the mask)
+// is kept by the blend.
 #include "ibl_common.glsl"
 
 in vec3 v_world;

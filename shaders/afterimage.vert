@@ -1,5 +1,6 @@
 #version 330 core
-// Afterimage motion blur (techniques B): the stretched copy of a fighter.
+// Afterimage motion blur (docs/effects.md, "Afterimage motion blur"): the
+// stretched copy of a fighter.
 // Each vertex is transformed by the current and the previous tick's
 // matrices; V = cur - prev, in view space (camera motion blurs too) or in
 // world space (u_world = 1: only the fighters' own motion).  A vertex

@@ -1,8 +1,9 @@
 #version 330 core
-// The sun flare (techniques A3) at quarter size: a glow round the sun and
-// ghosts along the axis from the sun through the screen centre, each a tap
-// of the flare texture, scaled by how much of the sun is visible.  Runs
-// only when the sun is on screen; the tone map adds the result in HDR.
+// The sun flare (docs/renderer.md, "Tone map, bloom, flare") at quarter size:
+// a glow round the sun and ghosts along the axis from the sun through the
+// screen centre, each a tap of the flare texture, scaled by how much of the
+// sun is visible.  Runs only when the sun is on screen; the tone map adds the
+// result in HDR.
 uniform sampler2D u_flare;
 uniform sampler2D u_sun_vis;
 uniform vec2 u_size;        // this target, pixels

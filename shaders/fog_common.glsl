@@ -1,6 +1,6 @@
 #ifndef FOG_COMMON_GLSL
 #define FOG_COMMON_GLSL
-// Fog map (techniques A8): height fog whose density comes from a top-down
+// Fog map (docs/effects.md, "Fog map"): height fog whose density comes from a top-down
 // map of mist particles (r_fx_fog.c draws it each frame), so the fog
 // varies at equal height and no translucent sheets are drawn.  Density at
 // a point p: map(p.xz) * exp(-max(p.y - base, 0) / height), times

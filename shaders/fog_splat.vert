@@ -1,5 +1,5 @@
 #version 330 core
-// The fog map (techniques A8): one sprite per mist particle, top-down.
+// The fog map (docs/effects.md, "Fog map"): one sprite per mist particle, top-down.
 // An instanced quad rather than a GL point: a point whose centre lies
 // outside the viewport is dropped whole, and sprites crossing the map's
 // edge are drawn again on the other side (the mist wraps round).

@@ -1,9 +1,9 @@
 #ifndef IBL_COMMON_GLSL
 #define IBL_COMMON_GLSL
-// Image-based lighting (techniques A2): six prefiltered cube maps, diffuse
-// and specular exponents 16 and 128, each with and without the key-light
-// area.  `key` (1 lit, 0 shadowed) blends the two; exponents between 16 and
-// 128 interpolate the two specular maps linearly.
+// Image-based lighting (docs/renderer.md, "Image-based lighting"): six
+// prefiltered cube maps, diffuse and specular exponents 16 and 128, each with
+// and without the key-light area.  `key` (1 lit, 0 shadowed) blends the two;
+// exponents between 16 and 128 interpolate the two specular maps linearly.
 uniform samplerCube u_diffuse_on, u_diffuse_off;
 uniform samplerCube u_spec16_on, u_spec16_off;
 uniform samplerCube u_spec128_on, u_spec128_off;

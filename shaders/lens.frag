@@ -1,11 +1,12 @@
 #version 330 core
 // variants: - FX_FOG
-// A fighter's visor: a low-alpha glass lens in HDR (techniques A1).  The
-// blend is premultiplied (ONE, ONE_MINUS_SRC_ALPHA): the tint is scaled by
-// alpha, the reflection is not, so a lens of alpha 0.15 still shows the sun
-// at full HDR strength.  The blend leaves the destination alpha (the mask)
-// alone.  In fog (A8) the lens fades into the fog's light like the head
-// behind it, so the two add up to the fogged head seen through the lens.
+// A fighter's visor: a low-alpha glass lens in HDR (docs/renderer.md, "HDR,
+// materials, mask").  The blend is premultiplied (ONE, ONE_MINUS_SRC_ALPHA):
+// the tint is scaled by alpha, the reflection is not, so a lens of alpha 0.15
+// still shows the sun at full HDR strength.  The blend leaves the destination
+// alpha (the mask) alone.  In fog (FX_FOG) the lens fades into the fog's light
+// like the head behind it, so the two add up to the fogged head seen through
+// the lens.
 #include "ibl_common.glsl"
 #include "fog_common.glsl"
 

@@ -1,13 +1,14 @@
 #ifndef LSPSM_COMMON_GLSL
 #define LSPSM_COMMON_GLSL
-// Light space perspective shadow maps (techniques C): one 1024x1024 depth
-// map of the key light, warped so texels crowd near the camera, drawn each
-// frame by the lspsm_map pass (r_fx_lspsm.c) from the buildings' low-poly
-// proxies and the fighters.  A second R8 map beside it marks the texels
-// whose nearest caster is a fighter, so the stage, which gets the
-// fighters' shadows from the blurred silhouette (A5) already, can leave
-// them out.  Only when u_lspsm_on == 1: lspsm_bind (runtime/fx/fx_lspsm.c) sets it with
-// everything below, and it is 0 whenever the map was not drawn this frame.
+// Light space perspective shadow maps (docs/effects.md, "Shadows in a large
+// world"): one 1024x1024 depth map of the key light, warped so texels crowd
+// near the camera, drawn each frame by the lspsm_map pass (r_fx_lspsm.c) from
+// the buildings' low-poly proxies and the fighters.  A second R8 map beside it
+// marks the texels whose nearest caster is a fighter, so the stage, which
+// gets the fighters' shadows from the blurred silhouette (SSFSM) already, can
+// leave them out.  Only when u_lspsm_on == 1: lspsm_bind
+// (runtime/fx/fx_lspsm.c) sets it with everything below, and it is 0 whenever
+// the map was not drawn this frame.
 uniform int u_lspsm_on;
 uniform sampler2DShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware
 uniform float u_lspsm_texel;         // one texel of the map, in texture coordinates
@@ -68,7 +69,7 @@ float lspsm_visibility(vec3 p, vec3 n, float offset, bool no_fighters)
 
 // A fighter at p: no self-shadow, others' shadows received.  The map is
 // looked up where the ray towards the light leaves the fighter's own box.
-// no_fighters: the screen-space mask (A5) already holds the other
+// no_fighters: the screen-space mask (SSFSM) already holds the other
 // fighter's shadow, so only the scenery's counts here.
 float lspsm_fighter_visibility(vec3 p, bool no_fighters)
 {

@@ -1,8 +1,9 @@
 #version 330 core
-// LSPSM auto-focus (techniques C): the 20x16 tilted sample pattern of the
-// frame's depth buffer, one sample per texel of a 20x16 target that is then
-// read back asynchronously and used next frame.  The pattern is
-// r_lspsm_focus_point's, in the same integer arithmetic.
+// LSPSM auto-focus (docs/effects.md, "Shadows in a large world"): the 20x16
+// tilted sample pattern of the frame's depth buffer, one sample per texel of
+// a 20x16 target that is then read back asynchronously and used next
+// frame.  The pattern is r_lspsm_focus_point's, in the same integer
+// arithmetic.
 uniform sampler2D u_depth;
 out vec4 o_depth;
 void main()

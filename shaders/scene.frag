@@ -1,23 +1,23 @@
 #version 330 core
 // variants: FIGHTER STAGE FIGHTER+SHADOWS+FX_FOG+FX_LSPSM STAGE+SHADOWS+FX_FOG+FX_LSPSM STAGE+MATERIAL=1 STAGE+MATERIAL=2+SHADOWS+FX_LSPSM STAGE+MATERIAL=3+SHADOWS
-// The HDR scene pass (techniques A1, A2, A5): image-based lighting only,
-// no ambient term.  Every surface blends its key-on and key-off IBL
-// results by its shadow factor: the filtered screen-space mask for the
-// fighters (SSFSM), the blurred silhouette mip chain for the stage.
-// Output: linear HDR, alpha = the fighters' mask.  On a stage with a fog
-// map (A8) the result is mixed with the fog's light last.  On a stage with
-// LSPSM (C) the key light is blocked further by the large-world shadow map:
-// the stage where its scenery casts, the fighters where the ray to the
-// light leaves their own box (no self-shadow) and never below
-// u_lspsm_keep, so they keep their directional shading in shadow.
+// The HDR scene pass (docs/renderer.md: "HDR, materials, mask", "Image-based
+// lighting", "Shadows"): image-based lighting only, no ambient term.  Every
+// surface blends its key-on and key-off IBL results by its shadow factor: the
+// filtered screen-space mask for the fighters (SSFSM), the blurred silhouette
+// mip chain for the stage. Output: linear HDR, alpha = the fighters' mask.  On
+// a stage with a fog map (FX_FOG) the result is mixed with the fog's light
+// last.  On a stage with LSPSM (FX_LSPSM) the key light is blocked further by the
+// large-world shadow map: the stage where its scenery casts, the fighters
+// where the ray to the light leaves their own box (no self-shadow) and never
+// below u_lspsm_keep, so they keep their directional shading in shadow.
 // Compiled per look (r_game.c, build_look_programs): SHADOWS, FX_FOG and
-// FX_LSPSM when the stage uses them, MATERIAL for the stage's surfaces,
-// so that no pixel runs code for what its stage or surface does not have
-// (a software rasteriser runs both sides of a branch).  The flat surfaces
+// FX_LSPSM when the stage uses them, MATERIAL for the stage's surfaces, so
+// that no pixel runs code for what its stage or surface does not have (a
+// software rasteriser runs both sides of a branch).  The flat surfaces
 // (MATERIAL 0-2) get the diffuse light from the vertex shader: with one
-// normal per face it is the same value, and two cube-map taps a pixel
-// fewer; the planks and the paving have exponent 16 alone, so they tap
-// those two specular maps and not the 128 ones.
+// normal per face it is the same value, and two cube-map taps a pixel fewer;
+// the planks and the paving have exponent 16 alone, so they tap those two
+// specular maps and not the 128 ones.
 #include "ibl_common.glsl"
 #include "fog_common.glsl"
 #include "lspsm_common.glsl"
@@ -129,7 +129,7 @@ void main()
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
 #endif
 #ifdef FX_LSPSM
-    if (u_lspsm_on == 1) // with the A5 shadows on, the fighters' come from the silhouette
+    if (u_lspsm_on == 1) // with the SSFSM shadows on, the fighters' come from the silhouette
         key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), u_shadows == 1);
 #endif
     float alpha = 0.0;

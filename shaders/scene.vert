@@ -4,8 +4,8 @@
 // per bone (bone index -1: world space).  Variants by #define:
 //   FIGHTER, STAGE, LENS   the HDR scene pass (scene.frag)
 //   LIGHT_VIEW             shadow map / silhouette from the key light
-// FIGHTER and LENS compute the fog map's optical depth per vertex (fog A8,
-// when FX_FOG); STAGE leaves it to the fragment shader (scene.frag says
+// FIGHTER and LENS compute the fog map's optical depth per vertex (when
+// FX_FOG); STAGE leaves it to the fragment shader (scene.frag says
 // why), and gives the flat surfaces (MATERIAL 0-2) their diffuse light.
 #include "fog_common.glsl"
 #include "ibl_common.glsl"

@@ -1,5 +1,5 @@
 #version 330 core
-// SSFSM step 2 (techniques A5): the screen-space shadow mask of the
+// SSFSM step 2 (docs/renderer.md, "Shadows"): the screen-space shadow mask of the
 // fighters.  Each pixel the z-prepass covered is taken back to world
 // space, into the key light's shadow map, and compared (2x2 PCF by the
 // sampler).  1 = lit, 0 = shadowed; pixels without a fighter stay lit.

@@ -2,7 +2,7 @@
 // variants: - FX_FOG
 // The stage's environment as seen, plus the sun disc (the sun is a delta
 // light in the prefiltered maps, so it is drawn analytically here).  In
-// fog (A8, FX_FOG: the look's programs, r_game.c) the sky fades into the
+// fog (FX_FOG: the look's programs, r_game.c) the sky fades into the
 // fog's light towards the horizon.
 #include "fog_common.glsl"
 in vec3 v_dir;

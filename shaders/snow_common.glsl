@@ -1,6 +1,6 @@
 #ifndef SNOW_COMMON_GLSL
 #define SNOW_COMMON_GLSL
-// Shared by the snow shaders (techniques A7, runtime/render/r_fx_snow.c).
+// Shared by the snow shaders (docs/effects.md, "Snow"; runtime/fx/fx_snow.c).
 
 // the snow's sheen: an IBL specular exponent (the spec16 maps)
 const float SNOW_EXPONENT = 16.0;

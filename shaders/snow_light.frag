@@ -1,5 +1,5 @@
 #version 330 core
-// Snow, fake subsurface scattering step 1 (techniques A7): the snow's
+// Snow, fake subsurface scattering step 1 (docs/effects.md, "Snow"): the snow's
 // lighting rendered in texture space, one texel per point of the snow
 // surface over the ring (the displacement map's layout).  Light and view
 // vectors are taken into the tangent space of the displaced surface at

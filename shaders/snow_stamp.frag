@@ -1,5 +1,5 @@
 #version 330 core
-// Snow footprints (techniques A7): drawn with a MIN blend into the
+// Snow footprints (docs/effects.md, "Snow"): drawn with a MIN blend into the
 // displacement map.  The snow under a bone is pressed down to the bone's
 // underside there (the deeper the bone reaches, the deeper the print) but
 // never below the fully trampled minimum, so it never becomes flat.

@@ -1,5 +1,5 @@
 #version 330 core
-// Snow surface (techniques A7): the colour, fresh or trampled by how far
+// Snow surface (docs/effects.md, "Snow"): the colour, fresh or trampled by how far
 // the vertex is pressed down, times the texture-space lighting blurred by
 // snow_light_blur (fake subsurface scattering, step 3; snow_light.frag
 // says what it holds).  The fighters' blurred silhouette takes the key

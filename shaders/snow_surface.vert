@@ -1,5 +1,5 @@
 #version 330 core
-// Snow surface (techniques A7): a grid over the ring top displaced by the
+// Snow surface (docs/effects.md, "Snow"): a grid over the ring top displaced by the
 // displacement map (vertex texture fetch).  Each vertex is a map texel
 // (a_cell) and fetches it exactly (texelFetch: no filtering, the cheap
 // fetch on a software rasteriser); cells -1 and size are the ring's edge

@@ -1,6 +1,6 @@
 #version 330 core
 // variants: - GLOW AA GLOW+AA
-// Tone map (techniques A3), one full-screen pass:
+// Tone map (docs/renderer.md, "Tone map, bloom, flare"), one full-screen pass:
 //   1. RGB -> Y, Cb, Cr (CbCr unnormalised: B - Y and R - Y)
 //   2. Y' from the curve ((1 - exp(-x^2))^1.5)^(1/gamma) in a float table
 //   3. CbCr scaled by Y'/Y (guarded near 0) and by the saturation

@@ -1,6 +1,6 @@
 #ifndef WATER_COMMON_GLSL
 #define WATER_COMMON_GLSL
-// Water (techniques A6): what the water shaders share.
+// Water (docs/effects.md, "Water"): what the water shaders share.
 
 // An HDR value the RGBA16F buffers can hold: no NaN, nothing past the
 // largest finite fp16 (65504), nothing negative.

@@ -1,5 +1,5 @@
 #version 330 core
-// Water (techniques A6): the reflection map's simple model.  The fighters
+// Water (docs/effects.md, "Water"): the reflection map's simple model.  The fighters
 // drawn with scene.vert through the camera mirrored about the water plane
 // (the view-projection does the mirroring, so v_world is the unmirrored
 // point): plain diffuse IBL in the bone colours, no normal or specular

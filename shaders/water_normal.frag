@@ -1,5 +1,5 @@
 #version 330 core
-// Water (techniques A6): the normal map derived from the simulation,
+// Water (docs/effects.md, "Water"): the normal map derived from the simulation,
 // central differences over the 256x256 grid, into RGBA8 (unorm8 fetches
 // are the cheap ones on a software renderer): xyz = the unit normal * 0.5
 // + 0.5, w = the height * 0.5 / h_max + 0.5 (the turbidity blend reads

@@ -1,5 +1,5 @@
 #version 330 core
-// Water (techniques A6): one step of the wave automaton on the 256x256
+// Water (docs/effects.md, "Water"): one step of the wave automaton on the 256x256
 // RGBA32F simulation texture (r: height, g: the height a step earlier),
 // drawn with cap_fullscreen.vert from one texture of the ping-pong pair
 // into the other.  The CPU reference fx_water_sim_step_raw

@@ -1,5 +1,5 @@
 #version 330 core
-// Water (techniques A6): new waves.  The CPU finds where the fighters'
+// Water (docs/effects.md, "Water"): new waves.  The CPU finds where the fighters'
 // bone capsules dip under the surface and how fast they move; each
 // contact is one point drawn into the simulation texture (additive
 // blending, red channel only), a cosine bump of radius a_splat.z cells and

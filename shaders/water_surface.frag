@@ -1,5 +1,5 @@
 #version 330 core
-// Water (techniques A6), drawn opaque (depth write on: translucent water
+// Water (docs/effects.md, "Water"), drawn opaque (depth write on: translucent water
 // would sort badly with the fighters' translucent parts).  It composites:
 //   - the under-water texture (water_under.frag), refracted: its uv
 //     perturbed by the normal map;

@@ -1,9 +1,9 @@
 #version 330 core
-// Water (techniques A6): the surface mesh over the ring's top face,
+// Water (docs/effects.md, "Water"): the surface mesh over the ring's top face,
 // displaced by the simulation (vertex texture fetch), plus a skirt down to
 // the ring floor along the edges so the water's side is closed.
 #include "water_common.glsl"
-uniform samplerCube u_diffuse_on; // the IBL's diffuse map (techniques A2)
+uniform samplerCube u_diffuse_on; // the IBL's diffuse map (docs/renderer.md, "Image-based lighting")
 layout(location = 0) in vec3 a_grid; // u, v in 0..1 over the pool; z: 0 surface, 1 skirt bottom, 2 skirt top
 uniform mat4 u_view_proj;
 uniform sampler2D u_state;

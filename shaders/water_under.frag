@@ -1,5 +1,5 @@
 #version 330 core
-// Water (techniques A6): the under-water part as its own texture.  Each
+// Water (docs/effects.md, "Water"): the under-water part as its own texture.  Each
 // pixel of the scene drawn so far (the ring floor, the fighters' legs) that
 // lies under the water plane gets height fog: the view ray's path under
 // the surface through a density that grows with depth (deeper = murkier).

@@ -1,8 +1,8 @@
 #version 330 core
 // Water: the under-water pass's triangle covering the viewport (as
 // cap_fullscreen.vert), plus the light of the murk, the IBL's diffuse
-// light from straight up (techniques A2): one fetch per vertex instead of
-// one per pixel.
+// light from straight up (docs/renderer.md, "Image-based lighting"): one
+// fetch per vertex instead of one per pixel.
 uniform samplerCube u_diffuse_on;
 flat out vec3 v_sky;
 void main()

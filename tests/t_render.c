@@ -77,7 +77,8 @@ void t_draw_read(r_game *r, const t_fb *f, const g_state *prev, const g_state *c
 {
     rgl_error_reset();
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, w, h), "%s", r_game_error(r));
+    rs_err e = {0};
+    T_ASSERTF(r_game_draw(r, prev, cur, 1.0f, w, h, &e), "%s", e.msg);
     if (px) {
         gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
         gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
@@ -161,8 +162,8 @@ void t_picture(const char *demo, uint64_t tick, uint64_t history, const r_game_o
     t_fb_make(&f, w, h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, f.fbo);
     for (uint64_t t = first; t < tick; t++) {
-        T_ASSERTF(r_game_advance(r, &prev, &cur, w, h, tick - t, NULL), "advancing tick %llu: %s", (unsigned long long)t,
-                  r_game_error(r));
+        T_ASSERTF(r_game_advance(r, &prev, &cur, w, h, tick - t, NULL, &e), "advancing tick %llu: %s",
+                  (unsigned long long)t, e.msg);
         prev = cur;
         g_step(&cur, &rp.inputs[2 * t], NULL);
     }

@@ -245,9 +245,13 @@ static void t_empty_frame_is_refused(void)
     g_state prev, cur;
     t_state_at("shallows", 300, &prev, &cur);
     r_game *r = t_game_new(false);
-    T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 0, 0));
-    T_CONTAINS(r_game_error(r), "cannot draw a 0x0 frame");
-    T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 64, -1));
+    rs_err e = {0};
+    T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 0, 0, &e));
+    T_CONTAINS(e.msg, "cannot draw a 0x0 frame");
+    T_EQ(e.code, R_ERR_SIZE);
+    rs_err_clear(&e);
+    T_ASSERT(!r_game_draw(r, &prev, &cur, 1.0f, 64, -1, &e));
+    T_EQ(e.code, R_ERR_SIZE);
     T_EQ(gl.GetError(), GL_NO_ERROR);
     r_game_destroy(r);
     plat_destroy(p);

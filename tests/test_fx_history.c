@@ -37,7 +37,8 @@ static void frame_at(const char *demo, uint64_t a, bool advance, frame_px *out)
         }
         rgl_error_reset();
         gl.BindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
-        T_ASSERTF(r_game_advance(r, &prev, &cur, W, H, a - t, NULL), "%s", r_game_error(r));
+        rs_err e = {0};
+        T_ASSERTF(r_game_advance(r, &prev, &cur, W, H, a - t, NULL, &e), "%s", e.msg);
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
         T_EQ(rgl_error_count(), 0);
         T_EQ(gl.GetError(), GL_NO_ERROR);

@@ -336,7 +336,8 @@ static void t_drawing_leaves_state_alone(void)
     gl.Enable(GL_CULL_FACE);
     gl.CullFace(GL_FRONT);
     gl.ColorMask(GL_TRUE, GL_FALSE, GL_TRUE, GL_FALSE);
-    T_ASSERTF(r_game_draw(r, &prev, &cur, 1.0f, W, H), "%s", r_game_error(r));
+    rs_err e = {0};
+    T_ASSERTF(r_game_draw(r, &prev, &cur, 1.0f, W, H, &e), "%s", e.msg);
     /* ... and the caller's framebuffer is bound again afterwards */
     GLint v = 0;
     gl.GetIntegerv(GL_FRAMEBUFFER_BINDING, &v);
@@ -385,10 +386,11 @@ static void counted_frame(r_game *r, t_fb *f, const g_state *prev, const g_state
     gl.DrawArrays = count_draw_arrays, gl.DrawElements = count_draw_elements, gl.BindFramebuffer = count_bind_fb;
     n_draws = n_binds = 0;
     gl.BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
-    bool ok = r_game_draw(r, prev, cur, 1.0f, W, H);
+    rs_err e = {0};
+    bool ok = r_game_draw(r, prev, cur, 1.0f, W, H, &e);
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.DrawArrays = real_draw_arrays, gl.DrawElements = real_draw_elements, gl.BindFramebuffer = real_bind_fb;
-    T_ASSERTF(ok, "%s", r_game_error(r));
+    T_ASSERTF(ok, "%s", e.msg);
     *draws = n_draws, *binds = n_binds;
 }
 
@@ -842,7 +844,23 @@ static void t_fighters_read_on_every_stage(void)
     plat_destroy(p);
 }
 
-T_MAIN({"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
+/* The renderer's error ids: each has its own text, and they are the
+ * render module's (rs_err.h). */
+static void t_error_ids(void)
+{
+    for (int a = R_ERR_BASE + 1; a < R_ERR_END; a++) {
+        const char *t = r_error_text(a);
+        T_ASSERTF(strcmp(t, "?") != 0, "id %d has no text", a);
+        for (int b = R_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, r_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+        T_ASSERT(!strcmp(rs_err_module_name(a), "render"));
+    }
+    T_ASSERT(!strcmp(r_error_text(0), "ok"));
+    T_ASSERT(!strcmp(r_error_text(R_ERR_BASE), "?") && !strcmp(r_error_text(R_ERR_END), "?"));
+    T_ASSERT(!strcmp(r_error_text(R_ERR_BASE + RS_ERR_BLOCK + 1), "?"));
+}
+
+T_MAIN({"error_ids", t_error_ids}, {"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"resolution_independent", t_resolution_independent},
        {"fighters_where_the_camera_says", t_fighters_where_the_camera_says},
        {"hud_shows_health_and_intro", t_hud_shows_health_and_intro},

@@ -1,5 +1,6 @@
-/* Afterimage motion blur (techniques B), on every stage: fast limbs leave
- * a stretched, translucent copy of themselves along their path.
+/* Afterimage motion blur (docs/effects.md, "Afterimage motion blur"), on
+ * every stage: fast limbs leave a stretched, translucent copy of themselves
+ * along their path.
  *
  * The technique draws each moving model twice, first the stretched copy
  * (depth test on, depth write off), then the model.  Here the models are
@@ -33,7 +34,7 @@ static bool create(r_game *r, rs_err *err)
 {
     fx_afterimage_state *a = calloc(1, sizeof *a);
     if (!a)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory");
     r_fx_set_state(r, &fx_afterimage_module, a);
     a->prog = r_program(&(r_program_desc){.vs = "afterimage.vert", .fs = "afterimage.frag"}, err);
     if (!a->prog)
@@ -41,7 +42,7 @@ static bool create(r_game *r, rs_err *err)
     r_mesh_data m = {0};
     if (!r_mesh_fighter(&m)) {
         r_mesh_free(&m);
-        return rs_fail(err, 1, "out of memory for the fighter mesh");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the fighter mesh");
     }
     for (size_t i = 0; i < m.nv; i++) {
         int b = (int)(m.v[i].bone + 0.5f);
@@ -97,11 +98,11 @@ static bool needed(void *u)
 {
     r_game *r = u;
     fx_afterimage_state *a = AFTERIMAGE(r);
-    if (!a || r->stage.afterimage == R_AFTERIMAGE_OFF)
+    if (!a || r_fx_stage(r)->afterimage == R_AFTERIMAGE_OFF)
         return false;
     a->any_fast = false;
-    const frame *f = &r->f;
-    float thr = r->stage.afterimage_speed;
+    const frame *f = r_fx_frame(r);
+    float thr = r_fx_stage(r)->afterimage_speed;
     /* Which bones leave a copy is the fighter's own motion in either mode:
      * measured in view space, a fighter standing still while the camera
      * followed the other one (a pan or zoom of 3 m/s at a head's far end)
@@ -120,9 +121,10 @@ static void run(void *u)
 {
     r_game *r = u;
     fx_afterimage_state *a = AFTERIMAGE(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     GLuint p = a->prog;
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    r_fx_gl core = r_fx_core_gl(r);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, core.hdr_fbo);
     gl.Viewport(0, 0, f->w, f->h);
     gl.Enable(GL_DEPTH_TEST);
     gl.DepthFunc(GL_LESS);
@@ -139,17 +141,17 @@ static void run(void *u)
     gl.UniformMatrix4fv(r_loc(p, "u_view_prev"), 1, GL_FALSE, f->view_prev.m);
     gl.UniformMatrix4fv(r_loc(p, "u_proj"), 1, GL_FALSE, f->proj.m);
     gl.Uniform1fv(r_loc(p, "u_radius"), 16, a->radius);
-    gl.Uniform1f(r_loc(p, "u_stretch"), r->stage.afterimage_stretch);
-    gl.Uniform1i(r_loc(p, "u_world"), r->stage.afterimage == R_AFTERIMAGE_WORLD);
+    gl.Uniform1f(r_loc(p, "u_stretch"), r_fx_stage(r)->afterimage_stretch);
+    gl.Uniform1i(r_loc(p, "u_world"), r_fx_stage(r)->afterimage == R_AFTERIMAGE_WORLD);
     gl.Uniform1f(r_loc(p, "u_opacity"), OPACITY);
-    gl.BindVertexArray(r->fighter_vao);
+    gl.BindVertexArray(core.fighter_vao);
     for (int i = 0; i < 2; i++) {
         gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &f->bones[i][0][0]);
         gl.UniformMatrix4fv(r_loc(p, "u_bones_prev"), G_BONES, GL_FALSE, &f->bones_prev[i][0][0]);
         gl.UniformMatrix4fv(r_loc(p, "u_bones_tick"), G_BONES, GL_FALSE, &f->bones_tick[i][0][0]);
         gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &f->colors[i][0][0]);
         gl.Uniform1fv(r_loc(p, "u_fast"), 16, a->fast[i]);
-        gl.DrawElements(GL_TRIANGLES, r->fighter_count, GL_UNSIGNED_INT, NULL);
+        gl.DrawElements(GL_TRIANGLES, core.fighter_count, GL_UNSIGNED_INT, NULL);
     }
     gl.Disable(GL_BLEND);
     gl.Disable(GL_STENCIL_TEST);
@@ -162,7 +164,7 @@ static const r_pass passes[] = {
 };
 
 /* History: none of its own.  The previous matrices are those of the game
- * state one tick before (r->f.bones_prev, view_prev: r_frame.c), which the
+ * state one tick before (frame.bones_prev, view_prev: r_frame.c), which the
  * caller hands r_game_draw as `prev`; a frame is a function of the two
  * game states alone. */
 const r_fx_module fx_afterimage_module = {

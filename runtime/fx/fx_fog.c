@@ -1,4 +1,4 @@
-/* Fog map (techniques A8, issue 8): mist particles laid over the stage,
+/* Fog map (docs/effects.md, "Fog map"): mist particles laid over the stage,
  * moved by a global wind plus the local wind that fast limbs stir up
  * (fx_fog_sim.c, once per game tick), are drawn each frame as soft
  * sprites into a top-down density map; the scene's vertex shaders read it
@@ -8,9 +8,9 @@
  *
  * One pass, "fog_map" (phase R_FX_PRE, writes RES_FOGMAP), on stages with
  * `fog = yes` only:
- *   1. the simulation follows the game: restart on r->f.reset, stir with
- *      the bone capsules' end points (r->f.caps against r->f.caps_prev),
- *      then r->f.steps ticks;
+ *   1. the simulation follows the game: restart on frame.reset, stir with
+ *      the bone capsules' end points (frame.caps against frame.caps_prev),
+ *      then frame.steps ticks;
  *   2. the particles (and the copies of those that cross the map's edge:
  *      the mist wraps round) are drawn additively into an R16F map of
  *      size x size texels over x, z in +-half metres, normalised so that
@@ -32,7 +32,7 @@
 extern const r_fx_module fx_fog_module;
 #define FOG(r) ((struct fx_fog_state *)r_fx_state((r), &fx_fog_module))
 
-/* What the fog looks like (A8 gives no numbers; these suit mistvale). */
+/* What the fog looks like (no reference numbers; these suit mistvale). */
 typedef struct fog_look {
     int map_size;     /* the map's edge, texels */
     float sprite_m;   /* a particle's sprite radius, m (at most half the map's half edge) */
@@ -90,7 +90,7 @@ static bool make_map(struct fx_fog_state *fg, int size, rs_err *err)
     fg->size = size;
     if (st != GL_FRAMEBUFFER_COMPLETE) {
         free_map(fg);
-        return rs_fail(err, 1, "fog map: %dx%d R16F target incomplete (%s)", size, size, rgl_enum_name(st));
+        return rs_fail(err, R_ERR_TARGET, "fog map: %dx%d R16F target incomplete (%s)", size, size, rgl_enum_name(st));
     }
     return true;
 }
@@ -157,10 +157,10 @@ static int draw_map(r_game *r, struct fx_fog_state *fg)
 static bool need_fog(void *u)
 {
     r_game *r = u;
-    return r->stage.fog && FOG(r);
+    return r_fx_stage(r)->fog && FOG(r);
 }
 
-/* Both fighters' bone end points now and a tick ago (r->f.caps*). */
+/* Both fighters' bone end points now and a tick ago (frame.caps*). */
 static int limb_points(const frame *f, float cur[][3], float prev[][3])
 {
     int n = 0;
@@ -178,7 +178,7 @@ static int limb_points(const frame *f, float cur[][3], float prev[][3])
 static void sim_follow(r_game *r)
 {
     struct fx_fog_state *fg = FOG(r);
-    const frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     /* step 1: the mist follows the game's ticks, never the frame rate */
     float cur[4 * G_BONES][3], prev[4 * G_BONES][3];
     int n = limb_points(f, cur, prev);
@@ -227,15 +227,16 @@ static void fog_bind(r_game *r, GLuint p, int unit, int what)
 {
     (void)what;
     struct fx_fog_state *fg = FOG(r);
-    bool on = fg && r->stage.fog && r_ran(&r->f, r, "fog_map");
+    bool on = fg && r_fx_stage(r)->fog && r_ran(r_fx_frame(r), r, "fog_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_fog_on"), on);
     r_bind_tex(p, "u_fog_map", unit, GL_TEXTURE_2D, on ? fg->tex : 0);
     if (!on)
         return;
     const fog_look *lk = &fg->look;
-    const r_stage *st = &r->stage;
-    gl.Uniform3f(r_loc(p, "u_fog_eye"), r->f.eye.x, r->f.eye.y, r->f.eye.z);
+    const r_stage *st = r_fx_stage(r);
+    const frame *f = r_fx_frame(r);
+    gl.Uniform3f(r_loc(p, "u_fog_eye"), f->eye.x, f->eye.y, f->eye.z);
     gl.Uniform1f(r_loc(p, "u_fog_half"), fg->sim.d.half);
     gl.Uniform1f(r_loc(p, "u_fog_density"), lk->density);
     gl.Uniform1f(r_loc(p, "u_fog_base"), lk->base);
@@ -248,7 +249,7 @@ static void fog_bind(r_game *r, GLuint p, int unit, int what)
     const r_paint_light *key = &st->key;
     double omega = 2 * 3.14159265358979 * (1 - cos(key->size_deg * 3.14159265358979 / 180));
     for (int k = 0; k < 3; k++) {
-        c[k] = half_clamp(st->sky_horizon[k] * lk->brightness + r->f.flash * flash[k] * lk->albedo);
+        c[k] = half_clamp(st->sky_horizon[k] * lk->brightness + f->flash * flash[k] * lk->albedo);
         if (st->sun) /* its irradiance */
             e[k] = half_clamp(st->sun_intensity * st->sun_color[k] * lk->albedo);
         else /* a painted disc of radiance intensity x (1 - smoothstep): 0.3 of it over its solid angle */
@@ -289,17 +290,17 @@ static bool fog_create(r_game *r, rs_err *err)
 {
     struct fx_fog_state *fg = calloc(1, sizeof *fg);
     if (!fg)
-        return rs_fail(err, 1, "fog: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "fog: out of memory");
     r_fx_set_state(r, &fx_fog_module, fg);
     fg->look = default_look;
     if (!fx_fog_sim_init(&fg->sim, NULL)) {
         fog_destroy(r);
-        return rs_fail(err, 1, "fog: out of memory for the mist");
+        return rs_fail(err, R_ERR_NOMEM, "fog: out of memory for the mist");
     }
     fg->cap = 4 * fg->sim.n; /* at most four copies each (a corner) */
     if (!(fg->inst = malloc((size_t)fg->cap * 3 * sizeof(float)))) {
         fog_destroy(r);
-        return rs_fail(err, 1, "fog: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "fog: out of memory");
     }
     if (!(fg->prog = r_program(&(r_program_desc){.vs = "fog_splat.vert", .fs = "fog_splat.frag"}, err))) {
         fog_destroy(r);
@@ -316,7 +317,7 @@ static bool fog_create(r_game *r, rs_err *err)
     gl.BindVertexArray(0);
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
     /* the quality knob (r_quality.fog_size, range checked at create) or the look's */
-    if (!make_map(fg, r->opts.q.fog_size > 0 ? r->opts.q.fog_size : fg->look.map_size, err)) {
+    if (!make_map(fg, r_fx_quality(r)->fog_size > 0 ? r_fx_quality(r)->fog_size : fg->look.map_size, err)) {
         fog_destroy(r);
         return false;
     }
@@ -329,7 +330,7 @@ static bool fog_create(r_game *r, rs_err *err)
  * counts.  fog_advance is the pass's step 1 without the map. */
 static const char *fog_define(const r_game *r)
 {
-    return r->stage.fog ? "FX_FOG" : NULL;
+    return r_fx_stage(r)->fog ? "FX_FOG" : NULL;
 }
 
 const r_fx_module fx_fog_module = {
@@ -422,7 +423,7 @@ bool fx_fog_accuracy_rows(FILE *out, rs_err *err)
     bool ok = false;
     if (!r || !ref || !map) {
         if (r)
-            rs_fail(err, 1, "fog accuracy: out of memory");
+            rs_fail(err, R_ERR_NOMEM, "fog accuracy: out of memory");
         goto done;
     }
     struct fx_fog_state *fg = FOG(r);

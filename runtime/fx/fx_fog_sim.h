@@ -1,4 +1,4 @@
-/* The fog map's mist (techniques A8), CPU side: particles lying over the
+/* The fog map's mist (docs/effects.md, "Fog map"), CPU side: particles lying over the
  * stage, moved once per game tick by a global wind plus local wind fields
  * that fast limbs leave behind them.  Pure C, no GL: fx_fog.c draws the
  * particles into the fog map each frame.

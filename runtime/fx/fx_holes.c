@@ -1,4 +1,4 @@
-/* Destruction holes with stencil (techniques D, issue 8).
+/* Destruction holes with stencil (docs/effects.md, "Destruction holes").
  *
  * The game places the craters (g_holes.c: heavy hits on a destructible
  * stage; part of the game state, so replays reproduce them).  The ring
@@ -49,7 +49,7 @@ struct fx_holes {
 static bool need_holes(void *u)
 {
     r_game *r = u;
-    return HOLES(r) && r->stage.holes && r->f.cur->nholes > 0;
+    return HOLES(r) && r_fx_stage(r)->holes && r_fx_frame(r)->cur->nholes > 0;
 }
 
 static void model(const g_hole *h, float m[16])
@@ -78,10 +78,11 @@ static void run_holes(void *u)
 {
     r_game *r = u;
     struct fx_holes *hs = HOLES(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     const g_state *st = f->cur;
     bool prepass = r_ran(f, r, "z_prepass");
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    r_fx_gl core = r_fx_core_gl(r);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, core.hdr_fbo);
     gl.Viewport(0, 0, f->w, f->h);
     gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     gl.DepthMask(GL_TRUE);
@@ -95,10 +96,10 @@ static void run_holes(void *u)
     gl.CullFace(GL_BACK);
 
     /* 1: the destructible terrain's depth */
-    GLuint pd = r->prog[P_DEPTH];
+    GLuint pd = core.prog_depth;
     gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     r_camera_uniforms(r, pd);
-    gl.BindVertexArray(r->ring_vao);
+    gl.BindVertexArray(core.ring_vao);
     gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, (const void *)(R_RING_TOP_FIRST * sizeof(unsigned)));
 
     /* nearest first */
@@ -168,14 +169,14 @@ static bool holes_create(r_game *r, rs_err *err)
 {
     struct fx_holes *hs = calloc(1, sizeof *hs);
     if (!hs)
-        return rs_fail(err, 1, "holes: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     r_fx_set_state(r, &fx_holes_module, hs);
     /* the unit sphere (a capsule of length 0) on bone 0: u_bones[0] places it */
     r_mesh_data m = {0};
     if (!r_mesh_capsule(&m, 0.0f, 1.0f, 0, SPHERE_SEG, SPHERE_RINGS)) {
         r_mesh_free(&m);
         holes_destroy(r);
-        return rs_fail(err, 1, "holes: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     }
     r_upload_mesh(&m, &hs->vao, &hs->vbo, &hs->ibo);
     hs->count = (GLsizei)m.ni;
@@ -187,7 +188,7 @@ static bool holes_create(r_game *r, rs_err *err)
 /* Inside "scene": the holes pass cleared the HDR target and drew already */
 static bool holes_scene_cleared(r_game *r)
 {
-    return r_ran(&r->f, r, "holes");
+    return r_ran(r_fx_frame(r), r, "holes");
 }
 
 /* Steps 5 and 6 (scene has bound the stage program and the ring's VAO):
@@ -195,10 +196,10 @@ static bool holes_scene_cleared(r_game *r)
  * depth is still there (the holes pass put the craters' depth in the rest). */
 static bool holes_draw_ring(r_game *r)
 {
-    if (!r_ran(&r->f, r, "holes"))
+    if (!r_ran(r_fx_frame(r), r, "holes"))
         return false;
     gl.DrawElements(GL_TRIANGLES, R_RING_TOP_FIRST, GL_UNSIGNED_INT, NULL);
-    gl.DrawElements(GL_TRIANGLES, r->ring_count - R_RING_TOP_FIRST - 6, GL_UNSIGNED_INT,
+    gl.DrawElements(GL_TRIANGLES, r_fx_core_gl(r).ring_count - R_RING_TOP_FIRST - 6, GL_UNSIGNED_INT,
                     (const void *)((R_RING_TOP_FIRST + 6) * sizeof(unsigned)));
     gl.DepthFunc(GL_EQUAL);
     gl.DrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, (const void *)(R_RING_TOP_FIRST * sizeof(unsigned)));

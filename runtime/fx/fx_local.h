@@ -1,11 +1,12 @@
-/* What the stage-effect modules (runtime/fx/) share beyond the render
- * core's insides: the pass-graph bits of their resources.  The contract
+/* What the stage-effect modules (runtime/fx/) share beyond what the render
+ * core hands them (runtime/render/r_fx_core.h): the pass-graph bits of
+ * their resources.  The contract
  * they implement is runtime/render/r_fx.h; the table that lists them is
  * fx_table.c.  A new effect takes the next free bit here. */
 #ifndef FX_LOCAL_H
 #define FX_LOCAL_H
 
-#include "../render/r_local.h"
+#include "../render/r_fx_core.h"
 
 #define FX_RES(k) (1u << (R_RES_FX_FIRST + (k)))
 enum {

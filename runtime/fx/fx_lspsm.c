@@ -1,4 +1,4 @@
-/* Shadows in a large world (techniques C, issue 8): light space
+/* Shadows in a large world (docs/effects.md, "Shadows in a large world"): light space
  * perspective shadow maps over a stage with buildings.
  *
  * The mathematics is r_lspsm.c (tested without GL); this module gives it
@@ -26,7 +26,7 @@
  * (pushed along the normal); the fighters look it up where the ray towards
  * the light leaves their own box (no self-shadow, others' shadows received)
  * and keep u_lspsm_keep of the key light in full shadow, so they keep their
- * directional shading.  When the stage's A5 shadows run (the blurred
+ * directional shading.  When the stage's fighter shadows run (the blurred
  * silhouette on the stage, the screen-space mask on the fighters), those
  * already cast the fighters, and every receiver ignores the
  * fighter-flagged texels; without them this map casts the fighters too.
@@ -82,7 +82,7 @@ struct fx_lspsm_state {
 static bool need_map(void *u)
 {
     r_game *r = u;
-    return r->stage.lspsm && LSPSM(r);
+    return r_fx_stage(r)->lspsm && LSPSM(r);
 }
 
 static bool need_buildings(void *u)
@@ -95,7 +95,7 @@ static bool need_buildings(void *u)
  * or a test's. */
 static r_vec3 to_light(const r_game *r)
 {
-    return LSPSM(r)->light_override ? LSPSM(r)->light : r->f.light_dir;
+    return LSPSM(r)->light_override ? LSPSM(r)->light : r_fx_frame(r)->light_dir;
 }
 
 static void take_focus(struct fx_lspsm_state *ls, bool reset)
@@ -125,7 +125,7 @@ static void run_map(void *u)
 {
     r_game *r = u;
     struct fx_lspsm_state *ls = LSPSM(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     take_focus(ls, f->reset);
     r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
                       .far = ls->focus.range > 0 ? ls->focus.range : R_LSPSM_LIMIT, .uniform = ls->uniform};
@@ -179,8 +179,8 @@ static void run_buildings(void *u)
     r_game *r = u;
     struct fx_lspsm_state *ls = LSPSM(r);
     r_begin_opaque(r);
-    if (r->f.depth_only) { /* a warm-up frame: their depth, for the focus (r_local.h) */
-        GLuint d = r->prog[P_DEPTH];
+    if (r_fx_frame(r)->depth_only) { /* a warm-up frame: their depth, for the focus (r_fx_core.h) */
+        GLuint d = r_fx_core_gl(r).prog_depth;
         gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         r_camera_uniforms(r, d);
         gl.BindVertexArray(ls->city_vao);
@@ -202,14 +202,14 @@ static void run_focus(void *u)
 {
     r_game *r = u;
     struct fx_lspsm_state *ls = LSPSM(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->focus_fbo);
     gl.Viewport(0, 0, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.Disable(GL_CULL_FACE);
     gl.UseProgram(ls->prog_focus);
-    r_bind_tex(ls->prog_focus, "u_depth", 0, GL_TEXTURE_2D, r->depth_tex);
+    r_bind_tex(ls->prog_focus, "u_depth", 0, GL_TEXTURE_2D, r_fx_core_gl(r).depth_tex);
     r_fullscreen(r);
     /* into the pixel-pack buffer: glReadPixels returns at once */
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, ls->pbo);
@@ -241,7 +241,7 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
     if (what != R_FX_BIND_SCENE)
         return;
     struct fx_lspsm_state *ls = LSPSM(r);
-    bool on = ls && r->stage.lspsm && r_ran(&r->f, r, "lspsm_map");
+    bool on = ls && r_fx_stage(r)->lspsm && r_ran(r_fx_frame(r), r, "lspsm_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
     /* the two samplers get their own units whether on or not: samplers of
@@ -250,7 +250,7 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
     r_bind_tex(p, "u_lspsm_flag", unit + 1, GL_TEXTURE_2D, on ? ls->flag_tex : 0);
     if (!on)
         return;
-    const frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     gl.UniformMatrix4fv(r_loc(p, "u_lspsm_shadow"), 1, GL_FALSE, ls->s.shadow.m);
     gl.Uniform3f(r_loc(p, "u_lspsm_eye"), ls->s.eye.x, ls->s.eye.y, ls->s.eye.z);
     gl.Uniform2f(r_loc(p, "u_lspsm_fade"), ls->s.fade[0], ls->s.fade[1]);
@@ -305,7 +305,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
 {
     struct fx_lspsm_state *ls = calloc(1, sizeof *ls);
     if (!ls)
-        return rs_fail(err, 1, "lspsm: out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "lspsm: out of memory");
     r_fx_set_state(r, &fx_lspsm_module, ls);
     if (!(ls->prog_map = r_program(&(r_program_desc){.vs = "scene.vert", .fs = "light_depth.frag",
                                                      .defines = "#define LIGHT_VIEW 1\n#define LSPSM 1\n"},
@@ -317,7 +317,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
     /* the map: depth with hardware comparison, bilinear = 2x2 PCF; outside
      * it (the border) nothing casts */
     const float one[4] = {1, 1, 1, 1}, zero[4] = {0, 0, 0, 0};
-    int q = r->opts.q.lspsm_size;
+    int q = r_fx_quality(r)->lspsm_size;
     ls->map = q <= 0 ? R_LSPSM_MAP : q < 256 ? 256 : q > 4096 ? 4096 : q;
     ls->map_tex = r_tex2d(GL_DEPTH_COMPONENT24, ls->map, ls->map, GL_DEPTH_COMPONENT, GL_FLOAT, NULL, GL_LINEAR,
                           GL_CLAMP_TO_BORDER);
@@ -342,7 +342,7 @@ static bool lspsm_create(r_game *r, rs_err *err)
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE || st2 != GL_FRAMEBUFFER_COMPLETE) {
         lspsm_destroy(r);
-        return rs_fail(err, 1, "lspsm: shadow map target incomplete (%s)",
+        return rs_fail(err, R_ERR_TARGET, "lspsm: shadow map target incomplete (%s)",
                        rgl_enum_name(st != GL_FRAMEBUFFER_COMPLETE ? st : st2));
     }
     RGL_CHECK("lspsm create");
@@ -357,12 +357,12 @@ static bool lspsm_load(r_game *r, rs_err *err)
     ls->pending = false;
     ls->focus.range = 0;
     memset(&ls->stats, 0, sizeof ls->stats);
-    const r_stage *st = &r->stage;
+    const r_stage *st = r_fx_stage(r);
     if (st->buildings <= 0)
         return true;
-    int gs = r->stage_game >= 0 ? r->stage_game : st->game_index;
+    int gs = r_fx_stage_game(r) >= 0 ? r_fx_stage_game(r) : st->game_index;
     float ring_half = gs >= 0 && gs < G_STAGES ? fx_to_float(g_stages[gs].ring_half) : 4.0f;
-    ls->nb = r_city_layout(st->buildings, (unsigned)st->buildings_seed, r->key_dir, ring_half, ls->b);
+    ls->nb = r_city_layout(st->buildings, (unsigned)st->buildings_seed, r_fx_key_dir(r), ring_half, ls->b);
     r_mesh_data city = {0}, proxy = {0};
     bool ok = true;
     for (int i = 0; i < ls->nb && ok; i++) {
@@ -382,7 +382,7 @@ static bool lspsm_load(r_game *r, rs_err *err)
     r_mesh_free(&proxy);
     if (!ok) {
         free_city(ls);
-        return rs_fail(err, 1, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
+        return rs_fail(err, R_ERR_NOMEM, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
     }
     return true;
 }
@@ -411,13 +411,13 @@ static bool lspsm_needs_frame(r_game *r)
 
 static void lspsm_advance(r_game *r)
 {
-    if (LSPSM(r) && r->f.reset)
+    if (LSPSM(r) && r_fx_frame(r)->reset)
         take_focus(LSPSM(r), true);
 }
 
 static const char *lspsm_define(const r_game *r)
 {
-    return r->stage.lspsm ? "FX_LSPSM" : NULL;
+    return r_fx_stage(r)->lspsm ? "FX_LSPSM" : NULL;
 }
 
 const r_fx_module fx_lspsm_module = {

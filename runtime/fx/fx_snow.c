@@ -1,4 +1,4 @@
-/* Snow (techniques A7, issue 8): fresh snow over the ring top that keeps
+/* Snow (docs/effects.md, "Snow"): fresh snow over the ring top that keeps
  * the fighters' footprints for the match.
  *
  *   snow_map         (PRE)      the displacement map, R_SNOW_MAP^2 R32F over
@@ -25,7 +25,7 @@
  *                               (step 3)
  *
  * The map follows game ticks only (r_fx.h): a frame stamps the contacts of
- * r->f.caps and r->f.caps_prev (this tick and the one before; the MIN
+ * frame.caps and frame.caps_prev (this tick and the one before; the MIN
  * blend makes stamping twice harmless), so a video drawn at 60 or 30
  * frames a second gets the same prints.  Larger gaps lose the skipped
  * ticks' contacts; a seek restarts from untouched snow. */
@@ -77,7 +77,7 @@ struct fx_snow_state {
 
 static float ring_half(const r_game *r)
 {
-    int st = r->ring_stage >= 0 ? r->ring_stage : r->stage.game_index;
+    int st = r_game_ring_stage(r) >= 0 ? r_game_ring_stage(r) : r_fx_stage(r)->game_index;
     return st >= 0 && st < G_STAGES ? fx_to_float(g_stages[st].ring_half) : 4.0f;
 }
 
@@ -175,7 +175,7 @@ static bool snow_create(r_game *r, rs_err *err)
 {
     struct fx_snow_state *s = calloc(1, sizeof *s);
     if (!s)
-        return rs_fail(err, 1, "out of memory for the snow");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     r_fx_set_state(r, &fx_snow_module, s);
     char stamps[64];
     snprintf(stamps, sizeof stamps, "#define MAX_STAMPS %d\n", MAX_STAMPS);
@@ -211,14 +211,14 @@ static bool snow_create(r_game *r, rs_err *err)
     uint8_t *px = malloc((size_t)R_SNOW_TEX * R_SNOW_TEX * 4);
     if (!px || !build_grid(s)) {
         free(px);
-        return rs_fail(err, 1, "out of memory for the snow");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     }
     s->color_tex = color_tex(fx_snow_tex_colors, px, GL_RG8, GL_RG);
     s->detail_tex = color_tex(fx_snow_tex_detail_normals, px, GL_RGBA8, GL_RGBA);
     free(px);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st_map != GL_FRAMEBUFFER_COMPLETE || st_light != GL_FRAMEBUFFER_COMPLETE)
-        return rs_fail(err, 1, "snow: the R32F height map (%s) or the RGBA16F light target (%s) cannot be drawn into",
+        return rs_fail(err, R_ERR_TARGET, "snow: the R32F height map (%s) or the RGBA16F light target (%s) cannot be drawn into",
                        rgl_enum_name(st_map), rgl_enum_name(st_light));
     RGL_CHECK("snow_create");
     return true;
@@ -230,7 +230,7 @@ static bool make_heights(struct fx_snow_state *s, float half, rs_err *err)
     const int n = R_SNOW_MAP;
     float *h = malloc((size_t)n * n * sizeof *h);
     if (!h)
-        return rs_fail(err, 1, "out of memory for the snow");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     fx_snow_tex_untouched(h, n, half);
     gl.BindTexture(GL_TEXTURE_2D, s->untouched_tex);
     gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, n, n, GL_RED, GL_FLOAT, h);
@@ -246,7 +246,7 @@ static bool make_heights(struct fx_snow_state *s, float half, rs_err *err)
 static bool snow_load(r_game *r, rs_err *err)
 {
     /* the map itself restarts on the first frame (load_look resets the ticks) */
-    return !r->stage.snow || make_heights(SNOW(r), ring_half(r), err);
+    return !r_fx_stage(r)->snow || make_heights(SNOW(r), ring_half(r), err);
 }
 
 /* ---- snow_map: reset and footprints ---- */
@@ -272,15 +272,16 @@ static bool need_map(void *u)
 {
     r_game *r = u;
     struct fx_snow_state *s = SNOW(r);
-    if (!r->stage.snow || !s)
+    if (!r_fx_stage(r)->snow || !s)
         return false;
     /* the contacts are found here so that a tick without any costs no pass */
     s->nstamp = 0;
-    if (r->f.steps > 0) {
-        add_contacts(s, r->f.caps, r->f.caps_prev);
-        add_contacts(s, r->f.caps_prev, r->f.caps_prev);
+    const frame *f = r_fx_frame(r);
+    if (f->steps > 0) {
+        add_contacts(s, f->caps, f->caps_prev);
+        add_contacts(s, f->caps_prev, f->caps_prev);
     }
-    return r->f.reset || s->half != ring_half(r) || s->nstamp > 0;
+    return f->reset || s->half != ring_half(r) || s->nstamp > 0;
 }
 
 static void stamp(r_game *r, const r_fx_capsule *caps, int n)
@@ -294,7 +295,7 @@ static void stamp(r_game *r, const r_fx_capsule *caps, int n)
     gl.Enable(GL_BLEND);
     gl.BlendEquation(GL_MIN); /* the snow only ever goes down */
     gl.BlendFunc(GL_ONE, GL_ONE);
-    gl.BindVertexArray(r->empty_vao);
+    gl.BindVertexArray(r_fx_core_gl(r).empty_vao);
     for (int done = 0; done < n;) {
         int m = n - done < MAX_STAMPS ? n - done : MAX_STAMPS;
         for (int k = 0; k < m; k++) {
@@ -325,7 +326,7 @@ static void run_map(void *u)
 {
     r_game *r = u;
     struct fx_snow_state *s = SNOW(r);
-    bool reset = r->f.reset;
+    bool reset = r_fx_frame(r)->reset;
     if (s->half != ring_half(r)) { /* the ring changed size under the same look */
         if (!make_heights(s, ring_half(r), NULL))
             return;
@@ -347,7 +348,7 @@ static void run_map(void *u)
 static bool need_snow(void *u)
 {
     r_game *r = u;
-    return r->stage.snow && SNOW(r);
+    return r_fx_stage(r)->snow && SNOW(r);
 }
 
 static void run_light(void *u)
@@ -369,8 +370,9 @@ static void run_light(void *u)
     gl.Uniform1f(r_loc(p, "u_half"), s->half);
     gl.Uniform1f(r_loc(p, "u_detail_tile"), DETAIL_TILE);
     gl.Uniform2f(r_loc(p, "u_size"), SNOW_LIGHT, SNOW_LIGHT);
-    gl.Uniform3f(r_loc(p, "u_eye"), r->f.eye.x, r->f.eye.y, r->f.eye.z);
-    gl.Uniform3f(r_loc(p, "u_light_dir"), r->f.light_dir.x, r->f.light_dir.y, r->f.light_dir.z);
+    const frame *f = r_fx_frame(r);
+    gl.Uniform3f(r_loc(p, "u_eye"), f->eye.x, f->eye.y, f->eye.z);
+    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
     r_fullscreen(r);
     /* and the key light's colour for the surface, once */
     p = s->prog[S_KEY];
@@ -378,7 +380,7 @@ static void run_light(void *u)
     gl.Viewport(0, 0, 1, 1);
     gl.UseProgram(p);
     r_bind_ibl(r, p);
-    gl.Uniform3f(r_loc(p, "u_light_dir"), r->f.light_dir.x, r->f.light_dir.y, r->f.light_dir.z);
+    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
     r_fullscreen(r);
 }
 
@@ -396,7 +398,7 @@ static void run_surface(void *u)
 {
     r_game *r = u;
     struct fx_snow_state *s = SNOW(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     GLuint p = s->prog[S_SURFACE];
     r_begin_opaque(r);
     r_camera_uniforms(r, p);
@@ -405,19 +407,14 @@ static void run_surface(void *u)
     r_bind_tex(p, "u_trampled", 2, GL_TEXTURE_2D, s->trampled_tex);
     r_bind_tex(p, "u_light", 3, GL_TEXTURE_2D, s->light_tex);
     r_bind_tex(p, "u_colors", 4, GL_TEXTURE_2D, s->color_tex);
-    r_bind_tex(p, "u_silhouette", 5, GL_TEXTURE_2D, r->sil_tex);
+    r_bind_tex(p, "u_silhouette", 5, GL_TEXTURE_2D, r_fx_core_gl(r).sil_tex);
     r_bind_tex(p, "u_key", 7, GL_TEXTURE_2D, s->key_tex);
     gl.Uniform1f(r_loc(p, "u_half"), s->half);
     gl.Uniform1f(r_loc(p, "u_color_tile"), COLOR_TILE);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     /* the fighters' blurred silhouette falls on the snow as on the ring (run_scene) */
     gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "silhouette_mips"));
-    gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
-    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
-    float waist[6] = {f->waist[0].x, f->waist[0].y, f->waist[0].z, f->waist[1].x, f->waist[1].y, f->waist[1].z};
-    gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
-    gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
-    gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
+    r_light_uniforms(p, f);
     gl.Uniform1f(r_loc(p, "u_sil_top"), SIL_LEVELS - 1);
     gl.BindVertexArray(s->grid_vao);
     gl.DrawElements(GL_TRIANGLES, s->grid_count, GL_UNSIGNED_INT, NULL);

@@ -4,21 +4,13 @@
 #include <math.h>
 #include <stddef.h>
 
-/* a small integer hash: deterministic noise, no libc rand() state */
-static uint32_t hash3(uint32_t x, uint32_t y, uint32_t seed)
-{
-    uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ seed * 0xcb1ab31fu;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return h;
-}
+#include "../util/rs_hash.h"
 
 static float lattice(int x, int y, int period, uint32_t seed)
 {
     if (period > 0) /* a tiling texture: the lattice wraps */
         x = (x % period + period) % period, y = (y % period + period) % period;
-    return (float)(hash3((uint32_t)x, (uint32_t)y, seed) & 0xffff) / 65535.0f;
+    return (float)(rs_hash_point((uint32_t)x, (uint32_t)y, seed) & 0xffff) / 65535.0f;
 }
 
 /* Smooth value noise in 0..1 at (x, y) in lattice cells; period > 0 makes
@@ -90,7 +82,7 @@ void fx_snow_tex_colors(uint8_t *rg, int n)
             p[0] = u8(0.95f + 0.05f * g);
             /* trampled: blotchy compacted snow, a little grit from the boots */
             float t = vnoise(u * 0.75f, v * 0.75f, 12, 41) * 0.5f + vnoise(u * 5, v * 5, 80, 42) * 0.5f;
-            float grit = hash3((uint32_t)x, (uint32_t)y, 43) % 100 < 6 ? 0.75f : 1.0f;
+            float grit = rs_hash_point((uint32_t)x, (uint32_t)y, 43) % 100 < 6 ? 0.75f : 1.0f;
             p[1] = u8((0.85f + 0.15f * t) * grit);
         }
 }

@@ -1,4 +1,4 @@
-/* Snow (techniques A7): the effect's procedural textures, plain CPU
+/* Snow (docs/effects.md, "Snow"): the effect's procedural textures, plain CPU
  * functions so tests check them without GL, and the snow module's
  * read-back hooks for the tests (defined in fx_snow.c).
  *

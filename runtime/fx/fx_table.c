@@ -8,7 +8,8 @@ extern const r_fx_module fx_fog_module, fx_lspsm_module, fx_holes_module, fx_wat
 const r_fx_module *const r_fx_modules[] = {
     &fx_fog_module,   /* first: the fog map is read by every later scene draw */
     &fx_lspsm_module, /* the shadow map, read by every later scene draw */
-    &fx_holes_module, /* before the other surfaces: it clears the frame (steps 1-3 of D) */
+    &fx_holes_module, /* before the other surfaces: it clears the frame (docs/effects.md,
+                         "Destruction holes", steps 1-3) */
     &fx_water_module,
     &fx_snow_module,
     &fx_afterimage_module,

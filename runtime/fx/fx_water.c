@@ -1,4 +1,4 @@
-/* Water (techniques A6, issue 8): the stage effect of `water = yes`.
+/* Water (docs/effects.md, "Water"): the stage effect of `water = yes`.
  *
  *   water_sim      (R_FX_PRE)  contacts -> splats on the CPU; per game tick
  *                              one automaton step on the 256x256 RGBA32F
@@ -16,9 +16,9 @@
  *
  * The water lies over the ring's top face (x, z within +-ring_half) at
  * R_WATER_LEVEL.  The simulation is a function of the game states alone:
- * it steps r->f.steps times (at most R_WATER_MAX_STEPS; the ticks past
+ * it steps frame.steps times (at most R_WATER_MAX_STEPS; the ticks past
  * that are dropped) with the contacts of the frame's tick, and restarts
- * flat on r->f.reset.  Nothing is built until a stage with water loads. */
+ * flat on frame.reset.  Nothing is built until a stage with water loads. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -228,7 +228,7 @@ static bool build(fx_water_state *w, rs_err *err)
         w->sim_tex[k] = r_tex2d(GL_RGBA32F, R_WATER_N, R_WATER_N, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         w->sim_fbo[k] = r_fbo_for(w->sim_tex[k], 0, 0);
         if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-            rs_fail(err, 1, "water: the %dx%d RGBA32F simulation target is not renderable on this driver", R_WATER_N,
+            rs_fail(err, R_ERR_TARGET, "water: the %dx%d RGBA32F simulation target is not renderable on this driver", R_WATER_N,
                     R_WATER_N);
             goto fail;
         }
@@ -247,7 +247,7 @@ static bool build(fx_water_state *w, rs_err *err)
     uint8_t *px = malloc((size_t)COLOR_SIZE * COLOR_SIZE * 4);
     if (!px || !build_mesh(w)) {
         free(px);
-        rs_fail(err, 1, "out of memory for the water");
+        rs_fail(err, R_ERR_NOMEM, "out of memory for the water");
         goto fail;
     }
     w->shallow_tex = color_tex(px, false);
@@ -268,10 +268,10 @@ static bool create(r_game *r, rs_err *err)
 {
     fx_water_state *w = calloc(1, sizeof *w);
     if (!w)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory");
     r_fx_set_state(r, &fx_water_module, w);
     fx_water_sim_params_fix(&w->prm);
-    w->mesh_n = r->opts.q.water_grid > 0 ? r->opts.q.water_grid : MESH_N; /* range checked by r_game_create_opts */
+    w->mesh_n = r_fx_quality(r)->water_grid > 0 ? r_fx_quality(r)->water_grid : MESH_N; /* range checked by r_game_create_opts */
     return true;
 }
 
@@ -289,15 +289,15 @@ static void destroy(r_game *r)
 static bool load(r_game *r, rs_err *err)
 {
     fx_water_state *w = WATER(r);
-    if (w && !r->stage.water)
+    if (w && !r_fx_stage(r)->water)
         free_targets(w);
-    return !r->stage.water || !w || w->built || build(w, err);
+    return !r_fx_stage(r)->water || !w || w->built || build(w, err);
 }
 
 static bool need_water(void *u)
 {
     r_game *r = u;
-    return r->stage.water && WATER(r) && WATER(r)->built;
+    return r_fx_stage(r)->water && WATER(r) && WATER(r)->built;
 }
 
 /* ---- the simulation ---- */
@@ -364,7 +364,7 @@ static void gpu_steps(r_game *r, fx_water_state *w, const fx_water_sim_splat *s,
 
 static float ring_half(const r_game *r)
 {
-    int st = r->ring_stage >= 0 ? r->ring_stage : r->stage.game_index;
+    int st = r_game_ring_stage(r) >= 0 ? r_game_ring_stage(r) : r_fx_stage(r)->game_index;
     return st >= 0 && st < G_STAGES ? fx_to_float(g_stages[st].ring_half) : 4.0f;
 }
 
@@ -374,7 +374,7 @@ static float ring_half(const r_game *r)
 static bool step_sim(r_game *r)
 {
     fx_water_state *w = WATER(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     if (f->reset)
         clear_state(w);
     w->prm.size = 2 * ring_half(r);
@@ -440,7 +440,7 @@ static void run_reflect(void *u)
 {
     r_game *r = u;
     fx_water_state *w = WATER(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     ensure_targets(w, f->w, f->h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->refl_fbo);
     gl.Viewport(0, 0, r_half(f->w, 1), r_half(f->h, 1));
@@ -454,8 +454,8 @@ static void run_reflect(void *u)
     mirror.m[5] = -1, mirror.m[13] = 2 * R_WATER_LEVEL;
     r_mat4 vp = r_mul(f->vp, mirror);
     /* the sky seen in the mirror, the sun disc too (its glint on the water) */
-    const r_stage *st = &r->stage;
-    GLuint p = r->prog[P_SKY];
+    const r_stage *st = r_fx_stage(r);
+    GLuint p = r_fx_core_gl(r).prog_sky;
     gl.Disable(GL_DEPTH_TEST);
     gl.UseProgram(p);
     /* the sky program keeps the fog uniforms run_sky set last frame (maybe
@@ -463,14 +463,8 @@ static void run_reflect(void *u)
     gl.Uniform1i(r_loc(p, "u_fog_on"), 0);
     r_mat4 inv = r_invert(vp);
     gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, inv.m);
-    r_bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r->sky_tex);
-    float rad = st->sun_size_deg * 0.5f * 3.14159265f / 180.0f;
-    double omega = 2 * 3.14159265358979 * (1 - cos(rad));
-    float L = st->sun ? (float)fmin(st->sun_intensity / omega, R_HALF_MAX) : 0.0f;
-    gl.Uniform3f(r_loc(p, "u_sun_dir"), st->sun_dir[0], st->sun_dir[1], st->sun_dir[2]);
-    gl.Uniform3f(r_loc(p, "u_sun_radiance"), fminf(L * st->sun_color[0], R_HALF_MAX),
-                 fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
-    gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
+    r_bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r_fx_core_gl(r).sky_tex);
+    r_sun_uniforms(p, st);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     r_fullscreen(r);
     /* the simple model: the fighters above the water, mirrored */
@@ -489,7 +483,7 @@ static void run_reflect(void *u)
  * the whole screen when a corner is behind the camera. */
 static void water_box(const r_game *r, float half, int box[4])
 {
-    const frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
     for (int k = 0; k < 8; k++) {
         r_vec3 c = r_v3(k & 1 ? half : -half, k & 2 ? R_WATER_LEVEL + WATER(r)->prm.h_max : 0.0f, k & 4 ? half : -half);
@@ -510,7 +504,7 @@ static void run_under(void *u)
 {
     r_game *r = u;
     fx_water_state *w = WATER(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     ensure_targets(w, f->w, f->h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, w->under_fbo);
     gl.Viewport(0, 0, f->w, f->h);
@@ -525,16 +519,17 @@ static void run_under(void *u)
     gl.Scissor(box[0], box[1], box[2], box[3]);
     GLuint p = w->prog[W_UNDER];
     gl.UseProgram(p);
-    r_bind_tex(p, "u_hdr", 0, GL_TEXTURE_2D, r->hdr_tex);
-    r_bind_tex(p, "u_depth", 1, GL_TEXTURE_2D, r->depth_tex);
-    r_bind_tex(p, "u_diffuse_on", 8, GL_TEXTURE_CUBE_MAP, r->ibl_tex[R_IBL_DIFFUSE][R_IBL_KEY_ON]);
+    r_fx_gl core = r_fx_core_gl(r);
+    r_bind_tex(p, "u_hdr", 0, GL_TEXTURE_2D, core.hdr_tex);
+    r_bind_tex(p, "u_depth", 1, GL_TEXTURE_2D, core.depth_tex);
+    r_bind_tex(p, "u_diffuse_on", 8, GL_TEXTURE_CUBE_MAP, core.diffuse_on);
     gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, f->inv_vp.m);
     gl.Uniform3f(r_loc(p, "u_eye"), f->eye.x, f->eye.y, f->eye.z);
     gl.Uniform2f(r_loc(p, "u_size"), (float)f->w, (float)f->h);
     gl.Uniform1f(r_loc(p, "u_level"), R_WATER_LEVEL);
     float half = ring_half(r);
     gl.Uniform2f(r_loc(p, "u_half"), half, half);
-    gl.Uniform3fv(r_loc(p, "u_wall_color"), 1, r->stage.ring_color);
+    gl.Uniform3fv(r_loc(p, "u_wall_color"), 1, r_fx_stage(r)->ring_color);
     gl.Uniform1f(r_loc(p, "u_fog_base"), FOG_BASE);
     gl.Uniform1f(r_loc(p, "u_fog_depth"), FOG_DEPTH);
     gl.Uniform3fv(r_loc(p, "u_fog_color"), 1, fog_color);
@@ -547,9 +542,10 @@ static void run_surface(void *u)
 {
     r_game *r = u;
     fx_water_state *w = WATER(r);
-    frame *f = &r->f;
+    const frame *f = r_fx_frame(r);
     float half = ring_half(r);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->hdr_fbo);
+    r_fx_gl core = r_fx_core_gl(r);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, core.hdr_fbo);
     gl.Viewport(0, 0, f->w, f->h);
     gl.Enable(GL_DEPTH_TEST); /* opaque: tested and written like any surface */
     gl.DepthFunc(GL_LESS);
@@ -558,7 +554,7 @@ static void run_surface(void *u)
     gl.Disable(GL_BLEND);
     GLuint p = w->prog[W_SURFACE];
     r_camera_uniforms(r, p);
-    r_bind_tex(p, "u_diffuse_on", 8, GL_TEXTURE_CUBE_MAP, r->ibl_tex[R_IBL_DIFFUSE][R_IBL_KEY_ON]);
+    r_bind_tex(p, "u_diffuse_on", 8, GL_TEXTURE_CUBE_MAP, core.diffuse_on);
     r_bind_tex(p, "u_state", 0, GL_TEXTURE_2D, w->sim_tex[w->cur]);
     r_bind_tex(p, "u_normal_map", 1, GL_TEXTURE_2D, w->normal_tex);
     r_bind_tex(p, "u_under", 2, GL_TEXTURE_2D, w->under_tex);

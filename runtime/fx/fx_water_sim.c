@@ -287,7 +287,7 @@ void fx_water_sim_accuracy_rows(FILE *out)
     if (!fx_water_sim_forced_run(&small, false, N, STEPS, REF, &base))
         return;
     fprintf(out,
-            "\nWater automaton (techniques A6): Courant number C = c dt / dx against stability.  Damping %.3f;\n"
+            "\nWater automaton (docs/effects.md, Water): Courant number C = c dt / dx against stability.  Damping %.3f;\n"
             "a %dx%d grid forced like the game (two sweeping feet and a stamp, splats every step), %d steps.\n"
             "margin = cap / C used (cap %.4f; the 2D CFL limit is 1/sqrt(2) = %.4f); growth = the worst mode's\n"
             "amplitude factor per step (analytic, < 1 decays); E max / E 1000 = the run's largest energy over its\n"

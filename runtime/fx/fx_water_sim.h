@@ -1,4 +1,4 @@
-/* Water (techniques A6): the wave automaton's CPU reference and its
+/* Water (docs/effects.md, "Water"): the wave automaton's CPU reference and its
  * parameters.  Plain C, no GL: shaders/water_sim.frag and water_splat.*
  * run the same formulas on the GPU (fx_water.c), and
  * tests/test_fx_water.c holds the two to each other.

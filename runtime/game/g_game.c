@@ -571,9 +571,3 @@ const char *g_event_name(int type)
                                                   "lightning"};
     return type >= 0 && type < G_EV_COUNT ? names[type] : "?";
 }
-
-const char *g_result_name(int result)
-{
-    static const char *const names[] = {"none", "ko", "ring_out", "time", "draw"};
-    return result >= 0 && result <= G_RES_DRAW ? names[result] : "?";
-}

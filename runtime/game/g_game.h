@@ -98,10 +98,10 @@ typedef struct g_fighter {
     int32_t hist_age[G_HIST];
 } g_fighter;
 
-/* A destruction hole (techniques D): a crater in the ring floor, centred
- * at (x, z) on the ring top, `r` the radius of the sphere that cuts it
- * (centred 0.4 r above the floor: 0.6 r deep, 0.92 r wide at the top).
- * Holes are decoration: the fighters still stand on a flat floor. */
+/* A destruction hole (docs/effects.md, "Destruction holes"): a crater in the
+ * ring floor, centred at (x, z) on the ring top, `r` the radius of the sphere
+ * that cuts it (centred 0.4 r above the floor: 0.6 r deep, 0.92 r wide at the
+ * top). Holes are decoration: the fighters still stand on a flat floor. */
 #define G_MAX_HOLES 30
 typedef struct g_hole {
     fx x, z, r;
@@ -179,7 +179,6 @@ void g_fighter_capsules(const g_state *st, int i, g_capsule out[G_BONES]);
 
 const char *g_move_name(int move);
 const char *g_event_name(int type);
-const char *g_result_name(int result);
 
 /* Destruction holes (g_holes.c).  g_hole_add places a crater of radius r
  * near (x, z): the first of a few candidate spots across the ring that

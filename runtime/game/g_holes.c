@@ -1,8 +1,8 @@
-/* Destruction holes (techniques D) as game state: where heavy hits leave
- * craters in the ring floor of a destructible stage.  The renderer draws
- * them with stencil (runtime/fx/fx_holes.c); here they are only
- * placed, kept from overlapping and capped, in fixed point, so a replay
- * makes the same holes on every machine. */
+/* Destruction holes (docs/effects.md, "Destruction holes") as game state:
+ * where heavy hits leave craters in the ring floor of a destructible
+ * stage.  The renderer draws them with stencil (runtime/fx/fx_holes.c); here
+ * they are only placed, kept from overlapping and capped, in fixed point, so
+ * a replay makes the same holes on every machine. */
 #include "g_local.h"
 
 bool g_holes_overlap(const g_hole *a, const g_hole *b)

@@ -1,4 +1,4 @@
-/* The buildings round a large outdoor ring (techniques C's "large world"):
+/* The buildings round a large outdoor ring (docs/effects.md, "Shadows in a large world"):
  * a deterministic layout from a stage's `buildings` and `buildings_seed`,
  * the detailed meshes the camera sees and the low-poly shadow proxies the
  * LSPSM map is drawn from.  Pure C, no GL: tests/test_city.c.

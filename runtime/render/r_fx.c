@@ -31,6 +31,50 @@ void r_fx_set_state(r_game *r, const r_fx_module *m, void *state)
         r->fx_state[i] = state;
 }
 
+const frame *r_fx_frame(const r_game *r)
+{
+    return &r->f;
+}
+
+const r_stage *r_fx_stage(const r_game *r)
+{
+    return &r->stage;
+}
+
+int r_fx_stage_game(const r_game *r)
+{
+    return r->stage_game;
+}
+
+const float *r_fx_key_dir(const r_game *r)
+{
+    return r->key_dir;
+}
+
+const r_quality *r_fx_quality(const r_game *r)
+{
+    return &r->opts.q;
+}
+
+r_fx_gl r_fx_core_gl(const r_game *r)
+{
+    return (r_fx_gl){
+        .hdr_fbo = r->hdr_fbo,
+        .hdr_tex = r->hdr_tex,
+        .depth_tex = r->depth_tex,
+        .sil_tex = r->sil_tex,
+        .sky_tex = r->sky_tex,
+        .diffuse_on = r->ibl_tex[R_IBL_DIFFUSE][R_IBL_KEY_ON],
+        .empty_vao = r->empty_vao,
+        .fighter_vao = r->fighter_vao,
+        .ring_vao = r->ring_vao,
+        .fighter_count = r->fighter_count,
+        .ring_count = r->ring_count,
+        .prog_depth = r->prog[P_DEPTH],
+        .prog_sky = r->prog[P_SKY],
+    };
+}
+
 int r_fx_units(void)
 {
     int n = 0;

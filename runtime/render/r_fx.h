@@ -1,4 +1,4 @@
-/* The stage-effect contract (issue 8; techniques A6-A8, B, C, D; issue 17).
+/* The stage-effect contract (docs/effects.md, "The effect contract").
  *
  * An effect is a module in runtime/fx/ (fx_<name>.c): one r_fx_module row
  * in the table runtime/fx/fx_table.c lists.  The render core calls it only
@@ -14,7 +14,7 @@
  *   create   at r_game_create: programs and fixed-size GL objects
  *   destroy  at r_game_destroy (also after a failed create; the state
  *            may then be NULL or half made)
- *   load     when the look changes (r->stage is the new stage)
+ *   load     when the look changes (r_fx_stage(r) is the new look)
  *
  * Passes, by phase; r_game.c's build_graph adds them in table order:
  *   R_FX_PRE          after the shadow passes, before "scene"
@@ -22,7 +22,9 @@
  *   R_FX_SURFACE      after "scene", before "sky": opaque surfaces
  *   R_FX_TRANSLUCENT  after "sky", before "lens"
  * Passes get the r_game as their user pointer; the frame being drawn is
- * r->f (r_local.h).
+ * r_fx_frame(r).  What the core hands the effects (the frame, the look,
+ * its GL objects, its drawing helpers) is r_fx_core.h; they see nothing
+ * else of it.
  *
  * Resources.  Bits from R_RES_FX_FIRST up of the pass graph's mask belong
  * to the effects (runtime/fx/fx_local.h gives them out); a module names
@@ -53,9 +55,9 @@
  * in the effect's own order (scene has bound the stage program and the
  * ring's VAO) and returns true, or returns false and scene draws it whole.
  *
- * History.  Simulations step r->f.steps times (whole game ticks since the
- * frame drawn last, 0 when a tick is drawn again) and restart when
- * r->f.reset is set, so a video of a replay (every tick drawn) is the same
+ * History.  Simulations step the frame's steps times (r_fx_frame: whole
+ * game ticks since the frame drawn last, 0 when a tick is drawn again)
+ * and restart when its reset is set, so a video of a replay (every tick drawn) is the same
  * on any machine.  What a module carries from one frame to the next is its
  * history, and a render that starts at tick A > 0 (render --ticks A:B, a
  * segment of a split job) rebuilds it exactly through three hooks:
@@ -66,7 +68,7 @@
  *                   R_FX_FROM_START (every tick since the last reset).
  *                   NULL: stateless on every stage.
  *   advance(r)      moves the history on by exactly one game tick without
- *                   drawing (r_game_advance sets up r->f for the tick
+ *                   drawing (r_game_advance sets up the frame for the tick
  *                   first, reset included).  Called on every advanced
  *                   tick, inside the module's window or not, so that a
  *                   reset reaches it; a module whose window is N ticks
@@ -152,7 +154,7 @@ typedef struct r_fx_module {
     bool (*draw_ring)(r_game *r);
     /* history */
     int (*warmup)(r_game *r);         /* on the loaded stage: R_FX_STATELESS, N ticks or R_FX_FROM_START */
-    void (*advance)(r_game *r);       /* one game tick, r->f set up; draws nothing on screen */
+    void (*advance)(r_game *r);       /* one game tick, the frame set up; draws nothing on screen */
     bool (*needs_frame)(r_game *r);   /* in its window: its history needs the drawn frame */
 } r_fx_module;
 
@@ -171,7 +173,7 @@ void r_fx_set_state(r_game *r, const r_fx_module *m, void *state);
 
 /* Contacts of both fighters' capsules with the plane y = level (at most
  * max, deepest first when there are more).  caps/caps_prev as in
- * r_local.h's frame.  Returns the number written. */
+ * r_fx_core.h's frame.  Returns the number written. */
 int r_fx_contacts(const r_fx_capsule caps[2][G_BONES], const r_fx_capsule prev[2][G_BONES], float level, r_fx_contact *out,
                   int max);
 

@@ -44,7 +44,7 @@ static bool build_ring(r_game *r, int game_stage, rs_err *err)
     const float glo[3] = {-g, -3.3f, -g}, ghi[3] = {g, -3.0f, g}; /* the ground far below */
     if (!r_mesh_box(&m, lo, hi) || !r_mesh_box(&m, glo, ghi)) {
         r_mesh_free(&m);
-        return rs_fail(err, 1, "out of memory for the ring mesh");
+        return rs_fail(err, R_ERR_NOMEM, "out of memory for the ring mesh");
     }
     r_free_mesh(&r->ring_vao, &r->ring_vbo, &r->ring_ibo);
     r_upload_mesh(&m, &r->ring_vao, &r->ring_vbo, &r->ring_ibo);
@@ -62,7 +62,7 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
                     : r->opts.hdr_format == R_GAME_HDR_RGBA16F  ? R_HDR_RGBA16F
                                                                 : st->hdr_format;
     if (r->opts.mask && r->hdr_format != R_HDR_RGBA16F)
-        return rs_fail(err, 1, "--mask needs an alpha channel: the r11g11b10f HDR format has none (use rgba16f)");
+        return rs_fail(err, R_ERR_OPTIONS, "--mask needs an alpha channel: the r11g11b10f HDR format has none (use rgba16f)");
     r_ibl_params ip;
     r_ibl_default_params(&ip);
     r_ibl ibl = {0};
@@ -201,7 +201,7 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
         free_targets(r);
-        return rs_fail(err, 1, "%dx%d HDR target (%s) incomplete (%s)", w, h,
+        return rs_fail(err, R_ERR_TARGET, "%dx%d HDR target (%s) incomplete (%s)", w, h,
                        hdr_fmt == GL_RGBA16F ? "rgba16f" : "r11g11b10f", rgl_enum_name(st));
     }
     r->tw = w, r->th = h, r->tfmt = r->hdr_format;
@@ -275,7 +275,7 @@ static bool build_look_programs(r_game *r, rs_err *err)
             n += (size_t)snprintf(defs + n, sizeof defs - n, "#define %s 1\n", name);
     }
     if (n >= sizeof defs)
-        return rs_fail(err, 1, "the look's shader defines are longer than %zu bytes", sizeof defs - 1);
+        return rs_fail(err, R_ERR_LOOK, "the look's shader defines are longer than %zu bytes", sizeof defs - 1);
     /* the buildings and the craters: only on a look that has them */
     bool buildings = r->stage.buildings > 0, holes = r->stage.holes;
     char key[sizeof defs + 32];
@@ -319,7 +319,7 @@ static bool build_graph(r_game *r, rs_err *err)
     /* the effects' resources: named and made persistent by their modules */
     uint32_t persistent = RES_PERSISTENT, fx_reads = 0;
     if (r_fx_nmodules > R_FX_MAX_MODULES)
-        return rs_fail(err, 1, "%d stage effects; r_game keeps state for %d", r_fx_nmodules, R_FX_MAX_MODULES);
+        return rs_fail(err, R_ERR_EFFECTS, "%d stage effects; r_game keeps state for %d", r_fx_nmodules, R_FX_MAX_MODULES);
     memcpy(r->res_names, core_res_names, sizeof core_res_names);
     for (int m = 0; m < r_fx_nmodules; m++) {
         const r_fx_module *mod = r_fx_modules[m];
@@ -328,7 +328,7 @@ static bool build_graph(r_game *r, rs_err *err)
             while (b < 32 && mod->res[k].bit != 1u << b)
                 b++;
             if (b < R_RES_FX_FIRST || b >= 32 || r->res_names[b])
-                return rs_fail(err, 1, "effect '%s': resource '%s' is not one free bit from %d up", mod->name,
+                return rs_fail(err, R_ERR_EFFECTS, "effect '%s': resource '%s' is not one free bit from %d up", mod->name,
                                mod->res[k].name, R_RES_FX_FIRST);
             r->res_names[b] = mod->res[k].name;
             if (mod->res[k].persistent)
@@ -337,7 +337,7 @@ static bool build_graph(r_game *r, rs_err *err)
         fx_reads |= mod->scene_reads;
     }
     if (r_fx_units() > R_FX_UNIT_END - R_FX_UNIT_FIRST)
-        return rs_fail(err, 1, "the effects' bind hooks want %d texture units; there are %d", r_fx_units(),
+        return rs_fail(err, R_ERR_EFFECTS, "the effects' bind hooks want %d texture units; there are %d", r_fx_units(),
                        R_FX_UNIT_END - R_FX_UNIT_FIRST);
     r_graph_init(&r->graph, persistent, r->res_names, 32);
     /* NULL: the stage effects' passes of that phase (r_fx.h) */
@@ -395,10 +395,10 @@ static bool check_quality(const r_quality *q, rs_err *err)
     const int v[] = {q->shadow_size, q->sil_size, q->water_grid, q->fog_size, q->bloom_levels};
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
         if (v[i] != 0 && (v[i] < k[i].lo || v[i] > k[i].hi))
-            return rs_fail(err, 1, "quality: %s %d out of range: %s is %d..%d (0 = default)", k[i].name, v[i],
+            return rs_fail(err, R_ERR_QUALITY, "quality: %s %d out of range: %s is %d..%d (0 = default)", k[i].name, v[i],
                            k[i].what, k[i].lo, k[i].hi);
     if (q->aa != R_AA_OFF && q->aa != R_AA_FXAA)
-        return rs_fail(err, 1, "quality: aa %d unknown (0 off, 1 fxaa)", (int)q->aa);
+        return rs_fail(err, R_ERR_QUALITY, "quality: aa %d unknown (0 off, 1 fxaa)", (int)q->aa);
     return true;
 }
 
@@ -412,7 +412,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     r_game *r = calloc(1, sizeof *r);
     if (!r || !(r->hud = malloc(HUD_MAX_QUADS * 6 * sizeof(hud_vertex)))) {
         free(r);
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, R_ERR_NOMEM, "out of memory");
         return NULL;
     }
     if (o)
@@ -478,7 +478,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     if (!px || !lut || !r->font_tex || !ok) {
         free(px);
         free(lut);
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, R_ERR_NOMEM, "out of memory");
         r_game_destroy(r);
         return NULL;
     }
@@ -594,7 +594,8 @@ static void leave_state(GLint out)
     gl.Enable(GL_DEPTH_TEST);
 }
 
-static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip);
+static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip,
+                 rs_err *err);
 
 int64_t r_game_history(r_game *r, int game_stage, rs_err *err)
 {
@@ -609,17 +610,18 @@ void r_game_restart(r_game *r)
     r->have_last = false;
 }
 
-bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h, uint64_t ahead, bool *drew)
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h, uint64_t ahead, bool *drew,
+                    rs_err *err)
 {
-    rs_err err = {0};
+    rs_err skipped = {0}; /* draw() meets the same failure again and reports it */
     if (drew)
         *drew = false;
-    bool by_drawing = w <= 0 || h <= 0 || !r_game_prepare(r, cur->stage, &err) ||
-                      (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) || r_fx_needs_frame(r, ahead);
+    bool by_drawing = w <= 0 || h <= 0 || !r_game_prepare(r, cur->stage, &skipped) ||
+                      (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &skipped)) || r_fx_needs_frame(r, ahead);
     if (by_drawing) {
         if (drew)
             *drew = true;
-        return draw(r, prev, cur, 1.0f, w, h, r->history_skip); /* which reports the error, or draws */
+        return draw(r, prev, cur, 1.0f, w, h, r->history_skip, err); /* which reports the error, or draws */
     }
     GLint out = 0;
     gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &out);
@@ -634,20 +636,20 @@ bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, i
     return true;
 }
 
-bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h)
+bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, rs_err *err)
 {
-    return draw(r, prev, cur, alpha, w, h, 0);
+    return draw(r, prev, cur, alpha, w, h, 0, err);
 }
 
-static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip)
+static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip,
+                 rs_err *err)
 {
     GLint out = 0;
     gl.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &out);
-    rs_err err = {0};
-    if (w <= 0 || h <= 0)
-        rs_fail(&err, 1, "cannot draw a %dx%d frame", w, h);
-    if (err.msg[0] || !r_game_prepare(r, cur->stage, &err) || !make_targets(r, w, h, &err)) {
-        snprintf(r->error, sizeof r->error, "%s", err.msg);
+    bool ok = w > 0 && h > 0;
+    if (!ok)
+        rs_fail(err, R_ERR_SIZE, "cannot draw a %dx%d frame", w, h);
+    if (!ok || !r_game_prepare(r, cur->stage, err) || !make_targets(r, w, h, err)) {
         gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)out);
         if (w > 0 && h > 0) {
             gl.Viewport(0, 0, w, h);
@@ -656,10 +658,8 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
         }
         return false;
     }
-    if (r->ring_stage != cur->stage && !build_ring(r, cur->stage, &err)) {
-        snprintf(r->error, sizeof r->error, "%s", err.msg);
+    if (r->ring_stage != cur->stage && !build_ring(r, cur->stage, err))
         return false;
-    }
     r_update_lut(r);
     known_state();
     frame *f = &r->f;
@@ -677,11 +677,6 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
 int r_game_ring_stage(const r_game *r)
 {
     return r->ring_stage;
-}
-
-const char *r_game_error(const r_game *r)
-{
-    return r->error;
 }
 
 r_graph *r_game_graph(r_game *r)

@@ -1,5 +1,5 @@
 /* The game renderer (renderer core, docs/renderer.md): the Virtua
- * Fighter 5 look of techniques A1-A3 and A5 on a pass graph.
+ * Fighter 5 look (docs/renderer.md) on a pass graph.
  *
  *   shadow_map, silhouette, silhouette_mips   from the key light
  *   z_prepass, shadow_mask, mask_filter        SSFSM for the fighters
@@ -18,6 +18,7 @@
 
 #include "../game/g_game.h"
 #include "../util/rs_err.h"
+#include "r_err.h"
 #include "r_graph.h"
 #include "r_math.h"
 #include "r_stage.h"
@@ -75,18 +76,20 @@ bool r_game_prepare(r_game *r, int game_stage, rs_err *err);
 bool r_game_set_stage(r_game *r, const r_stage *st, rs_err *err);
 const r_stage *r_game_stage(const r_game *r);
 
-/* Draws into the bound framebuffer, viewport 0,0,w,h.  Returns false (and
- * clears to black) when the stage could not be loaded: r_game_error. */
-bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h);
-const char *r_game_error(const r_game *r);
+/* Draws into the bound framebuffer, viewport 0,0,w,h.  Returns false with
+ * err filled (and clears to black) when the frame cannot be drawn: a size
+ * out of range (R_ERR_SIZE), a look that cannot load (the stage file's,
+ * shaders' or IBL's id), targets the driver cannot make (R_ERR_TARGET),
+ * out of memory (R_ERR_NOMEM). */
+bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, rs_err *err);
 /* Starting a render at tick A > 0 exactly (r_fx.h, "History"):
  *
  *   h = r_game_history(r, stage, err);        how far back frame A looks
  *   from = h == R_GAME_FROM_START ? 0 : A - min(A, h);
  *   r_game_restart(r);                        the first tick advanced resets
  *   for (t = from; t < A; t++)                states before `from`: simulated only
- *       r_game_advance(r, &prev_t, &cur_t, w, h, A - t);
- *   r_game_draw(r, &prev_A, &cur_A, 1, w, h); the frame a full render draws
+ *       r_game_advance(r, &prev_t, &cur_t, w, h, A - t, NULL, err);
+ *   r_game_draw(r, &prev_A, &cur_A, 1, w, h, err); the frame a full render draws
  *
  * r_game_history loads the stage's look (as r_game_prepare) and returns the
  * ticks of history its effects carry into a frame: 0 (none: frame A needs
@@ -101,9 +104,10 @@ void r_game_restart(r_game *r);
  * frame that will be drawn (>= 1).  Where an effect whose window holds
  * this tick needs the frame itself (LSPSM's auto-focus), the frame is
  * drawn into the bound framebuffer at alpha 1 and *drew (may be NULL) is
- * set.  prev, w, h as r_game_draw would get them.  Returns false as
- * r_game_draw does. */
-bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h, uint64_t ahead, bool *drew);
+ * set.  prev, w, h as r_game_draw would get them.  Returns false with err
+ * filled as r_game_draw does. */
+bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, int h, uint64_t ahead, bool *drew,
+                    rs_err *err);
 
 /* --passes: time every pass; per_frame prints one line per frame to out. */
 void r_game_passes(r_game *r, bool per_frame, FILE *out);

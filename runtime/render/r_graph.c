@@ -1,4 +1,5 @@
 #include "r_graph.h"
+#include "r_err.h"
 
 #include <string.h>
 #include <time.h>
@@ -29,17 +30,17 @@ static const char *res_name(const r_graph *g, uint32_t bits)
 bool r_graph_add(r_graph *g, const r_pass *p, rs_err *err)
 {
     if (g->n >= R_GRAPH_MAX)
-        return rs_fail(err, 1, "render graph: more than %d passes", R_GRAPH_MAX);
+        return rs_fail(err, R_ERR_GRAPH, "render graph: more than %d passes", R_GRAPH_MAX);
     if (!p->name || !p->run || !p->needed)
-        return rs_fail(err, 1, "render graph: pass %d has no name, run or needed", g->n);
+        return rs_fail(err, R_ERR_GRAPH, "render graph: pass %d has no name, run or needed", g->n);
     if (r_graph_find(g, p->name) >= 0)
-        return rs_fail(err, 1, "render graph: two passes named '%s'", p->name);
+        return rs_fail(err, R_ERR_GRAPH, "render graph: two passes named '%s'", p->name);
     uint32_t available = g->persistent;
     for (int i = 0; i < g->n; i++)
         available |= g->pass[i].writes;
     uint32_t missing = (p->reads | p->may_read) & ~available;
     if (missing)
-        return rs_fail(err, 1, "render graph: pass '%s' reads '%s', which no earlier pass writes", p->name,
+        return rs_fail(err, R_ERR_GRAPH, "render graph: pass '%s' reads '%s', which no earlier pass writes", p->name,
                        res_name(g, missing));
     g->pass[g->n++] = *p;
     return true;

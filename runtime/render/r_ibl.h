@@ -1,6 +1,6 @@
-/* Image-based lighting (techniques A2): a stage's HDR environment and its
- * six prefiltered cube maps, computed on the CPU by straightforward
- * spherical integration and cached on disk.
+/* Image-based lighting (docs/renderer.md, "Image-based lighting"): a stage's
+ * HDR environment and its six prefiltered cube maps, computed on the CPU by
+ * straightforward spherical integration and cached on disk.
  *
  * Cube maps use OpenGL's face order and orientation (+X -X +Y -Y +Z -Z;
  * face f, texel (i, j): s = 2(i+0.5)/N - 1, t = 2(j+0.5)/N - 1, row j = 0

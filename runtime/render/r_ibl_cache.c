@@ -170,7 +170,7 @@ static bool write_unique(const char *path, const void *data, size_t n, rs_err *e
     snprintf(tmp, sizeof tmp, "%s.XXXXXX", path);
     int fd = mkstemp(tmp);
     if (fd < 0)
-        return rs_fail(err, 1, "%s: cannot create: %s", tmp, strerror(errno));
+        return rs_fail(err, R_IBL_ERR_FILE, "%s: cannot create: %s", tmp, strerror(errno));
     const char *p = data;
     size_t left = n;
     int saved = 0;
@@ -192,7 +192,7 @@ static bool write_unique(const char *path, const void *data, size_t n, rs_err *e
         saved = errno;
     if (saved) {
         unlink(tmp);
-        return rs_fail(err, 1, "%s: write failed: %s", path, strerror(saved));
+        return rs_fail(err, R_IBL_ERR_FILE, "%s: write failed: %s", path, strerror(saved));
     }
     return true;
 }

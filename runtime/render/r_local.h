@@ -1,6 +1,6 @@
-/* The game renderer's insides, shared by the render core's files and the
- * stage-effect modules (runtime/fx/, contract in r_fx.h).  Not an API:
- * include only from runtime/render and runtime/fx. */
+/* The game renderer's insides, shared by the render core's files.  Not an
+ * API: include only from runtime/render.  The stage effects (runtime/fx/)
+ * see the part of the core they use through r_fx_core.h. */
 #ifndef R_LOCAL_H
 #define R_LOCAL_H
 
@@ -10,6 +10,7 @@
 
 #include "../gl/rgl.h"
 #include "r_fx.h"
+#include "r_fx_core.h"
 #include "r_game.h"
 #include "r_graph.h"
 #include "r_ibl.h"
@@ -18,7 +19,6 @@
 #define HUD_MAX_QUADS 4096
 #define SHADOW_SIZE 1024 /* SSFSM light depth map: r->shadow_size (r_quality.shadow_size) */
 #define SIL_SIZE 512     /* silhouette, level 0: r->sil_size (r_quality.sil_size) */
-#define SIL_LEVELS 5     /* the sharp level and 4 blurred ones */
 /* Screen-space sizes are fractions of the frame height, with today's
  * look kept at R_REF_ROWS (docs/renderer.md, "Resolution independence"). */
 #define R_REF_ROWS 720
@@ -27,21 +27,6 @@
 #define SKY_SIZE 128     /* the environment as seen */
 #define LENS_ALPHA 0.15f
 
-/* resources of the pass graph */
-enum {
-    RES_ENV = 1u << 0,  /* IBL maps, sky, LUT, textures: built at load */
-    RES_SHADOW = 1u << 1,
-    RES_SIL = 1u << 2,
-    RES_DEPTH = 1u << 3,
-    RES_MASK = 1u << 4,
-    RES_HDR = 1u << 5,
-    RES_BLOOM = 1u << 6,
-    RES_SUNVIS = 1u << 7,
-    RES_OUT = 1u << 8,
-    RES_FLARE = 1u << 9,
-};
-#define R_RES_CORE 10      /* the core's resources: bits 0..9 */
-#define R_RES_FX_FIRST 10  /* from here up, the stage effects' (r_fx.h) */
 #define RES_PERSISTENT RES_ENV
 
 typedef struct hud_vertex {
@@ -62,33 +47,7 @@ enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK
        P_GLOW, /* + 4 variants: bloom's last blur with its second level x the flare (r_post.c) */
        P_TONE = P_GLOW + 4, /* + 1 variant: with the glow */
        P_COUNT = P_TONE + 2 };
-/* scene.frag's materials (MATERIAL): what the stage programs draw */
-enum { R_MAT_PLANKS, R_MAT_PAVED, R_MAT_BUILDING, R_MAT_HOLE };
 
-typedef struct frame {
-    const g_state *prev, *cur;
-    float alpha;
-    int w, h;
-    r_mat4 vp, inv_vp, light;
-    r_vec3 eye, light_dir, waist[2];
-    float bones[2][16][16], colors[2][16][4];
-    float flash, saturation, exposure;
-    bool sun_on_screen;
-    float sun_px[2];
-    int fig_box[4]; /* x, y, w, h: the fighters on screen plus the mask filter's reach */
-    GLint out_fbo;
-    /* for the stage effects (r_fx.h): whole ticks, never interpolated, so
-     * what the simulations see is a function of the game states alone */
-    r_fx_capsule caps[2][G_BONES], caps_prev[2][G_BONES]; /* at cur->tick and prev->tick */
-    int steps;   /* game ticks since the frame drawn last: simulation steps to run now */
-    bool reset;  /* the sequence broke (first frame, seek, new stage): restart simulations */
-    r_mat4 view, proj, view_prev; /* the camera now and at prev->tick (afterimages); vp = proj * view */
-    float bones_prev[2][16][16], bones_tick[2][16][16]; /* at prev->tick and cur->tick, not interpolated */
-    /* a warm-up frame (r_game_advance drawing for an effect's history): the
-     * scene's depth is all that history reads (LSPSM's focus), so the
-     * scene passes draw depth alone and the light-space maps are not drawn */
-    bool depth_only;
-} frame;
 
 struct r_game {
     r_game_opts opts;
@@ -147,7 +106,6 @@ struct r_game {
     uint64_t last_tick; /* of the frame drawn last, for frame.steps */
     bool have_last;
     frame f;
-    char error[768];
 };
 
 
@@ -162,21 +120,9 @@ bool r_fx_needs_frame(r_game *r, uint64_t ahead); /* a module whose window holds
                                                      before the first drawn one needs the frame */
 void r_fx_advance(r_game *r);                  /* every module's history, one tick */
 
-/* stencil bits: the scene pass marks the fighters' pixels */
-#define R_STENCIL_FIGHTER 0x80
 
-/* the GL layer (r_gl.c) */
-GLint r_loc(GLuint p, const char *name);
-void r_upload_mesh(const r_mesh_data *m, GLuint *vao, GLuint *vbo, GLuint *ibo);
-void r_free_mesh(GLuint *vao, GLuint *vbo, GLuint *ibo);
-GLuint r_tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type, const void *px, GLenum filter, GLenum wrap);
-GLuint r_fbo_for(GLuint color, int level, GLuint depth); /* depth: a GL_DEPTH24_STENCIL8 texture or 0 */
+/* the GL layer (r_gl.c), beside r_fx_core.h's */
 GLuint r_cube_tex(int n, float *const face[6], int levels); /* RGB16F faces; mipmapped when levels > 1 */
-void r_bind_tex(GLuint p, const char *name, int unit, GLenum target, GLuint t);
-void r_bind_ibl(r_game *r, GLuint p); /* units 8..13 */
-void r_fullscreen(r_game *r);      /* one triangle: cap_fullscreen.vert */
-int r_half(int v, int k);          /* v >> k, at least 1 */
-void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
 /* r_blur_into's state with program p (blur.frag or a variant), not drawn:
  * the caller sets the variant's uniforms, then r_fullscreen */
 void r_blur_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
@@ -187,23 +133,9 @@ void r_bloom_plan(int w, int h, int *steps, int *w4);
 
 /* per-frame set-up (r_frame.c) */
 void r_frame_setup(r_game *r, frame *f); /* f->prev, cur, alpha, w, h, out_fbo set: the rest */
-bool r_ran(const frame *f, r_game *r, const char *name); /* did the pass run this frame (so far) */
 
 /* the scene (r_scene.c) */
-void r_draw_fighters(r_game *r, GLuint p); /* both fighters with program p (scene.vert), VAO left bound */
-void r_camera_uniforms(r_game *r, GLuint p); /* uses p; u_view_proj, u_eye */
-/* Uses the stage program that draws `material` (R_MAT_*) and sets its
- * uniforms for this frame (lighting, shadows, the effects' maps through
- * r_fx_bind); returns it.  The ring's material is r_ring_material's
- * (paved ground on a look with buildings). */
-GLuint r_stage_program(r_game *r, int material);
 int r_ring_material(const r_game *r);
-/* Opaque drawing into the HDR target: its FBO and the frame's viewport,
- * depth test (less) and writes, back faces culled, no blending. */
-void r_begin_opaque(r_game *r);
-/* The ring mesh (build_ring): its box's +y face, the destructible ring
- * top, is the 6 indices from here; the ground's box follows the ring's. */
-#define R_RING_TOP_FIRST 30
 bool r_build_lens(r_mesh_data *m); /* the visor's mesh */
 
 /* The core passes, each in the file of its responsibility; r_game.c's

@@ -1,7 +1,8 @@
 /* Light Space Perspective Shadow Maps: the light's matrices, the fallback to
  * uniform shadow mapping, the depth auto-focus, the fade and the fighters'
- * box-exit lookup (techniques C).  Pure arithmetic, no GL: the matrices are
- * built in double and handed over as floats.
+ * box-exit lookup (docs/effects.md, "Shadows in a large world").  Pure
+ * arithmetic, no GL: the matrices are built in double and handed over as
+ * floats.
  *
  * The light frame: z towards the light, y = the view direction with its
  * component along the light removed (the warp axis), x = y cross z; origin at

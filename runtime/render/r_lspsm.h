@@ -1,4 +1,5 @@
-/* Light Space Perspective Shadow Maps (techniques C): the CPU side, no GL.
+/* Light Space Perspective Shadow Maps (docs/effects.md, "Shadows in a large
+ * world"): the CPU side, no GL.
  *
  * One 1024x1024 map covers the part of the view frustum between `near` and
  * `far` (at most 100 m; "the body").  The map is warped by a perspective

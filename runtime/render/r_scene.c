@@ -107,6 +107,27 @@ void r_begin_opaque(r_game *r)
     gl.Disable(GL_BLEND);
 }
 
+void r_light_uniforms(GLuint p, const frame *f)
+{
+    gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
+    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
+    float waist[6] = {f->waist[0].x, f->waist[0].y, f->waist[0].z, f->waist[1].x, f->waist[1].y, f->waist[1].z};
+    gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
+    gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
+    gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
+}
+
+void r_sun_uniforms(GLuint p, const r_stage *st)
+{
+    float rad = st->sun_size_deg * 0.5f * 3.14159265f / 180.0f;
+    double omega = 2 * 3.14159265358979 * (1 - cos(rad)); /* the disc's solid angle */
+    float L = st->sun ? (float)fmin(st->sun_intensity / omega, R_HALF_MAX) : 0.0f;
+    gl.Uniform3f(r_loc(p, "u_sun_dir"), st->sun_dir[0], st->sun_dir[1], st->sun_dir[2]);
+    gl.Uniform3f(r_loc(p, "u_sun_radiance"), fminf(L * st->sun_color[0], R_HALF_MAX),
+                 fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
+    gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
+}
+
 int r_ring_material(const r_game *r)
 {
     return r->stage.buildings > 0 ? R_MAT_PAVED : R_MAT_PLANKS;
@@ -123,12 +144,7 @@ GLuint r_stage_program(r_game *r, int material)
     r_fx_bind(r, p, R_FX_BIND_SCENE);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     gl.Uniform3fv(r_loc(p, "u_ring_color"), 1, r->stage.ring_color);
-    gl.UniformMatrix4fv(r_loc(p, "u_light_proj"), 1, GL_FALSE, f->light.m);
-    gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
-    float waist[6] = {f->waist[0].x, f->waist[0].y, f->waist[0].z, f->waist[1].x, f->waist[1].y, f->waist[1].z};
-    gl.Uniform3fv(r_loc(p, "u_waist"), 2, waist);
-    gl.Uniform1f(r_loc(p, "u_lod_start"), 0.6f);
-    gl.Uniform1f(r_loc(p, "u_lod_scale"), 1.6f);
+    r_light_uniforms(p, f);
     return p;
 }
 
@@ -146,14 +162,7 @@ static void run_sky(void *u)
     gl.UseProgram(p);
     gl.UniformMatrix4fv(r_loc(p, "u_inv_view_proj"), 1, GL_FALSE, f->inv_vp.m);
     r_bind_tex(p, "u_env", 0, GL_TEXTURE_CUBE_MAP, r->sky_tex);
-    const r_stage *st = &r->stage;
-    float rad = st->sun_size_deg * 0.5f * 3.14159265f / 180.0f;
-    double omega = 2 * 3.14159265358979 * (1 - cos(rad)); /* the disc's solid angle */
-    float L = st->sun ? (float)fmin(st->sun_intensity / omega, R_HALF_MAX) : 0.0f;
-    gl.Uniform3f(r_loc(p, "u_sun_dir"), st->sun_dir[0], st->sun_dir[1], st->sun_dir[2]);
-    gl.Uniform3f(r_loc(p, "u_sun_radiance"), fminf(L * st->sun_color[0], R_HALF_MAX),
-                 fminf(L * st->sun_color[1], R_HALF_MAX), fminf(L * st->sun_color[2], R_HALF_MAX));
-    gl.Uniform1f(r_loc(p, "u_sun_cos"), cosf(rad));
+    r_sun_uniforms(p, &r->stage);
     gl.Uniform1f(r_loc(p, "u_flash"), f->flash);
     r_fx_bind(r, p, R_FX_BIND_SKY);
     r_fullscreen(r);

@@ -1,4 +1,4 @@
-/* The fighters' shadows (SSFSM, techniques A5): the key light's depth
+/* The fighters' shadows (SSFSM, docs/renderer.md, "Shadows"): the key light's depth
  * map, the blurred silhouette projected on the stage, the z-prepass and
  * the screen-space shadow mask with its filter.  Six passes, run on
  * stages with `shadows = yes`; r_game.c puts them first in the graph. */

@@ -6,6 +6,7 @@
 #include "../gl/rgl.h"
 #include "../util/rs_img.h"
 #include "r_shader.h"
+#include "r_err.h"
 
 /* Geometry in quarter pixels (GL window coordinates, origin bottom-left).
  * Rectangle edges sit on whole pixels (centres are at .5); triangle
@@ -100,13 +101,13 @@ struct r_smoke {
 r_smoke *r_smoke_create(int w, int h, rs_err *err)
 {
     if (w < R_SMOKE_MIN_SIZE || h < R_SMOKE_MIN_SIZE || w > glcaps.max_texture_size || h > glcaps.max_texture_size) {
-        rs_fail(err, 1, "smoke scene size %dx%d out of range (expected %d..%d per side)", w, h, R_SMOKE_MIN_SIZE,
+        rs_fail(err, R_ERR_SIZE, "smoke scene size %dx%d out of range (expected %d..%d per side)", w, h, R_SMOKE_MIN_SIZE,
                 glcaps.max_texture_size);
         return NULL;
     }
     r_smoke *s = calloc(1, sizeof *s);
     if (!s) {
-        rs_fail(err, 1, "out of memory");
+        rs_fail(err, R_ERR_NOMEM, "out of memory");
         return NULL;
     }
     s->w = w;
@@ -161,7 +162,7 @@ r_smoke *r_smoke_create(int w, int h, rs_err *err)
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
-        rs_fail(err, 1, "smoke scene: RGBA8 %dx%d framebuffer incomplete (%s)", w, h, rgl_enum_name(st));
+        rs_fail(err, R_ERR_TARGET, "smoke scene: RGBA8 %dx%d framebuffer incomplete (%s)", w, h, rgl_enum_name(st));
         r_smoke_destroy(s);
         return NULL;
     }

@@ -72,7 +72,7 @@ typedef struct r_stage {
 
     float ring_color[3];  /* albedo, 0..1 */
 
-    /* tone map (techniques A3) */
+    /* tone map (docs/renderer.md, "Tone map, bloom, flare") */
     float exposure;       /* 0.001..1000 */
     float gamma;          /* 0.1..10 */
     float saturation;     /* 0..10 */
@@ -84,12 +84,12 @@ typedef struct r_stage {
 
     /* stage effects (docs/effects.md) */
     bool water, snow, fog, holes;
-    /* light space perspective shadow maps over the whole stage (techniques
-     * C): the key light's shadows of the buildings (and the fighters) */
+    /* light space perspective shadow maps over the whole stage (docs/effects.md,
+     * "Shadows in a large world"): the key light's shadows of the buildings (and the fighters) */
     bool lspsm;
     int buildings;        /* how many buildings stand round the ring, 0..R_STAGE_MAX_BUILDINGS */
     int buildings_seed;   /* their layout (r_city.h), 0..2^24 */
-    r_afterimage afterimage;  /* motion blur of fast limbs (techniques B) */
+    r_afterimage afterimage;  /* motion blur of fast limbs (docs/effects.md, "Afterimage motion blur") */
     float afterimage_stretch; /* old position = cur - stretch * V, 1..8 */
     float afterimage_speed;   /* m/s a bone must move at to leave an afterimage */
 } r_stage;

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "../util/rs_img.h"
+#include "r_err.h"
 
 bool r_target_create(r_target *t, int w, int h, rs_err *err)
 {
@@ -27,7 +28,7 @@ bool r_target_create(r_target *t, int w, int h, rs_err *err)
     gl.BindRenderbuffer(GL_RENDERBUFFER, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
         r_target_destroy(t);
-        return rs_fail(err, 1, "%dx%d render target incomplete (%s)", w, h, rgl_enum_name(st));
+        return rs_fail(err, R_ERR_TARGET, "%dx%d render target incomplete (%s)", w, h, rgl_enum_name(st));
     }
     return true;
 }

@@ -3,20 +3,12 @@
 #include <math.h>
 #include <stddef.h>
 
-/* a small integer hash: deterministic noise, no libc rand() state */
-static uint32_t hash2(uint32_t x, uint32_t y, uint32_t seed)
-{
-    uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ seed * 0xcb1ab31fu;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return h;
-}
+#include "../util/rs_hash.h"
 
 static float noise01(int x, int y, int size, uint32_t seed)
 {
-    return (float)(hash2((uint32_t)((x % size + size) % size), (uint32_t)((y % size + size) % size), seed) & 0xffff) /
-           65535.0f;
+    uint32_t wx = (uint32_t)((x % size + size) % size), wy = (uint32_t)((y % size + size) % size);
+    return (float)(rs_hash_point(wx, wy, seed) & 0xffff) / 65535.0f;
 }
 
 static float height(int x, int y, int size)
@@ -52,7 +44,7 @@ void r_tex_spec_map(uint8_t *rgba, int size)
     for (int y = 0; y < size; y++)
         for (int x = 0; x < size; x++) {
             uint8_t *p = rgba + ((size_t)y * size + x) * 4;
-            uint32_t h = hash2((uint32_t)x, (uint32_t)y, 99);
+            uint32_t h = rs_hash_point((uint32_t)x, (uint32_t)y, 99);
             if ((h & 1023) < 31) { /* ~3%: a bright coloured fleck, very glossy */
                 const uint8_t *c = fleck[(h >> 10) & 3];
                 p[0] = c[0], p[1] = c[1], p[2] = c[2], p[3] = 255;

@@ -1,7 +1,8 @@
 /* Procedural textures of the renderer core, generated at load (no asset
- * files): the fighters' normal map and colour specular map (techniques A1:
- * normal maps plus colour specular maps make highlights sparkle) and the
- * sun flare.  Plain CPU functions so tests can check them without GL. */
+ * files): the fighters' normal map and colour specular map (docs/renderer.md,
+ * "HDR, materials, mask": normal maps plus colour specular maps make
+ * highlights sparkle) and the sun flare.  Plain CPU functions so tests can
+ * check them without GL. */
 #ifndef R_TEX_H
 #define R_TEX_H
 

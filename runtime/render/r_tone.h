@@ -1,4 +1,4 @@
-/* The tone curve (techniques A3): luminance Y is mapped with
+/* The tone curve (docs/renderer.md, "Tone map, bloom, flare"): luminance Y is mapped with
  *     Y' = ((1 - exp(-x^2))^1.5)^(1/gamma),   x = exposure * Y
  * (gamma folded in: the output is display-encoded), then CbCr is scaled by
  * Y'/Y.  The curve is built on the CPU into a float lookup table whenever
