@@ -32,6 +32,7 @@ t_util_includes_render() { plant runtime/util/rs_err.c '#include "../render/r_gr
 t_capture_includes_player() { plant capture/cap.c '#include "../player/mv.h"' 'capture may include only'; }
 t_service_includes_cmd() { plant service/svc_json.c '#include "../cmd/cli.h"' 'service may include only'; }
 t_private_header() { plant cmd/main.c '#include "../runtime/platform/plat_local.h"' 'a private header of runtime/platform'; }
+t_effects_see_the_core_contract() { plant runtime/fx/fx_fog.c '#include "../render/r_local.h"' 'a private header of runtime/render'; }
 t_core_names_effect() {
     fx=$(cd "$ROOT" && ls runtime/fx/*.h 2>/dev/null | head -1)
     [ -n "$fx" ] || t_skip_env "no runtime/fx/*.h in this tree"
@@ -39,5 +40,5 @@ t_core_names_effect() {
 }
 
 t_run tree_follows_layers engine_includes_capture engine_includes_cmd util_includes_render capture_includes_player \
-    service_includes_cmd private_header core_names_effect
+    service_includes_cmd private_header effects_see_the_core_contract core_names_effect
 t_done

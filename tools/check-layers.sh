@@ -32,9 +32,9 @@ player              runtime/util runtime/gl runtime/platform runtime/game runtim
 service             runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render capture runtime/audio
 cmd                 runtime runtime/util runtime/gl runtime/platform runtime/game runtime/replay runtime/render runtime/fx capture player service runtime/audio
 '
-# private header            folders besides its own that may include it
+# private header            folders besides its own that may include it (none
+# today: the effects see the render core through r_fx_core.h, not r_local.h)
 LOCAL_OK='
-runtime/render/r_local.h    runtime/fx
 '
 
 if git rev-parse --show-toplevel >/dev/null 2>&1 && [ "$(git rev-parse --show-toplevel)" = "$(pwd -P)" ]; then
