@@ -125,22 +125,24 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
     switch (r->type) {
     case C_INT:
         if (!parse_long(v, &n, &rest) || *rest)
-            return rs_fail(err, 1, "%s: '%s' is not a whole number", r->name, v);
+            return rs_fail(err, SVC_CONFIG_ERR_NUMBER, "%s: '%s' is not a whole number", r->name, v);
         if (n < r->lo || n > r->hi)
-            return rs_fail(err, 1, "%s: %ld is out of range (expected %ld..%ld)", r->name, n, r->lo, r->hi);
+            return rs_fail(err, SVC_CONFIG_ERR_RANGE, "%s: %ld is out of range (expected %ld..%ld)", r->name, n, r->lo,
+                           r->hi);
         *(int *)(base + r->off) = (int)n;
         return true;
     case C_BYTES: {
         if (!parse_long(v, &n, &rest))
-            return rs_fail(err, 1, "%s: '%s' is not a size (expected bytes, or a number with K or M)", r->name, v);
+            return rs_fail(err, SVC_CONFIG_ERR_BYTES,
+                           "%s: '%s' is not a size (expected bytes, or a number with K or M)", r->name, v);
         long mul = 1;
         if (*rest == 'K' || *rest == 'k')
             mul = 1024, rest++;
         else if (*rest == 'M' || *rest == 'm')
             mul = 1024 * 1024, rest++;
         if (*rest || n < 0 || n > r->hi / mul || n * mul < r->lo)
-            return rs_fail(err, 1, "%s: '%s' is out of range (expected %ldK..%ldM)", r->name, v, r->lo / 1024,
-                           r->hi >> 20);
+            return rs_fail(err, SVC_CONFIG_ERR_RANGE, "%s: '%s' is out of range (expected %ldK..%ldM)", r->name, v,
+                           r->lo / 1024, r->hi >> 20);
         *(long *)(base + r->off) = n * mul;
         return true;
     }
@@ -148,11 +150,11 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
         /* the dump must reload as the same value: no comment marks or
          * line breaks, which a config file could not hold */
         if (strpbrk(v, "#\r\n"))
-            return rs_fail(err, 1, "%s: '#' and line breaks are not allowed in values", r->name);
+            return rs_fail(err, SVC_CONFIG_ERR_TEXT, "%s: '#' and line breaks are not allowed in values", r->name);
         if (strlen(v) > (size_t)r->hi)
-            return rs_fail(err, 1, "%s: longer than %ld characters", r->name, r->hi);
+            return rs_fail(err, SVC_CONFIG_ERR_TOO_LONG, "%s: longer than %ld characters", r->name, r->hi);
         if (r->lo && !*v)
-            return rs_fail(err, 1, "%s: must not be empty", r->name);
+            return rs_fail(err, SVC_CONFIG_ERR_EMPTY, "%s: must not be empty", r->name);
         snprintf(base + r->off, (size_t)r->hi + 1, "%s", v);
         return true;
     case C_SIZE: {
@@ -162,9 +164,11 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
             return true;
         }
         if (!parse_long(v, &w, &rest) || (*rest != 'x' && *rest != 'X') || !parse_long(rest + 1, &h, &rest) || *rest)
-            return rs_fail(err, 1, "%s: '%s' is not a size (expected WxH, such as 640x360)", r->name, v);
+            return rs_fail(err, SVC_CONFIG_ERR_DIMENSIONS, "%s: '%s' is not a size (expected WxH, such as 640x360)",
+                           r->name, v);
         if (w < r->lo || h < r->lo || w > r->hi || h > r->hi || (w | h) & 1)
-            return rs_fail(err, 1, "%s: %ldx%ld: each side must be even and %ld..%ld", r->name, w, h, r->lo, r->hi);
+            return rs_fail(err, SVC_CONFIG_ERR_RANGE, "%s: %ldx%ld: each side must be even and %ld..%ld", r->name, w, h,
+                           r->lo, r->hi);
         *(int *)(base + r->off) = (int)w;
         *(int *)(base + r->off2) = (int)h;
         return true;
@@ -184,35 +188,48 @@ static bool set_row(svc_config *c, const c_row *r, const char *v, rs_err *err)
             }
             p += k + (bar != NULL);
         }
-        return rs_fail(err, 1, "%s: '%s' is not one of %s", r->name, v, r->choices);
+        return rs_fail(err, SVC_CONFIG_ERR_CHOICE, "%s: '%s' is not one of %s", r->name, v, r->choices);
     }
     case C_DURATION: {
         if (!parse_long(v, &n, &rest))
-            return rs_fail(err, 1, "%s: '%s' is not a duration (expected seconds, or a number with s, m, h or d)",
-                           r->name, v);
+            return rs_fail(err, SVC_CONFIG_ERR_DURATION,
+                           "%s: '%s' is not a duration (expected seconds, or a number with s, m, h or d)", r->name, v);
         long mul = *rest == 'd' ? 86400 : *rest == 'h' ? 3600 : *rest == 'm' ? 60 : 1;
         if (*rest && strchr("smhd", *rest))
             rest++;
         if (*rest || n < 0 || n > r->hi / mul)
-            return rs_fail(err, 1, "%s: '%s' is out of range (expected 0..%ldd)", r->name, v, r->hi / 86400);
+            return rs_fail(err, SVC_CONFIG_ERR_RANGE, "%s: '%s' is out of range (expected 0..%ldd)", r->name, v,
+                           r->hi / 86400);
         *(long *)(base + r->off) = n * mul;
         return true;
     }
     case C_LISTEN: {
         const char *colon = strrchr(v, ':');
         if (!colon || colon == v || strlen(v) >= (size_t)r->hi || strpbrk(v, "#\r\n "))
-            return rs_fail(err, 1, "%s: '%s' is not address:port (such as 127.0.0.1:8080)", r->name, v);
+            return rs_fail(err, SVC_CONFIG_ERR_ADDRESS, "%s: '%s' is not address:port (such as 127.0.0.1:8080)",
+                           r->name, v);
         /* an IPv6 host goes in brackets, or "::1" would read as ":" port 1 */
         if (v[0] == '[' ? colon[-1] != ']' : memchr(v, ':', (size_t)(colon - v)) != NULL)
-            return rs_fail(err, 1, "%s: '%s' is not address:port; an IPv6 address goes in brackets, such as [::1]:8080",
+            return rs_fail(err, SVC_CONFIG_ERR_ADDRESS,
+                           "%s: '%s' is not address:port; an IPv6 address goes in brackets, such as [::1]:8080",
                            r->name, v);
         if (!parse_long(colon + 1, &n, &rest) || *rest || n < 0 || n > 65535)
-            return rs_fail(err, 1, "%s: '%s': the port must be 0..65535", r->name, v);
+            return rs_fail(err, SVC_CONFIG_ERR_ADDRESS, "%s: '%s': the port must be 0..65535", r->name, v);
         snprintf(base + r->off, (size_t)r->hi, "%s", v);
         return true;
     }
     }
     return false;
+}
+
+const char *svc_config_error_text(int code)
+{
+    static const char *const text[] = {
+#define X(id, t) t,
+        SVC_CONFIG_ERRORS(X)
+#undef X
+    };
+    return rs_err_text_of(code, RS_ERR_MOD_SVC_CONFIG, text, (int)(sizeof text / sizeof text[0]));
 }
 
 void svc_config_defaults(svc_config *c)
@@ -230,7 +247,7 @@ bool svc_config_set(svc_config *c, const char *name, const char *value, rs_err *
         char known[1024] = "";
         for (size_t i = 0; i < NROWS; i++)
             snprintf(known + strlen(known), sizeof known - strlen(known), "%s%s", i ? ", " : "", rows[i].name);
-        return rs_fail(err, 1, "unknown setting '%s' (known: %s)", name, known);
+        return rs_fail(err, SVC_CONFIG_ERR_UNKNOWN, "unknown setting '%s' (known: %s)", name, known);
     }
     return set_row(c, r, value, err);
 }
@@ -254,7 +271,7 @@ bool svc_config_load(svc_config *c, const char *path, rs_err *err)
     bool ok = true;
     int line = 0;
     if (strlen(text) != len) {
-        ok = rs_fail(err, 1, "%s: contains a NUL byte (not a text file)", path);
+        ok = rs_fail(err, SVC_CONFIG_ERR_FILE, "%s: contains a NUL byte (not a text file)", path);
         goto out;
     }
     /* strtok_r would skip empty lines and so miscount; walk by hand */
@@ -273,7 +290,7 @@ bool svc_config_load(svc_config *c, const char *path, rs_err *err)
             continue;
         char *eq = strchr(s, '=');
         if (!eq) {
-            ok = rs_fail(err, 1, "%s:%d: expected 'name = value', got '%s'", path, line, s);
+            ok = rs_fail(err, SVC_CONFIG_ERR_SYNTAX, "%s:%d: expected 'name = value', got '%s'", path, line, s);
             break;
         }
         *eq = 0;
@@ -306,10 +323,12 @@ static bool default_data(svc_config *c, rs_err *err)
     else if ((v = getenv("HOME")) && v[0] == '/')
         n = snprintf(c->data, max + 1, "%s/.local/state/ringside", v);
     else
-        return rs_fail(err, 1, "data: no default (neither STATE_DIRECTORY, XDG_STATE_HOME nor HOME is set); "
-                               "give --data DIR");
+        return rs_fail(err, SVC_CONFIG_ERR_DATA_DEFAULT,
+                       "data: no default (neither STATE_DIRECTORY, XDG_STATE_HOME nor HOME is set); "
+                       "give --data DIR");
     if (n < 0 || (size_t)n > max)
-        return rs_fail(err, 1, "data: the default from the environment is longer than %zu characters", max);
+        return rs_fail(err, SVC_CONFIG_ERR_DATA_DEFAULT,
+                       "data: the default from the environment is longer than %zu characters", max);
     return true;
 }
 
@@ -322,12 +341,12 @@ bool svc_config_finish(svc_config *c, rs_err *err)
     if (!c->output[0])
         snprintf(c->output, sizeof c->output, "%s/videos", c->data);
     if (c->width > c->max_width || c->height > c->max_height)
-        return rs_fail(err, 1, "size %dx%d is larger than max_size %dx%d", c->width, c->height, c->max_width,
-                       c->max_height);
+        return rs_fail(err, SVC_CONFIG_ERR_SIZE_LIMIT, "size %dx%d is larger than max_size %dx%d", c->width, c->height,
+                       c->max_width, c->max_height);
     rs_err serr = {0};
     if (c->render_width && !cap_check_sizes_for(CAP_I420, c->render_width, c->render_height, c->width, c->height, &serr))
-        return rs_fail(err, 1, "size %dx%d with render_size %dx%d: %s", c->width, c->height, c->render_width,
-                       c->render_height, serr.msg);
+        return rs_fail(err, SVC_CONFIG_ERR_RENDER_SIZE, "size %dx%d with render_size %dx%d: %s", c->width, c->height,
+                       c->render_width, c->render_height, serr.msg);
     return true;
 }
 

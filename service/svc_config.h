@@ -11,6 +11,36 @@
 
 #include "../runtime/util/rs_err.h"
 
+/* Error ids (rs_err.h) of the settings: a value, a config file, or the
+ * settings taken together.  The message names the setting and the value. */
+#define SVC_CONFIG_ERRORS(X)                                                                  \
+    X(NUMBER, "not a whole number")                                                           \
+    X(RANGE, "a value outside the setting's bounds")                                          \
+    X(BYTES, "not a size in bytes (a number, or one with K or M)")                            \
+    X(TEXT, "a text value with '#' or a line break")                                          \
+    X(TOO_LONG, "a text value longer than the setting holds")                                 \
+    X(EMPTY, "an empty value where one is needed")                                            \
+    X(DIMENSIONS, "not a WxH size")                                                           \
+    X(CHOICE, "not one of the setting's choices")                                             \
+    X(DURATION, "not a duration (seconds, or a number with s, m, h or d)")                   \
+    X(ADDRESS, "not address:port")                                                            \
+    X(UNKNOWN, "no setting by that name")                                                     \
+    X(FILE, "the config file is not text")                                                    \
+    X(SYNTAX, "a config file line is not 'name = value'")                                     \
+    X(DATA_DEFAULT, "no usable default data directory from the environment")                 \
+    X(SIZE_LIMIT, "size is larger than max_size")                                             \
+    X(RENDER_SIZE, "size and render_size do not go together")
+
+typedef enum svc_config_error {
+    SVC_CONFIG_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC_CONFIG),
+#define X(id, text) SVC_CONFIG_ERR_##id,
+    SVC_CONFIG_ERRORS(X)
+#undef X
+        SVC_CONFIG_ERR_END
+} svc_config_error;
+
+const char *svc_config_error_text(int code);
+
 enum { SVC_LOG_DEBUG, SVC_LOG_INFO, SVC_LOG_WARN, SVC_LOG_ERROR };
 
 typedef struct svc_config {

@@ -41,23 +41,20 @@
  * comes back through reap (svc_reap_leases) with its attempt given back
  * and a lost lease counted (svc_store.h).
  *
- * Children get PR_SET_PDEATHSIG: a daemon killed with SIGKILL takes its
- * renders with it, so a restarted daemon never races an orphan. */
-#define _GNU_SOURCE /* pipe2, O_CLOEXEC, close_range */
+ * Children get PR_SET_PDEATHSIG (svc_child.c, which starts them and reads
+ * their pipes): a daemon killed with SIGKILL takes its renders with it, so
+ * a restarted daemon never races an orphan. */
 #include <errno.h>
-#include <fcntl.h>
 #include <inttypes.h>
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/file.h>
-#include <sys/prctl.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "svc_child.h"
 #include "svc_local.h"
 #include "svc_log.h"
 #include "../runtime/util/rs_file.h"
@@ -94,12 +91,6 @@ static double now_s(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static void final_paths(const svc_daemon *d, const svc_job *j, char *video, size_t nv, char *hashes, size_t nh)
-{
-    snprintf(video, nv, "%s/%" PRId64 ".%s", d->cfg.output, j->id, j->format);
-    snprintf(hashes, nh, "%s/%" PRId64 ".hashes", d->cfg.output, j->id);
 }
 
 static void publish(svc_daemon *d, const worker *w)
@@ -153,17 +144,10 @@ static const char *ctx(const worker *w)
     return buf;
 }
 
-static void close_fd(int *fd)
-{
-    if (*fd >= 0)
-        close(*fd);
-    *fd = -1;
-}
-
 static void worker_clear(svc_daemon *d, worker *w)
 {
-    close_fd(&w->prog_fd);
-    close_fd(&w->err_fd);
+    svc_child_close(&w->prog_fd);
+    svc_child_close(&w->err_fd);
     if (w->f.replay[0])
         unlink(w->f.replay);
     /* a child killed with SIGKILL could not remove its own ".part" files */
@@ -226,59 +210,11 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
     char **argv = svc_unit_argv(&d->cfg, j, &w->f, w->units, w->nunits, err);
     if (!argv)
         return false;
-    int prog[2], errp[2];
-    if (pipe2(prog, O_CLOEXEC) != 0) {
-        svc_argv_free(argv);
-        return rs_fail(err, SVC_ERR_SYSTEM, "pipe: %s", strerror(errno));
-    }
-    if (pipe2(errp, O_CLOEXEC) != 0) {
-        close(prog[0]), close(prog[1]);
-        svc_argv_free(argv);
-        return rs_fail(err, SVC_ERR_SYSTEM, "pipe: %s", strerror(errno));
-    }
-    pid_t parent = getpid();
-    pid_t pid = fork();
-    if (pid < 0) {
-        close(prog[0]), close(prog[1]), close(errp[0]), close(errp[1]);
-        svc_argv_free(argv);
-        return rs_fail(err, SVC_ERR_SYSTEM, "fork: %s", strerror(errno));
-    }
-    if (pid == 0) {
-        /* the child: only async-signal-safe calls until exec */
-        prctl(PR_SET_PDEATHSIG, SIGKILL);
-        if (getppid() != parent)
-            _exit(127);
-        /* its own process group: Ctrl-C at the daemon's terminal (or a
-         * signal to the daemon's group) reaches the daemon, which decides */
-        setpgid(0, 0);
-        int devnull = open("/dev/null", O_RDWR);
-        if (devnull < 0 || dup2(devnull, 0) < 0 || dup2(devnull, 1) < 0 || dup2(errp[1], 2) < 0 ||
-            dup2(prog[1], 3) < 0)
-            _exit(127);
-        /* dup2 clears close-on-exec on 0..3; everything else (the HTTP
-         * sockets, the database) was opened with it or is closed here */
-        close_range(4, ~0U, 0);
-        struct sigaction sa = {0};
-        sa.sa_handler = SIG_DFL;
-        sigaction(SIGTERM, &sa, NULL);
-        sigaction(SIGINT, &sa, NULL);
-        sigaction(SIGPIPE, &sa, NULL);
-        sigset_t none;
-        sigemptyset(&none);
-        sigprocmask(SIG_SETMASK, &none, NULL);
-        execv(d->exe, argv);
-        static const char msg[] = "ringside serve: cannot run the renderer\n";
-        ssize_t r = write(2, msg, sizeof msg - 1);
-        (void)r;
-        _exit(127);
-    }
+    pid_t pid;
+    bool started = svc_child_start(d->exe, argv, &pid, &w->prog_fd, &w->err_fd, err);
     svc_argv_free(argv);
-    close(prog[1]);
-    close(errp[1]);
-    w->prog_fd = prog[0];
-    w->err_fd = errp[0];
-    fcntl(w->prog_fd, F_SETFL, O_NONBLOCK);
-    fcntl(w->err_fd, F_SETFL, O_NONBLOCK);
+    if (!started)
+        return false;
     w->pid = pid;
     w->busy = true;
     w->total = j->unit.kind == SVC_UNIT_SEGMENT ? j->unit.end_tick - j->unit.first_tick : j->frames_total;
@@ -343,48 +279,28 @@ static void on_err_line(svc_daemon *d, worker *w, char *line)
     svc_log(SVC_LOG_DEBUG, w->job.id, "%s%s says: %s", ctx(w), w->job.unit.kind == SVC_UNIT_JOIN ? "join" : "render", m);
 }
 
-/* Reads what is there; splits lines.  Returns false at EOF or error. */
-static bool drain(svc_daemon *d, worker *w, int *fd, char *buf, size_t cap, size_t *len, bool prog)
+/* The child's progress (fd 3) and message (stderr) lines so far. */
+static void prog_line(void *w, char *line)
 {
-    while (*fd >= 0) {
-        ssize_t n = read(*fd, buf + *len, cap - 1 - *len);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
-            return true;
-        if (n <= 0) {
-            close_fd(fd);
-            if (*len) { /* an unterminated last line */
-                buf[*len] = 0;
-                prog ? on_prog_line(w, buf) : on_err_line(d, w, buf);
-                *len = 0;
-            }
-            return false;
-        }
-        *len += (size_t)n;
-        buf[*len] = 0;
-        char *start = buf, *nl;
-        while ((nl = strchr(start, '\n'))) {
-            *nl = 0;
-            prog ? on_prog_line(w, start) : on_err_line(d, w, start);
-            start = nl + 1;
-        }
-        *len = (size_t)(buf + *len - start);
-        memmove(buf, start, *len);
-        if (*len == cap - 1) /* a line longer than the buffer: take it as it is */
-            *len = 0;
-    }
-    return false;
+    on_prog_line(w, line);
 }
 
-static void describe_status(int status, char *out, size_t n)
+typedef struct err_ctx {
+    svc_daemon *d;
+    worker *w;
+} err_ctx;
+
+static void err_line(void *c, char *line)
 {
-    if (WIFEXITED(status))
-        snprintf(out, n, "exit status %d", WEXITSTATUS(status));
-    else if (WIFSIGNALED(status))
-        snprintf(out, n, "killed by signal %d (%s)", WTERMSIG(status), strsignal(WTERMSIG(status)));
-    else
-        snprintf(out, n, "status %d", status);
+    err_ctx *e = c;
+    on_err_line(e->d, e->w, line);
+}
+
+static void read_child(svc_daemon *d, worker *w)
+{
+    err_ctx e = {d, w};
+    svc_child_read(&w->prog_fd, w->prog_buf, sizeof w->prog_buf, &w->prog_len, prog_line, w);
+    svc_child_read(&w->err_fd, w->err_buf, sizeof w->err_buf, &w->err_len, err_line, &e);
 }
 
 /* A problem of this machine (full disk, output directory gone): the jobs
@@ -448,7 +364,8 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
     svc_job *j = &w->job;
     rs_err err = {0};
     char video[1100], hashes[1100], why[SVC_ERROR_MAX];
-    final_paths(d, j, video, sizeof video, hashes, sizeof hashes);
+    svc_job_file(&d->cfg, j->id, j->format, video, sizeof video);
+    svc_job_file(&d->cfg, j->id, "hashes", hashes, sizeof hashes);
     if (rename(w->f.hashes, hashes) != 0 || rename(w->f.out, video) != 0) {
         /* this machine's problem (disk, a vanished directory), not the job's */
         snprintf(why, sizeof why, "the %s finished but its output could not be moved to %s: %s",
@@ -529,13 +446,12 @@ static void bad_segments(svc_daemon *d, worker *w)
 /* A child ended: decide what its unit (and so its job) becomes. */
 static void on_exit_status(svc_daemon *d, worker *w, int status)
 {
-    drain(d, w, &w->prog_fd, w->prog_buf, sizeof w->prog_buf, &w->prog_len, true);
-    drain(d, w, &w->err_fd, w->err_buf, sizeof w->err_buf, &w->err_len, false);
+    read_child(d, w);
     svc_job *j = &w->job;
     int kind = j->unit.kind;
     rs_err err = {0};
     char how[128], why[SVC_ERROR_MAX + 160];
-    describe_status(status, how, sizeof how);
+    svc_child_status(status, how, sizeof how);
     double secs = now_s() - w->spawned;
     int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     {
@@ -625,8 +541,7 @@ out:
 static void tend(svc_daemon *d, worker *w, double now)
 {
     int64_t before = w->done;
-    drain(d, w, &w->prog_fd, w->prog_buf, sizeof w->prog_buf, &w->prog_len, true);
-    drain(d, w, &w->err_fd, w->err_buf, sizeof w->err_buf, &w->err_len, false);
+    read_child(d, w);
     if (w->done > before && w->job.unit.kind != SVC_UNIT_JOIN) { /* a join copies frames, it draws none */
         pthread_mutex_lock(&d->mu);
         d->frames_rendered += (uint64_t)(w->done - before);

@@ -271,14 +271,11 @@ int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format
 {
     char path[1400];
     int n = 0;
-    snprintf(path, sizeof path, "%s/%" PRId64 ".%s", cfg->output, id, format);
-    n += unlink(path) == 0;
-    snprintf(path, sizeof path, "%s/%" PRId64 ".hashes", cfg->output, id);
-    n += unlink(path) == 0;
-    svc_job_file(cfg, id, "png", path, sizeof path);
-    n += unlink(path) == 0;
-    svc_job_file(cfg, id, "log", path, sizeof path);
-    n += unlink(path) == 0;
+    const char *exts[] = {format, "hashes", "png", "log"};
+    for (int i = 0; i < 4; i++) {
+        svc_job_file(cfg, id, exts[i], path, sizeof path);
+        n += unlink(path) == 0;
+    }
     svc_remove_job_files(cfg, id);
     return n;
 }

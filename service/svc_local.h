@@ -148,8 +148,9 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
 char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_files *f, const svc_unit *units, int n,
                      rs_err *err);
 void svc_argv_free(char **argv);
-/* "OUTPUT/N.png", "OUTPUT/N.log": a job's poster and render log (the log
- * gathers every unit's attempts, appended as each ends). */
+/* "OUTPUT/N.EXT": a finished job's files, all named here: the video
+ * (EXT its format), N.hashes, the poster N.png and the render log N.log
+ * (the log gathers every unit's attempts, appended as each ends). */
 void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out, size_t n);
 /* Appends one unit attempt's log block to OUTPUT/N.log in one write (units
  * of a split job may end at once, on several daemons). */

@@ -26,7 +26,7 @@
  *  - times are Unix seconds from the database's clock, so machines with
  *    skewed clocks still agree on leases.
  *
- * Units (the segments of issue 18).  What a worker claims is a unit of a
+ * Units (docs/service.md, "Segments").  What a worker claims is a unit of a
  * job, not the job: an unsplit job (segment_ticks 0, or a replay no longer
  * than one segment) is one WHOLE unit, a split job is `segments` SEGMENT
  * units of segment_ticks ticks each (the last shorter) plus one JOIN unit.

@@ -74,7 +74,7 @@ bool sq_schema_lost(const sq_driver *drv, void *c, const char *has_column, rs_er
  * adds jobs.token_id to a queue made before tokens existed. */
 bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool migrate, rs_err *err);
 
-/* The replay's header kept with each job (issue 22: the dashboard's
+/* The replay's header kept with each job (docs/service.md, "Dashboard": the
  * stage, players, winner): jobs.stage, kind1, kind2, winner, rounds1 and
  * rounds2, added where missing, to new and old queues alike, as
  * sq_schema_lost does.  Old jobs read stage -1: not known. */

@@ -1217,6 +1217,53 @@ static void t_upload_params(void)
     T_ASSERT(!strcmp(SVC_JOB_PARAM_LIST, "size,format,codec,crf,bitrate,preset,pix_fmt,audio,quality,name"));
 }
 
+/* Config errors carry their own ids: each with a text of its own, in the
+ * "service config" block, and a bad value fails with the id of what is
+ * wrong with it (the message is for people, the id for callers). */
+static void t_config_error_ids(void)
+{
+    T_EQ(RS_ERR_MODULE(SVC_CONFIG_ERR_BASE + 1), RS_ERR_MOD_SVC_CONFIG);
+    T_EQ(RS_ERR_MODULE(SVC_CONFIG_ERR_END - 1), RS_ERR_MOD_SVC_CONFIG);
+    T_ASSERT(!strcmp(rs_err_module_name(SVC_CONFIG_ERR_RANGE), "service config"));
+    for (int a = SVC_CONFIG_ERR_BASE + 1; a < SVC_CONFIG_ERR_END; a++) {
+        const char *t = svc_config_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        for (int b = SVC_CONFIG_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, svc_config_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(svc_config_error_text(SVC_CONFIG_ERR_END), "?"));
+    static const struct {
+        const char *name, *value;
+        int code;
+    } bad[] = {
+        {"workers", "two", SVC_CONFIG_ERR_NUMBER},      {"workers", "100000", SVC_CONFIG_ERR_RANGE},
+        {"max_upload", "lots", SVC_CONFIG_ERR_BYTES},   {"size", "640", SVC_CONFIG_ERR_DIMENSIONS},
+        {"size", "641x360", SVC_CONFIG_ERR_RANGE},      {"format", "avi", SVC_CONFIG_ERR_CHOICE},
+        {"retention", "soon", SVC_CONFIG_ERR_DURATION}, {"listen", "8080", SVC_CONFIG_ERR_ADDRESS},
+        {"listen", "::1:80", SVC_CONFIG_ERR_ADDRESS},   {"nope", "1", SVC_CONFIG_ERR_UNKNOWN},
+        {"data", "a#b", SVC_CONFIG_ERR_TEXT},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        svc_config c;
+        svc_config_defaults(&c);
+        rs_err e = {0};
+        T_ASSERTF(!svc_config_set(&c, bad[i].name, bad[i].value, &e), "%s = '%s' accepted", bad[i].name,
+                  bad[i].value);
+        T_ASSERTF(e.code == bad[i].code, "%s = '%s': %s, want %s", bad[i].name, bad[i].value,
+                  svc_config_error_text(e.code), svc_config_error_text(bad[i].code));
+    }
+    svc_config c;
+    svc_config_defaults(&c);
+    rs_err e = {0};
+    SET_OK(&c, "data", "/srv/ring");
+    SET_OK(&c, "max_size", "640x360");
+    SET_OK(&c, "size", "1280x720");
+    T_ASSERT(!svc_config_finish(&c, &e) && e.code == SVC_CONFIG_ERR_SIZE_LIMIT);
+    const char *path = tmp_path("bad_ids.conf");
+    t_write(t_tmpdir(), "bad_ids.conf", "workers 2\n");
+    T_ASSERT(!svc_config_load(&c, path, &e) && e.code == SVC_CONFIG_ERR_SYNTAX);
+}
+
 T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t_tokens_and_bearer},
        {"config_defaults", t_config_defaults}, {"config_data_default", t_config_data_default}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
        {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
@@ -1229,4 +1276,5 @@ T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"upload_verified", t_upload_verified},
        {"http_status_table", t_http_status_table}, {"encode_options", t_encode_options},
-       {"route_table", t_route_table}, {"upload_params", t_upload_params})
+       {"route_table", t_route_table}, {"upload_params", t_upload_params},
+       {"config_error_ids", t_config_error_ids})
