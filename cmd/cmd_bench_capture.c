@@ -23,6 +23,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 #define MAX_RUNS 9
 
@@ -255,7 +256,7 @@ int bench_capture(int argc, char **argv)
     if (!data || !rp_read(demo, &b.rp, &err))
         goto done;
     if (b.rp.ticks < b.start + (uint64_t)b.frames) {
-        rs_fail(&err, 1, "%s has %" PRIu64 " ticks; --frames %d from tick %" PRIu64 " needs more", demo, b.rp.ticks,
+        rs_fail(&err, JOB_ERR_TICKS, "%s has %" PRIu64 " ticks; --frames %d from tick %" PRIu64 " needs more", demo, b.rp.ticks,
                 b.frames, b.start);
         goto done;
     }
@@ -266,7 +267,7 @@ int bench_capture(int argc, char **argv)
         goto done;
     b.mem = malloc(cap_frame_bytes(CAP_I420, b.w, b.h) * (size_t)b.frames);
     if (!b.mem) {
-        rs_fail(&err, 1, "out of memory for %d frames", b.frames);
+        rs_fail(&err, JOB_ERR_NOMEM, "out of memory for %d frames", b.frames);
         goto done;
     }
     if (!r_target_create(&b.t, b.sw, b.sh, &err))
@@ -353,7 +354,7 @@ int bench_capture(int argc, char **argv)
         if (f && cli_fclose(f) != 0)
             ok = false;
         if (!ok) {
-            rs_fail(&err, 1, "%s: cannot write", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: cannot write", csv);
             goto done;
         }
     }

@@ -31,6 +31,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 /* The demos and the tick each one's frames start at: where its stage
  * shows what it has (the golden images' ticks, tests/test_render.c). */
@@ -214,7 +215,7 @@ static bool draw_frames(const char *data, int d, const config *c, int frames, in
      * llvmpipe compiles a program's code at its first draw */
     uint64_t first = demos[d].tick - FRAME_STEP, end = demos[d].tick + (uint64_t)FRAME_STEP * (uint64_t)(frames - 1) + 1;
     if (end > rp.ticks) {
-        rs_fail(err, 1, "%s: too short for %d frames from tick %" PRIu64, path, frames, demos[d].tick);
+        rs_fail(err, JOB_ERR_TICKS, "%s: too short for %d frames from tick %" PRIu64, path, frames, demos[d].tick);
         goto done;
     }
     if (!(r = r_game_create_opts(&(r_game_opts){.q = c->q, .quiet = true}, err)) || !r_game_prepare(r, rp.stage, err) ||
@@ -376,7 +377,7 @@ int bench_quality(int argc, char **argv)
     result(*res)[MAXCONFIGS] = calloc(NDEMOS, sizeof *res);
     const char *data = rs_data_dir(&err);
     if (!ref || !px || !ya || !yb || !res) {
-        rs_fail(&err, 1, "out of memory");
+        rs_fail(&err, JOB_ERR_NOMEM, "out of memory");
         goto done;
     }
     if (!data || !(p = plat_create(&(plat_desc){.hidden = true}, &err)))
@@ -476,7 +477,7 @@ int bench_quality(int argc, char **argv)
     if (csv && *csv) {
         FILE *f = cli_bench_open("bench", csv, user_csv, overwrite);
         if (!f) {
-            rs_fail(&err, 1, "%s: not written", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: not written", csv);
             goto done;
         }
         fprintf(f, "stage,configuration,scale,aa,shadow_size,sil_size,mask_half,bloom_levels,lspsm_size,fog_size,water_grid,"
@@ -490,7 +491,7 @@ int bench_quality(int argc, char **argv)
                         res[d][ci].psnr, res[d][ci].ssim, frames, w, h);
             }
         if (cli_fclose(f) != 0) {
-            rs_fail(&err, 1, "%s: cannot write", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: cannot write", csv);
             goto done;
         }
     }

@@ -32,6 +32,7 @@
 #include "../runtime/render/r_target.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 #define MAX_RUNS 15
 #define NFRAMES 8 /* distinct synthetic frames */
@@ -241,7 +242,7 @@ static bool verify(bench *b, mode_res *m, rs_err *err)
     size_t n = (size_t)b->w * 4;
     uint8_t *row = malloc(n);
     if (!row)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, JOB_ERR_NOMEM, "out of memory");
     rgl_check("bench upload: before verify");
     mv_csp csp;
     mv_csp_make(b->info.matrix, b->info.full_range, &csp);
@@ -249,7 +250,7 @@ static bool verify(bench *b, mode_res *m, rs_err *err)
         show_and_read(b, m, f % NSLOTS, ycc[f], row);
         if (!rgl_check("bench upload: verify")) {
             free(row);
-            return rs_fail(err, 1, "%s upload: GL errors while verifying the picture", mv_up_name(m->mode));
+            return rs_fail(err, JOB_ERR_GL, "%s upload: GL errors while verifying the picture", mv_up_name(m->mode));
         }
         double rgb[3];
         mv_csp_apply(&csp, ycc[f][0], ycc[f][1], ycc[f][2], rgb);
@@ -263,7 +264,7 @@ static bool verify(bench *b, mode_res *m, rs_err *err)
             black &= px[0] < 8 && px[1] < 8 && px[2] < 8;
             for (int ch = 0; ch < 3; ch++)
                 if (abs(px[ch] - want[ch]) > 4) {
-                    rs_fail(err, 1,
+                    rs_fail(err, JOB_ERR_VERIFY,
                             "%s upload: %s: pixel (%d, %d) is %d,%d,%d, expected about %d,%d,%d from Y/Cb/Cr "
                             "%d/%d/%d: the path is broken",
                             mv_up_name(m->mode), black ? "the frame drawn is black" : "wrong picture", x, b->h / 2,
@@ -380,7 +381,7 @@ int bench_upload(int argc, char **argv)
     memset(res, 0, sizeof res);
     for (int k = 0; k < NFRAMES; k++) {
         if (!(b.frames[k] = malloc(b.bytes))) {
-            rs_fail(&err, 1, "out of memory for %d frames of %zu bytes", NFRAMES, b.bytes);
+            rs_fail(&err, JOB_ERR_NOMEM, "out of memory for %d frames of %zu bytes", NFRAMES, b.bytes);
             goto done;
         }
         synth(&b.info, k, b.frames[k]);
@@ -393,7 +394,7 @@ int bench_upload(int argc, char **argv)
         fprintf(stderr, "ringside bench: egl unavailable, using %s: %s\n", plat_backend_name(p),
                 plat_fallback_reason(p));
     if (b.w > glcaps.max_texture_size || b.h > glcaps.max_texture_size) {
-        rs_fail(&err, 1, "--size %dx%d: this context's textures stop at %d", b.w, b.h, glcaps.max_texture_size);
+        rs_fail(&err, JOB_ERR_LIMIT, "--size %dx%d: this context's textures stop at %d", b.w, b.h, glcaps.max_texture_size);
         status = RS_EXIT_USAGE;
         goto done;
     }
@@ -438,7 +439,7 @@ int bench_upload(int argc, char **argv)
             run_mode(&b, m, 0, (int)frames, false, &m->s[rep]);
             m->s[rep].synced = run_mode(&b, m, (int)frames, nsync, true, NULL);
             if (!rgl_check("bench upload")) {
-                rs_fail(&err, 1, "%s upload: GL errors during the run", mv_up_name(m->mode));
+                rs_fail(&err, JOB_ERR_GL, "%s upload: GL errors during the run", mv_up_name(m->mode));
                 goto done;
             }
         }
@@ -533,7 +534,7 @@ int bench_upload(int argc, char **argv)
             ok = false;
         if (!ok) {
             if (!err.msg[0])
-                rs_fail(&err, 1, "%s: cannot write", csv);
+                rs_fail(&err, JOB_ERR_WRITE, "%s: cannot write", csv);
             goto done;
         }
     }

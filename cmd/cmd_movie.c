@@ -26,6 +26,7 @@
 #include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 #include "../runtime/util/rs_out.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -312,7 +313,7 @@ int cmd_movie(int argc, char **argv)
     /* --dump DIR is created, as an output is, when the folder it is in exists */
     if (s->dump && stat(s->dump, &dst) != 0 && (!rs_out_check(s->dump, false, &s->err) || mkdir(s->dump, 0777) != 0)) {
         if (!s->err.msg[0])
-            rs_fail(&s->err, 1, "%s: cannot create: %s", s->dump, strerror(errno));
+            rs_fail(&s->err, JOB_ERR_CREATE, "%s: cannot create: %s", s->dump, strerror(errno));
         goto done;
     }
     if (hashes && !(s->hashes = cli_text_open("movie", hashes, s->overwrite)))
@@ -346,7 +347,7 @@ int cmd_movie(int argc, char **argv)
         if (!r_target_create(&s->target, s->w, s->h, &s->err))
             goto done;
         if (!(s->px = malloc((size_t)s->w * s->h * 3))) {
-            rs_fail(&s->err, 1, "out of memory for a %dx%d frame", s->w, s->h);
+            rs_fail(&s->err, JOB_ERR_NOMEM, "out of memory for a %dx%d frame", s->w, s->h);
             goto done;
         }
     }

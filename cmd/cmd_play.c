@@ -28,6 +28,7 @@
 #include "../runtime/util/rs_img.h"
 #include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -159,7 +160,7 @@ static bool ss_fit(play *s, int w, int h)
     s->ss_w = w, s->ss_h = h;
     while (rw > w || rh > h) {
         if (s->nss == 4 || !r_target_create(&s->ss[s->nss], rw, rh, &s->err))
-            return s->nss == 4 ? rs_fail(&s->err, 1, "%dx%d: too many halvings", rw, rh) : false;
+            return s->nss == 4 ? rs_fail(&s->err, JOB_ERR_LIMIT, "%dx%d: too many halvings", rw, rh) : false;
         s->nss++;
         if (rw <= 2 * w && rh <= 2 * h)
             break;
@@ -176,7 +177,7 @@ static bool draw_frame(play *s, GLuint fbo, float alpha, int w, int h)
     const r_target *top = s->nss ? &s->ss[0] : NULL;
     gl.BindFramebuffer(GL_FRAMEBUFFER, top ? top->fbo : fbo);
     if (!r_game_draw(s->r, &s->prev, &s->cur, alpha, top ? top->w : w, top ? top->h : h))
-        return rs_fail(&s->err, 1, "%s", r_game_error(s->r));
+        return rs_fail(&s->err, JOB_ERR_DRAW, "%s", r_game_error(s->r));
     for (int i = 0; i < s->nss; i++) {
         const r_target *src = &s->ss[i];
         int dw = i + 1 < s->nss ? s->ss[i + 1].w : w, dh = i + 1 < s->nss ? s->ss[i + 1].h : h;
@@ -224,7 +225,7 @@ static bool screenshot(play *s, const char *path, rs_err *err)
         plat_size(s->p, &w, &h);
     uint8_t *px = malloc((size_t)w * h * 4);
     if (!px)
-        return rs_fail(err, 1, "out of memory for a %dx%d screenshot", w, h);
+        return rs_fail(err, JOB_ERR_NOMEM, "out of memory for a %dx%d screenshot", w, h);
     if (!draw_frame(s, s->target.fbo, 1.0f, w, h)) {
         free(px);
         return false;

@@ -26,6 +26,7 @@
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
 #include "../runtime/util/rs_version.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -432,7 +433,7 @@ int cmd_render(int argc, char **argv)
     if (!rp_read(replay, &rp, &err))
         goto done;
     if (end > (long)rp.ticks) {
-        rs_fail(&err, 1, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", replay, first, end,
+        rs_fail(&err, JOB_ERR_TICKS, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", replay, first, end,
                 rp.ticks);
         status = RS_EXIT_USAGE;
         goto done;
@@ -520,7 +521,7 @@ int cmd_render(int argc, char **argv)
         char exe[1100], what[160];
         ssize_t ne = readlink("/proc/self/exe", exe, sizeof exe - 1);
         if (ne <= 0) {
-            rs_fail(&err, 1, "cannot find this program (/proc/self/exe): %s", strerror(errno));
+            rs_fail(&err, JOB_ERR_PROCESS, "cannot find this program (/proc/self/exe): %s", strerror(errno));
             goto done;
         }
         exe[ne] = 0;
@@ -535,7 +536,7 @@ int cmd_render(int argc, char **argv)
     }
     /* a manifest says "complete": an older one must not vouch for the files this render replaces */
     if (segment && unlink(seg_manifest) != 0 && errno != ENOENT) {
-        rs_fail(&err, 1, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
+        rs_fail(&err, JOB_ERR_WRITE, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
         goto done;
     }
     if (hashes && !strcmp(hashes, "-")) {
@@ -543,7 +544,7 @@ int cmd_render(int argc, char **argv)
     } else if (hashes) {
         snprintf(hpart, sizeof hpart, "%s.part", hashes);
         if (!(hf = fopen(hpart, "w"))) {
-            rs_fail(&err, 1, "%s: cannot create: %s", hpart, strerror(errno));
+            rs_fail(&err, JOB_ERR_CREATE, "%s: cannot create: %s", hpart, strerror(errno));
             goto done;
         }
         cd.hashes = hf;
@@ -575,7 +576,7 @@ int cmd_render(int argc, char **argv)
         uint64_t tick = j.tick; /* every tick is a frame */
         if (stop_requested) {
             ok = false;
-            rs_fail(&err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
+            rs_fail(&err, JOB_ERR_INTERRUPTED, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
                     out, tick, t_end);
             break;
         }
@@ -600,7 +601,7 @@ int cmd_render(int argc, char **argv)
     if (!cap_close(cp, ok, &st, &err))
         goto done;
     if (cd.hashes == stdout && fflush(stdout) != 0) {
-        rs_fail(&err, 1, "--hashes -: write failed");
+        rs_fail(&err, JOB_ERR_WRITE, "--hashes -: write failed");
         goto done;
     }
     if (hf) {
@@ -611,7 +612,7 @@ int cmd_render(int argc, char **argv)
             struct stat vst;
             if (stat(out, &vst) == 0 && S_ISREG(vst.st_mode))
                 unlink(out);
-            rs_fail(&err, 1, "%s: write failed; %s removed with it", hashes, out);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: write failed; %s removed with it", hashes, out);
             goto done;
         }
         hpart[0] = 0;
