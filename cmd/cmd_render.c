@@ -309,8 +309,16 @@ static bool picture_option(render_opts *o, int c, const char *arg)
     case 's': return cli_out_size("--size", arg, &cd->w, &cd->h);
     case 'r': return cli_size("--render-size", arg, R_RENDER_MAX, &cd->src_w, &cd->src_h);
     case 'L': return (o->quality = cli_quality("render", arg)) != NULL;
-    case 'c': return word2("--capture", arg, "async", CAP_ASYNC, "sequential", CAP_SEQUENTIAL, (int *)&cd->mode);
-    case 'd': return word2("--downscale", arg, "gpu", CAP_DS_GPU, "cpu", CAP_DS_CPU, (int *)&cd->downscale);
+    case 'c':
+        if (!word2("--capture", arg, "async", CAP_ASYNC, "sequential", CAP_SEQUENTIAL, &k))
+            return false;
+        cd->mode = (cap_mode)k;
+        return true;
+    case 'd':
+        if (!word2("--downscale", arg, "gpu", CAP_DS_GPU, "cpu", CAP_DS_CPU, &k))
+            return false;
+        cd->downscale = (cap_downscale)k;
+        return true;
     case 'p': if (!cli_int("--pbo", arg, 1, CAP_MAX_PBO, &v)) return false; cd->pbo = (int)v; return true;
     case 'Q':
         if (!cli_int("--queue", arg, 0, 1000, &v))
