@@ -19,6 +19,7 @@
 
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_img.h"
+#include "job_err.h"
 
 #ifdef RS_HAVE_CAIRO
 #include <cairo-svg.h>
@@ -31,11 +32,11 @@ bool bench_chart_check(const char *path, rs_err *err)
 {
     char svg[1100];
     if (!bench_chart_svg_path(path, svg, sizeof svg))
-        return rs_fail(err, 1, "%s: a chart is written as .png (and .svg beside it)", path);
+        return rs_fail(err, JOB_ERR_CHART, "%s: a chart is written as .png (and .svg beside it)", path);
 #ifdef RS_HAVE_CAIRO
     return true;
 #else
-    return rs_fail(err, 1, "%s: this build has no cairo, so no charts (install libcairo2-dev and rebuild, or give --chart '')",
+    return rs_fail(err, JOB_ERR_CHART, "%s: this build has no cairo, so no charts (install libcairo2-dev and rebuild, or give --chart '')",
                    path);
 #endif
 }
@@ -192,7 +193,7 @@ static bool write_png(const char *path, const layout *l, const bench_chart *c, r
             }
         ok = rs_png_write(path, W, l->h, 3, rgb, err);
     } else {
-        rs_fail(err, 1, "%s: cairo: %s", path, st != CAIRO_STATUS_SUCCESS ? cairo_status_to_string(st) : "out of memory");
+        rs_fail(err, JOB_ERR_CHART, "%s: cairo: %s", path, st != CAIRO_STATUS_SUCCESS ? cairo_status_to_string(st) : "out of memory");
     }
     free(rgb);
     cairo_surface_destroy(s);
@@ -264,11 +265,11 @@ static bool write_svg(const char *path, const layout *l, const bench_chart *c, r
     const char *root = st == CAIRO_STATUS_SUCCESS && mem_put(&drawn, "", 1) ? strstr(drawn.p, "<svg") : NULL;
     const char *end = root ? strchr(root, '>') : NULL;
     if (!end)
-        rs_fail(err, 1, "%s: cairo: %s", path,
+        rs_fail(err, JOB_ERR_CHART, "%s: cairo: %s", path,
                 st != CAIRO_STATUS_SUCCESS ? cairo_status_to_string(st) : "no <svg> element in its output");
     else if (!mem_put(&out, drawn.p, (size_t)(end + 1 - drawn.p)) || !mem_put(&out, "\n", 1) || !svg_words(&out, c) ||
              !mem_put(&out, end + 1, drawn.n - 1 - (size_t)(end + 1 - drawn.p)))
-        rs_fail(err, 1, "%s: out of memory", path);
+        rs_fail(err, JOB_ERR_NOMEM, "%s: out of memory", path);
     else
         ok = rs_write_part(path, out.p, out.n, err) && rs_commit_file(path, err);
     free(drawn.p);
@@ -283,7 +284,7 @@ bool bench_chart_write(const char *path, const bench_chart *c, rs_err *err)
         return false;
     bench_chart_svg_path(path, svg, sizeof svg);
     if (c->n < 1 || c->n > CHART_MAX_BARS)
-        return rs_fail(err, 1, "%s: %d bars (expected 1..%d)", path, c->n, CHART_MAX_BARS);
+        return rs_fail(err, JOB_ERR_CHART, "%s: %d bars (expected 1..%d)", path, c->n, CHART_MAX_BARS);
     cairo_surface_t *probe = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1);
     cairo_t *cr = cairo_create(probe);
     layout l = measure(cr, c);

@@ -43,6 +43,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_img.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -182,7 +183,7 @@ static bool load_script(attract *a, const char *path)
 {
     FILE *f = fopen(path, "r");
     if (!f)
-        return rs_fail(&a->err, 1, "%s: %s", path, strerror(errno));
+        return rs_fail(&a->err, JOB_ERR_SCRIPT, "%s: %s", path, strerror(errno));
     char line[256];
     int ln = 0;
     int64_t prev = 0;
@@ -206,7 +207,7 @@ static bool load_script(attract *a, const char *path)
         ev e = {0};
         if (n != 3 || t < 0 || t < prev || (strcmp(who, "p1") && strcmp(who, "p2")) || !parse_keys(keys, &e.keys)) {
             fclose(f);
-            return rs_fail(&a->err, 1,
+            return rs_fail(&a->err, JOB_ERR_SCRIPT,
                            "%s:%d: expected 'TICK p1|p2 KEYS' with TICK >= %" PRId64
                            " and KEYS '-' or up+down+left+right+punch+kick+guard+start",
                            path, ln, prev);
@@ -218,7 +219,7 @@ static bool load_script(attract *a, const char *path)
             ev *g = realloc(a->script, cap * sizeof *g);
             if (!g) {
                 fclose(f);
-                return rs_fail(&a->err, 1, "%s: out of memory", path);
+                return rs_fail(&a->err, JOB_ERR_NOMEM, "%s: out of memory", path);
             }
             a->script = g;
         }
@@ -537,7 +538,7 @@ static bool screenshot(attract *a, const char *path)
         plat_size(a->p, &w, &h);
     uint8_t *px = malloc((size_t)w * h * 3);
     if (!px)
-        return rs_fail(&a->err, 1, "out of memory for a %dx%d screenshot", w, h);
+        return rs_fail(&a->err, JOB_ERR_NOMEM, "out of memory for a %dx%d screenshot", w, h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, a->target.fbo);
     draw(a, 1.0f, w, h);
     r_read_pixels(a->target.fbo, w, h, 3, px);

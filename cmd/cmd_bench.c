@@ -18,6 +18,7 @@
 #include "../runtime/util/rs_progress.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_smoke.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -98,7 +99,7 @@ static bool bench_backend(const char *name, int w, int h, int frames, int runs, 
     if (!px) {
         r_smoke_destroy(s);
         plat_destroy(p);
-        return rs_fail(err, 1, "out of memory for a %dx%d frame", w, h);
+        return rs_fail(err, JOB_ERR_NOMEM, "out of memory for a %dx%d frame", w, h);
     }
     double draw[64], rd[64];
     r_smoke_draw(s); /* warm-up: shader JIT, first allocation */
@@ -209,7 +210,7 @@ static int bench_sim(int argc, char **argv)
     if (!ran)
         goto done;
     if (!res.ok) {
-        rs_fail(&err, 1, "synthetic replay desynced at tick %llu: the simulation is not deterministic",
+        rs_fail(&err, JOB_ERR_VERIFY, "synthetic replay desynced at tick %llu: the simulation is not deterministic",
                 (unsigned long long)res.desync_tick);
         goto done;
     }
@@ -233,7 +234,7 @@ static int bench_sim(int argc, char **argv)
         if (f && cli_fclose(f) != 0)
             wrote = false;
         if (!wrote) {
-            rs_fail(&err, 1, "%s: cannot write", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: cannot write", csv);
             goto done;
         }
     }

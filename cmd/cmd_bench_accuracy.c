@@ -34,6 +34,7 @@
 #include "../runtime/util/rs_img.h"
 #include "../runtime/util/rs_oiio.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 static double psnr_rgb(const uint8_t *a, const float *ref, size_t npx)
 {
@@ -238,7 +239,7 @@ static FILE *csv_open(const char *path, const char *header, rs_err *err)
 {
     FILE *f = cli_bench_open("bench", path, csv_rules.user, csv_rules.overwrite);
     if (!f) {
-        rs_fail(err, 1, "%s: not written", path);
+        rs_fail(err, JOB_ERR_WRITE, "%s: not written", path);
         return NULL;
     }
     fprintf(f, "%s\n", header);
@@ -248,7 +249,7 @@ static FILE *csv_open(const char *path, const char *header, rs_err *err)
 static bool csv_close(FILE *f, const char *path, rs_err *err)
 {
     if (f && fclose(f) != 0)
-        return rs_fail(err, 1, "%s: write failed", path);
+        return rs_fail(err, JOB_ERR_WRITE, "%s: write failed", path);
     return true;
 }
 
@@ -395,7 +396,7 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     const char *data = rs_data_dir(&err);
     char demo[1200];
     if (!full || !small || !yuv || !ref || !back) {
-        rs_fail(&err, 1, "out of memory");
+        rs_fail(&err, JOB_ERR_NOMEM, "out of memory");
         goto done;
     }
     if (!data)
@@ -404,7 +405,7 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     if (!rp_read(demo, &rp, &err))
         goto done;
     if (rp.ticks < 600 + 60 * (uint64_t)frames) {
-        rs_fail(&err, 1, "%s is too short for %d frames", demo, frames);
+        rs_fail(&err, JOB_ERR_TICKS, "%s is too short for %d frames", demo, frames);
         goto done;
     }
     if (!(p = plat_create(&(plat_desc){.hidden = true}, &err)) || !(r = r_game_create(&err)))
@@ -469,7 +470,7 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     FILE *cf = NULL;
     if (csv && *csv) {
         if (!(cf = cli_bench_open("bench", csv, csv_rules.user, csv_rules.overwrite))) {
-            rs_fail(&err, 1, "%s: not written", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: not written", csv);
             goto done;
         }
         fprintf(cf, "filter,psnr_db,ms_per_frame,frames,render_w,render_h,w,h\n");
@@ -485,7 +486,7 @@ static int bench_capture_accuracy(int frames, int sw, int sh, int w, int h, cons
     if (cf) {
         fprintf(cf, "ycbcr420_roundtrip,%.3f,,%d,%d,%d,%d,%d\n", conv / frames, frames, sw, sh, w, h);
         if (fclose(cf) != 0) {
-            rs_fail(&err, 1, "%s: write failed", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: write failed", csv);
             goto done;
         }
     }

@@ -23,6 +23,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 #define MAX_RUNS 9
 
@@ -45,6 +46,7 @@ typedef struct bench {
     r_game *r;
     r_target t;
     uint8_t *mem; /* frames captured once, for writer-only */
+    plat *p;
 } bench;
 
 static void reset_peak_rss(void)
@@ -186,7 +188,16 @@ static void help(void)
            "the");
 }
 
-int bench_capture(int argc, char **argv)
+/* What the command line asks for, beyond the sizes that go into bench. */
+typedef struct capture_opts {
+    long nrep;
+    const r_preset *quality;
+    const char *sink, *csv, *chart;
+    bool quiet, overwrite, user_csv, user_chart;
+} capture_opts;
+
+/* The command line into b and o, checked; -1 to go on, else the exit status. */
+static int parse_options(int argc, char **argv, bench *b, capture_opts *o)
 {
     static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
                                          {"render-size", required_argument, 0, 'r'}, {"sink", required_argument, 0, 'k'},
@@ -195,136 +206,145 @@ int bench_capture(int argc, char **argv)
                                          {"runs", required_argument, 0, 'R'},   {"quality", required_argument, 0, 'L'},
                                          {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
-    long nrep = 3;
-    bench b = {.frames = 300, .w = 640, .h = 360, .start = 600};
-    const r_preset *quality = &r_presets[R_PRESET_DEFAULT];
-    const char *sink = "mp4", *csv = "out/bench-capture.csv", *chart = "out/bench-capture.png";
-    bool quiet = false, overwrite = false, user_csv = false, user_chart = false;
+    *o = (capture_opts){.nrep = 3, .quality = &r_presets[R_PRESET_DEFAULT], .sink = "mp4", .csv = "out/bench-capture.csv",
+                        .chart = "out/bench-capture.png"};
     long v;
     int c;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
         switch (c) {
-        case 'f': if (!cli_int("--frames", optarg, 10, 100000, &v)) return RS_EXIT_USAGE; b.frames = (int)v; break;
-        case 's': if (!cli_size("--size", optarg, 8192, &b.w, &b.h)) return RS_EXIT_USAGE; break;
-        case 'r': if (!cli_size("--render-size", optarg, R_RENDER_MAX, &b.sw, &b.sh)) return RS_EXIT_USAGE; break;
-        case 'L': if (!(quality = cli_quality("bench", optarg))) return RS_EXIT_USAGE; break;
+        case 'f': if (!cli_int("--frames", optarg, 10, 100000, &v)) return RS_EXIT_USAGE; b->frames = (int)v; break;
+        case 's': if (!cli_size("--size", optarg, 8192, &b->w, &b->h)) return RS_EXIT_USAGE; break;
+        case 'r': if (!cli_size("--render-size", optarg, R_RENDER_MAX, &b->sw, &b->sh)) return RS_EXIT_USAGE; break;
+        case 'L': if (!(o->quality = cli_quality("bench", optarg))) return RS_EXIT_USAGE; break;
         case 'k':
             if (strcmp(optarg, "mp4") && strcmp(optarg, "y4m") && strcmp(optarg, "null")) {
                 cli_error("bench", "--sink '%s': expected mp4, y4m or null", optarg);
                 return RS_EXIT_USAGE;
             }
-            sink = optarg;
+            o->sink = optarg;
             break;
-        case 'c': csv = optarg; user_csv = true; break;
-        case 'C': chart = optarg; user_chart = true; break;
-        case 'y': overwrite = true; break;
-        case 'n': overwrite = false; break;
-        case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
-        case 'q': quiet = true; break;
+        case 'c': o->csv = optarg; o->user_csv = true; break;
+        case 'C': o->chart = optarg; o->user_chart = true; break;
+        case 'y': o->overwrite = true; break;
+        case 'n': o->overwrite = false; break;
+        case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &o->nrep)) return RS_EXIT_USAGE; break;
+        case 'q': o->quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }
     }
     rs_err err = {0};
-    if (!b.sw)
-        r_preset_render_size(quality, b.w, b.h, R_RENDER_MAX, &b.sw, &b.sh);
-    if (!cap_check_sizes(b.sw, b.sh, b.w, b.h, &err)) {
+    if (!b->sw)
+        r_preset_render_size(o->quality, b->w, b->h, R_RENDER_MAX, &b->sw, &b->sh);
+    if (!cap_check_sizes(b->sw, b->sh, b->w, b->h, &err)) {
         cli_error("bench", "%s", err.msg);
         return RS_EXIT_USAGE;
     }
-    if (chart && *chart && !bench_chart_check(chart, &err)) { /* before minutes of runs, not after */
+    if (o->chart && *o->chart && !bench_chart_check(o->chart, &err)) { /* before minutes of runs, not after */
         cli_error("bench", "--chart %s", err.msg);
         return RS_EXIT_USAGE;
     }
-    if ((user_csv && *csv && !cli_out_ok("bench", csv, overwrite)) ||
-        (user_chart && *chart && !cli_out_ok("bench", chart, overwrite)))
+    if ((o->user_csv && *o->csv && !cli_out_ok("bench", o->csv, o->overwrite)) ||
+        (o->user_chart && *o->chart && !cli_out_ok("bench", o->chart, o->overwrite)))
         return RS_EXIT_FAIL;
-    char outpath[64];
-    snprintf(outpath, sizeof outpath, !strcmp(sink, "null") ? "null:" : "out/bench-capture-scratch.%s", sink);
-    b.out = outpath;
-    const char *data = rs_data_dir(&err);
+    return -1;
+}
+
+/* The demo, the sink's folder, the context, the renderer and the memory
+ * for writer-only's frames. */
+static bool setup(bench *b, const capture_opts *o, rs_err *err)
+{
+    const char *data = rs_data_dir(err);
     char demo[1200];
     if (data)
         snprintf(demo, sizeof demo, "%s/demos/dojo.rsr", data);
-    int status = RS_EXIT_FAIL;
-    plat *p = NULL;
-    run runs[16];
-    int nrun = 0;
-    if (!data || !rp_read(demo, &b.rp, &err))
-        goto done;
-    if (b.rp.ticks < b.start + (uint64_t)b.frames) {
-        rs_fail(&err, 1, "%s has %" PRIu64 " ticks; --frames %d from tick %" PRIu64 " needs more", demo, b.rp.ticks,
-                b.frames, b.start);
-        goto done;
-    }
+    if (!data || !rp_read(demo, &b->rp, err))
+        return false;
+    if (b->rp.ticks < b->start + (uint64_t)b->frames)
+        return rs_fail(err, JOB_ERR_TICKS, "%s has %" PRIu64 " ticks; --frames %d from tick %" PRIu64 " needs more", demo,
+                       b->rp.ticks, b->frames, b->start);
     cap_sink probe;
-    if (strcmp(sink, "null") && (!rs_mkdirs_for(outpath, &err) || !cap_sink_for(outpath, b.w, b.h, &probe, &err)))
-        goto done;
-    if (!(p = plat_create(&(plat_desc){.hidden = true}, &err)) || !(b.r = r_game_create_opts(&(r_game_opts){.q = quality->q}, &err)))
-        goto done;
-    b.mem = malloc(cap_frame_bytes(CAP_I420, b.w, b.h) * (size_t)b.frames);
-    if (!b.mem) {
-        rs_fail(&err, 1, "out of memory for %d frames", b.frames);
-        goto done;
-    }
-    if (!r_target_create(&b.t, b.sw, b.sh, &err))
-        goto done;
+    if (strcmp(o->sink, "null") && (!rs_mkdirs_for(b->out, err) || !cap_sink_for(b->out, b->w, b->h, &probe, err)))
+        return false;
+    if (!(b->p = plat_create(&(plat_desc){.hidden = true}, err)) ||
+        !(b->r = r_game_create_opts(&(r_game_opts){.q = o->quality->q}, err)))
+        return false;
+    b->mem = malloc(cap_frame_bytes(CAP_I420, b->w, b->h) * (size_t)b->frames);
+    if (!b->mem)
+        return rs_fail(err, JOB_ERR_NOMEM, "out of memory for %d frames", b->frames);
+    return r_target_create(&b->t, b->sw, b->sh, err);
+}
 
+/* The median of v[0..n-1] (sorted in place). */
+static double median(double *v, long n)
+{
+    for (long x = 1; x < n; x++) /* insertion sort: a handful of values */
+        for (long y = x; y > 0 && v[y] < v[y - 1]; y--) {
+            double t = v[y];
+            v[y] = v[y - 1];
+            v[y - 1] = t;
+        }
+    return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
+}
+
+/* Every configuration, interleaved, o->nrep times; each fps the median. */
+static bool measure(bench *b, const capture_opts *o, run *runs, int *nrun, rs_err *err)
+{
     /* frames for writer-only, captured once (not timed) */
     run prep = {.kind = 3, .mode = CAP_SEQUENTIAL, .ds = CAP_DS_GPU};
-    if (!do_run(&b, &prep, &err))
-        goto done;
-
-    runs[nrun++] = (run){.name = "render-only", .kind = 1};
-    runs[nrun++] = (run){.name = "writer-only", .kind = 2};
-    runs[nrun++] = (run){.name = "sequential", .mode = CAP_SEQUENTIAL};
+    if (!do_run(b, &prep, err))
+        return false;
+    int n = 0;
+    runs[n++] = (run){.name = "render-only", .kind = 1};
+    runs[n++] = (run){.name = "writer-only", .kind = 2};
+    runs[n++] = (run){.name = "sequential", .mode = CAP_SEQUENTIAL};
     const int pbos[3] = {1, 2, 3}, queues[3] = {0, 8, 120};
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
-            run *r = &runs[nrun++];
+            run *r = &runs[n++];
             *r = (run){.mode = CAP_ASYNC, .pbo = pbos[i], .queue = queues[j]};
             snprintf(r->name, sizeof r->name, "async pbo%d q%d", pbos[i], queues[j]);
         }
+    *nrun = n;
     /* the configurations interleaved, nrep times; each figure is the median */
-    for (int rep = 0; rep < nrep; rep++)
-        for (int i = 0; i < nrun; i++) {
-            if (!quiet && isatty(2))
-                fprintf(stderr, "\rbench capture: run %d of %ld, %-16s   ", rep + 1, nrep, runs[i].name);
-            if (!do_run(&b, &runs[i], &err))
-                goto done;
+    for (int rep = 0; rep < o->nrep; rep++)
+        for (int i = 0; i < n; i++) {
+            if (!o->quiet && isatty(2))
+                fprintf(stderr, "\rbench capture: run %d of %ld, %-16s   ", rep + 1, o->nrep, runs[i].name);
+            if (!do_run(b, &runs[i], err))
+                return false;
             runs[i].fps_each[rep] = runs[i].fps;
         }
-    for (int i = 0; i < nrun; i++) {
+    for (int i = 0; i < n; i++) {
         double v2[MAX_RUNS];
         memcpy(v2, runs[i].fps_each, sizeof v2);
-        for (int x = 1; x < nrep; x++) /* insertion sort: a handful of values */
-            for (int y = x; y > 0 && v2[y] < v2[y - 1]; y--) {
-                double t = v2[y];
-                v2[y] = v2[y - 1];
-                v2[y - 1] = t;
-            }
-        runs[i].fps = nrep % 2 ? v2[nrep / 2] : (v2[nrep / 2 - 1] + v2[nrep / 2]) / 2;
+        runs[i].fps = median(v2, o->nrep);
     }
-    if (!quiet && isatty(2))
+    if (!o->quiet && isatty(2))
         fprintf(stderr, "\r%60s\r", "");
+    return true;
+}
 
-    printf("bench capture: %d frames of demos/dojo.rsr, quality %s, drawn %dx%d, out %dx%d, sink %s, %s\n", b.frames,
-           quality->name, b.sw, b.sh,
-           b.w, b.h, sink, glcaps.renderer);
-    printf("fps: median of %ld interleaved runs; stage times and peaks: the last run\n", nrep);
+/* The table on standard output, with the ratios the benchmark is for. */
+static void print_table(const bench *b, const capture_opts *o, const run *runs, int nrun)
+{
+    printf("bench capture: %d frames of demos/dojo.rsr, quality %s, drawn %dx%d, out %dx%d, sink %s, %s\n", b->frames,
+           o->quality->name, b->sw, b->sh,
+           b->w, b->h, o->sink, glcaps.renderer);
+    printf("fps: median of %ld interleaved runs; stage times and peaks: the last run\n", o->nrep);
     printf("%-16s %7s %8s %8s %8s %8s %8s %8s %8s %5s %7s\n", "config", "fps", "render", "dscale", "readbk", "fence",
            "map+cp", "q-wait", "write", "hwm", "rss MB");
     for (int i = 0; i < nrun; i++) {
-        run *r = &runs[i];
-        double n = (double)b.frames;
+        const run *r = &runs[i];
+        double n = (double)b->frames;
         printf("%-16s %7.1f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %5d %7.0f\n", r->name, r->fps, r->ms_render,
                r->st.ms_downscale / n, r->st.ms_readback / n, r->st.ms_fence_wait / n, r->st.ms_map_copy / n,
                r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water, r->rss_mb);
     }
     printf("(ms per frame; render = simulate + draw calls on the game thread; write = writer thread in the sink)\n");
-    bool null_sink = !strcmp(sink, "null");
+    bool null_sink = !strcmp(o->sink, "null");
     double render_only = runs[0].fps, writer_only = null_sink ? 1e300 : runs[1].fps, seq = runs[2].fps;
     const run *def = &runs[3 + 1 * 3 + 2]; /* pbo 2, queue 120: the defaults */
     double slowest = render_only < writer_only ? render_only : writer_only;
@@ -336,47 +356,73 @@ int bench_capture(int argc, char **argv)
     else
         printf("async / min(render-only %.1f, writer-only %.1f fps):   %.2f   (goal >= 0.9)\n", render_only,
                writer_only, def->fps / slowest);
+}
+
+/* --csv and --chart. */
+static bool write_outputs(const bench *b, const capture_opts *o, run *runs, int nrun, rs_err *err)
+{
+    const char *csv = o->csv, *chart = o->chart, *sink = o->sink;
     if (csv && *csv) {
-        FILE *f = cli_bench_open("bench", csv, user_csv, overwrite);
+        FILE *f = cli_bench_open("bench", csv, o->user_csv, o->overwrite);
         bool ok = f != NULL;
         if (ok)
             ok = fprintf(f, "config,fps,render_ms,downscale_ms,readback_ms,fence_ms,map_copy_ms,queue_wait_ms,write_ms,"
                             "high_water,rss_mb,frames,render_w,render_h,w,h,sink\n") > 0;
         for (int i = 0; ok && i < nrun; i++) {
-            run *r = &runs[i];
-            double n = (double)b.frames;
+            const run *r = &runs[i];
+            double n = (double)b->frames;
             ok = fprintf(f, "%s,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%.0f,%d,%d,%d,%d,%d,%s\n", r->name, r->fps,
                          r->ms_render, r->st.ms_downscale / n, r->st.ms_readback / n, r->st.ms_fence_wait / n,
                          r->st.ms_map_copy / n, r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water,
-                         r->rss_mb, b.frames, b.sw, b.sh, b.w, b.h, sink) > 0;
+                         r->rss_mb, b->frames, b->sw, b->sh, b->w, b->h, sink) > 0;
         }
         if (f && cli_fclose(f) != 0)
             ok = false;
-        if (!ok) {
-            rs_fail(&err, 1, "%s: cannot write", csv);
-            goto done;
-        }
+        if (!ok)
+            return rs_fail(err, JOB_ERR_WRITE, "%s: cannot write", csv);
     }
     if (chart && *chart) {
+        bool null_sink = !strcmp(sink, "null");
+        const run *def = &runs[3 + 1 * 3 + 2];
         bench_bar bars[16];
         int nb = 0;
         for (int i = 0; i < nrun; i++)
             if (!(null_sink && runs[i].kind == 2))
                 bars[nb++] = (bench_bar){runs[i].name, runs[i].fps, &runs[i] == def || i == 2};
         char title[128];
-        snprintf(title, sizeof title, "capture fps, %dx%d to %dx%d, %s", b.sw, b.sh, b.w, b.h, sink);
+        snprintf(title, sizeof title, "capture fps, %dx%d to %dx%d, %s", b->sw, b->sh, b->w, b->h, sink);
         bench_chart bc = {title, "frames per second (fps), higher is better", "fps", bars, nb};
-        if (!bench_chart_write(chart, &bc, &err))
-            goto done;
+        if (!bench_chart_write(chart, &bc, err))
+            return false;
     }
-    status = RS_EXIT_OK;
-done:
+    return true;
+}
+
+int bench_capture(int argc, char **argv)
+{
+    bench b = {.frames = 300, .w = 640, .h = 360, .start = 600};
+    capture_opts o;
+    int status = parse_options(argc, argv, &b, &o);
+    if (status >= 0)
+        return status;
+    rs_err err = {0};
+    char outpath[64];
+    snprintf(outpath, sizeof outpath, !strcmp(o.sink, "null") ? "null:" : "out/bench-capture-scratch.%s", o.sink);
+    b.out = outpath;
+    run runs[16];
+    int nrun = 0;
+    status = RS_EXIT_FAIL;
+    if (setup(&b, &o, &err) && measure(&b, &o, runs, &nrun, &err)) {
+        print_table(&b, &o, runs, nrun);
+        if (write_outputs(&b, &o, runs, nrun, &err))
+            status = RS_EXIT_OK;
+    }
     if (status != RS_EXIT_OK)
         cli_error("bench", "%s", err.msg);
-    if (p) {
+    if (b.p) {
         r_target_destroy(&b.t);
         r_game_destroy(b.r);
-        plat_destroy(p);
+        plat_destroy(b.p);
     }
     free(b.mem);
     rp_free(&b.rp);

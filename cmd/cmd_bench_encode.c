@@ -30,6 +30,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 /* what is tried per codec: presets fast to slow, CRF points from high quality to low */
 typedef struct trial_set {
@@ -111,7 +112,7 @@ static bool render_frames(int frames, int sw, int sh, int w, int h, bool quiet, 
         return false;
     uint64_t first = rp.ticks >= 600 + (uint64_t)frames ? 600 : 0;
     if (rp.ticks < first + (uint64_t)frames) {
-        rs_fail(err, 1, "%s has %llu ticks, fewer than %d frames", demo, (unsigned long long)rp.ticks, frames);
+        rs_fail(err, JOB_ERR_TICKS, "%s has %llu ticks, fewer than %d frames", demo, (unsigned long long)rp.ticks, frames);
         goto done;
     }
     if (!(p = plat_create(&(plat_desc){.hidden = true}, err)) || !(r = r_game_create(err)) ||
@@ -252,13 +253,13 @@ int bench_encode(int argc, char **argv)
     uint8_t *back = malloc(fb * (size_t)frames);
     FILE *cf = NULL;
     if (!m.buf || !back) {
-        rs_fail(&err, 1, "out of memory for %ld frames of %dx%d", frames, w, h);
+        rs_fail(&err, JOB_ERR_NOMEM, "out of memory for %ld frames of %dx%d", frames, w, h);
         goto done;
     }
     if (!render_frames((int)frames, sw, sh, w, h, quiet, &m, &err))
         goto done;
     if (csv && !(cf = rs_mkdirs_for(csv, &err) ? fopen(csv, "w") : NULL)) {
-        rs_fail(&err, 1, "%s: cannot create", csv);
+        rs_fail(&err, JOB_ERR_CREATE, "%s: cannot create", csv);
         goto done;
     }
     if (cf)
@@ -305,12 +306,12 @@ int bench_encode(int argc, char **argv)
         bool wrote = fclose(cf) == 0;
         cf = NULL;
         if (!wrote) {
-            rs_fail(&err, 1, "%s: write failed", csv);
+            rs_fail(&err, JOB_ERR_WRITE, "%s: write failed", csv);
             goto done;
         }
     }
     if (!rows) {
-        rs_fail(&err, 1, "no encoder gave a result");
+        rs_fail(&err, JOB_ERR_NO_RESULT, "no encoder gave a result");
         goto done;
     }
     status = RS_EXIT_OK;

@@ -31,6 +31,7 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 /* The demos and the tick each one's frames start at: where its stage
  * shows what it has (the golden images' ticks, tests/test_render.c). */
@@ -214,7 +215,7 @@ static bool draw_frames(const char *data, int d, const config *c, int frames, in
      * llvmpipe compiles a program's code at its first draw */
     uint64_t first = demos[d].tick - FRAME_STEP, end = demos[d].tick + (uint64_t)FRAME_STEP * (uint64_t)(frames - 1) + 1;
     if (end > rp.ticks) {
-        rs_fail(err, 1, "%s: too short for %d frames from tick %" PRIu64, path, frames, demos[d].tick);
+        rs_fail(err, JOB_ERR_TICKS, "%s: too short for %d frames from tick %" PRIu64, path, frames, demos[d].tick);
         goto done;
     }
     if (!(r = r_game_create_opts(&(r_game_opts){.q = c->q, .quiet = true}, err)) || !r_game_prepare(r, rp.stage, err) ||
@@ -302,49 +303,69 @@ static int config_like(double scale, const r_quality *q)
     return -1;
 }
 
-int bench_quality(int argc, char **argv)
+/* What the command line asks for. */
+typedef struct quality_opts {
+    int w, h, frames;
+    bool use[NDEMOS];    /* the stages measured */
+    int nuse;
+    bool quiet, overwrite, user_csv, user_chart;
+    const char *csv, *chart;
+} quality_opts;
+
+/* The results, one a stage and configuration, and what they sum to. */
+typedef struct quality_res {
+    result (*res)[MAXCONFIGS];
+    double mean_ms[MAXCONFIGS], min_db[MAXCONFIGS], min_ssim[MAXCONFIGS];
+} quality_res;
+
+/* --stages a,b,...: the shipped demos to measure. */
+static bool parse_stages(quality_opts *o, const char *arg)
+{
+    for (int d = 0; d < NDEMOS; d++)
+        o->use[d] = false;
+    for (const char *p = arg; *p;) {
+        size_t k = strcspn(p, ",");
+        int found = -1;
+        for (int d = 0; d < NDEMOS; d++)
+            if (strlen(demos[d].name) == k && !strncmp(p, demos[d].name, k))
+                found = d;
+        if (found < 0) {
+            cli_error("bench", "--stages '%s': '%.*s' is not a shipped demo (dojo, harbor, mistvale, plaza, "
+                      "quarry, shallows, snowfield, temple)", arg, (int)k, p);
+            return false;
+        }
+        o->use[found] = true;
+        p += k + (p[k] == ',');
+    }
+    return true;
+}
+
+/* The command line into o, checked, and the configurations listed; -1 to
+ * go on, else the exit status. */
+static int parse_options(int argc, char **argv, quality_opts *o)
 {
     static const struct option opts[] = {{"size", required_argument, 0, 's'},   {"frames", required_argument, 0, 'f'},
                                          {"stages", required_argument, 0, 'S'}, {"csv", required_argument, 0, 'c'},
                                          {"chart", required_argument, 0, 'C'},  {"quiet", no_argument, 0, 'q'},
                                          {"help", no_argument, 0, 'h'},         {"overwrite", no_argument, 0, 'y'},
                                          {"no-overwrite", no_argument, 0, 'n'}, {0}};
-    int w = 640, h = 360, frames = 4, c;
-    long v;
-    bool use[NDEMOS], quiet = false, overwrite = false, user_csv = false, user_chart = false;
-    const char *csv = "out/bench-quality.csv", *chart = "out/bench-quality.png";
+    *o = (quality_opts){.w = 640, .h = 360, .frames = 4, .csv = "out/bench-quality.csv", .chart = "out/bench-quality.png"};
     for (int d = 0; d < NDEMOS; d++)
-        use[d] = true;
+        o->use[d] = true;
+    long v;
+    int c;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "hynq", opts, NULL)) != -1) {
         switch (c) {
-        case 's': if (!cli_out_size("--size", optarg, &w, &h)) return RS_EXIT_USAGE; break;
-        case 'f': if (!cli_int("--frames", optarg, 1, 30, &v)) return RS_EXIT_USAGE; frames = (int)v; break;
-        case 'S': {
-            for (int d = 0; d < NDEMOS; d++)
-                use[d] = false;
-            for (const char *p = optarg; *p;) {
-                size_t k = strcspn(p, ",");
-                int found = -1;
-                for (int d = 0; d < NDEMOS; d++)
-                    if (strlen(demos[d].name) == k && !strncmp(p, demos[d].name, k))
-                        found = d;
-                if (found < 0) {
-                    cli_error("bench", "--stages '%s': '%.*s' is not a shipped demo (dojo, harbor, mistvale, plaza, "
-                              "quarry, shallows, snowfield, temple)", optarg, (int)k, p);
-                    return RS_EXIT_USAGE;
-                }
-                use[found] = true;
-                p += k + (p[k] == ',');
-            }
-            break;
-        }
-        case 'c': csv = optarg; user_csv = true; break;
-        case 'C': chart = optarg; user_chart = true; break;
-        case 'q': quiet = true; break;
-        case 'y': overwrite = true; break;
-        case 'n': overwrite = false; break;
+        case 's': if (!cli_out_size("--size", optarg, &o->w, &o->h)) return RS_EXIT_USAGE; break;
+        case 'f': if (!cli_int("--frames", optarg, 1, 30, &v)) return RS_EXIT_USAGE; o->frames = (int)v; break;
+        case 'S': if (!parse_stages(o, optarg)) return RS_EXIT_USAGE; break;
+        case 'c': o->csv = optarg; o->user_csv = true; break;
+        case 'C': o->chart = optarg; o->user_chart = true; break;
+        case 'q': o->quiet = true; break;
+        case 'y': o->overwrite = true; break;
+        case 'n': o->overwrite = false; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }
@@ -360,80 +381,93 @@ int bench_quality(int argc, char **argv)
         if (config_like(r_presets[i].scale, &r_presets[i].q) < 0)
             configs[NCONFIGS++] = (config){r_presets[i].name, r_presets[i].scale, r_presets[i].q, 3};
     rs_err err = {0};
-    if (chart && *chart && !bench_chart_check(chart, &err)) {
+    if (o->chart && *o->chart && !bench_chart_check(o->chart, &err)) {
         cli_error("bench", "--chart %s", err.msg);
         return RS_EXIT_USAGE;
     }
-    if ((user_csv && *csv && strcmp(csv, "-") && !cli_out_ok("bench", csv, overwrite)) ||
-        (user_chart && *chart && !cli_out_ok("bench", chart, overwrite)))
+    if ((o->user_csv && *o->csv && strcmp(o->csv, "-") && !cli_out_ok("bench", o->csv, o->overwrite)) ||
+        (o->user_chart && *o->chart && !cli_out_ok("bench", o->chart, o->overwrite)))
         return RS_EXIT_USAGE;
+    for (int d = 0; d < NDEMOS; d++)
+        o->nuse += o->use[d];
+    return -1;
+}
 
-    int status = RS_EXIT_FAIL;
-    plat *p = NULL;
+/* Every configuration on every stage asked for, against the reference
+ * (configuration 0, drawn first); then the means and the worst stages. */
+static bool measure(const quality_opts *o, const char *data, quality_res *q, rs_err *err)
+{
+    int w = o->w, h = o->h, frames = o->frames;
     size_t fbytes = (size_t)w * h * 4 * (size_t)frames;
     uint8_t *ref = malloc(fbytes), *px = malloc(fbytes);
     float *ya = malloc((size_t)w * h * sizeof *ya), *yb = malloc((size_t)w * h * sizeof *yb);
-    result(*res)[MAXCONFIGS] = calloc(NDEMOS, sizeof *res);
-    const char *data = rs_data_dir(&err);
-    if (!ref || !px || !ya || !yb || !res) {
-        rs_fail(&err, 1, "out of memory");
-        goto done;
-    }
-    if (!data || !(p = plat_create(&(plat_desc){.hidden = true}, &err)))
-        goto done;
-    int nuse = 0;
-    for (int d = 0; d < NDEMOS; d++)
-        nuse += use[d];
+    bool ok = ref && px && ya && yb;
+    if (!ok)
+        rs_fail(err, JOB_ERR_NOMEM, "out of memory");
     double t_start = rs_now();
-    for (int d = 0, k = 0; d < NDEMOS; d++) {
-        if (!use[d])
+    for (int d = 0, k = 0; ok && d < NDEMOS; d++) {
+        if (!o->use[d])
             continue;
         k++;
-        for (int ci = 0; ci < NCONFIGS; ci++) {
-            result *rr = &res[d][ci];
-            if (!draw_frames(data, d, &configs[ci], frames, w, h, ci == 0 ? ref : px, &rr->ms, &err))
-                goto done;
+        for (int ci = 0; ok && ci < NCONFIGS; ci++) {
+            result *rr = &q->res[d][ci];
+            if (!(ok = draw_frames(data, d, &configs[ci], frames, w, h, ci == 0 ? ref : px, &rr->ms, err)))
+                break;
             if (ci == 0)
                 rr->psnr = 99, rr->ssim = 1;
             else
                 compare(px, ref, frames, w, h, ya, yb, &rr->psnr, &rr->ssim);
             rr->done = true;
-            if (!quiet)
+            if (!o->quiet)
                 fprintf(stderr, "bench quality: %s (%d/%d) %-22s %8.2f ms %7.2f dB  SSIM %.4f  [%.0f s]\n",
-                        demos[d].name, k, nuse, configs[ci].name, rr->ms, rr->psnr, rr->ssim, rs_now() - t_start);
+                        demos[d].name, k, o->nuse, configs[ci].name, rr->ms, rr->psnr, rr->ssim, rs_now() - t_start);
         }
     }
+    free(ref);
+    free(px);
+    free(ya);
+    free(yb);
+    for (int ci = 0; ok && ci < NCONFIGS; ci++) {
+        double sum = 0;
+        q->min_db[ci] = 99, q->min_ssim[ci] = 1;
+        for (int d = 0; d < NDEMOS; d++) {
+            if (!o->use[d])
+                continue;
+            sum += q->res[d][ci].ms;
+            q->min_db[ci] = fmin(q->min_db[ci], q->res[d][ci].psnr);
+            q->min_ssim[ci] = fmin(q->min_ssim[ci], q->res[d][ci].ssim);
+        }
+        q->mean_ms[ci] = sum / o->nuse;
+    }
+    return ok;
+}
 
-    /* the table: per configuration, mean ms and the worst stage */
+/* The table: per configuration, mean ms and the worst stage. */
+static void print_configs(const quality_opts *o, const quality_res *q)
+{
     printf("bench quality: %dx%d output, %d frames a stage (%d ticks apart), reference: 4x4 pixels per output\n"
            "pixel, every knob at full; ms: draw + box downscale, finished, median a frame, mean over stages\n",
-           w, h, frames, FRAME_STEP);
+           o->w, o->h, o->frames, FRAME_STEP);
     printf("%-22s %9s %7s %9s %9s", "configuration", "ms/frame", "fps", "min dB", "min SSIM");
     for (int d = 0; d < NDEMOS; d++)
-        if (use[d])
+        if (o->use[d])
             printf(" %9.9s", demos[d].name);
     printf("\n");
-    double mean_ms[MAXCONFIGS], min_db[MAXCONFIGS], min_ssim[MAXCONFIGS];
     for (int ci = 0; ci < NCONFIGS; ci++) {
-        double s = 0;
-        min_db[ci] = 99, min_ssim[ci] = 1;
-        for (int d = 0; d < NDEMOS; d++) {
-            if (!use[d])
-                continue;
-            s += res[d][ci].ms;
-            min_db[ci] = fmin(min_db[ci], res[d][ci].psnr);
-            min_ssim[ci] = fmin(min_ssim[ci], res[d][ci].ssim);
-        }
-        mean_ms[ci] = s / nuse;
-        printf("%-22s %9.2f %7.1f %9.2f %9.4f", configs[ci].name, mean_ms[ci], 1000 / mean_ms[ci], min_db[ci],
-               min_ssim[ci]);
+        printf("%-22s %9.2f %7.1f %9.2f %9.4f", configs[ci].name, q->mean_ms[ci], 1000 / q->mean_ms[ci], q->min_db[ci],
+               q->min_ssim[ci]);
         for (int d = 0; d < NDEMOS; d++)
-            if (use[d])
-                printf(" %9.2f", res[d][ci].psnr);
+            if (o->use[d])
+                printf(" %9.2f", q->res[d][ci].psnr);
         printf("\n");
     }
+}
 
-    /* the presets: the fastest candidate inside each budget */
+/* The presets: the fastest candidate inside each budget, against the
+ * shipped ones, and their frame rates per stage. */
+static void print_presets(const quality_opts *o, const quality_res *q)
+{
+    const double *mean_ms = q->mean_ms, *min_db = q->min_db;
     printf("\npresets (the fastest combination whose PSNR is inside the budget on every stage measured):\n");
     printf("%-10s %8s  %-22s %9s %9s  %s\n", "preset", "budget", "chosen", "ms/frame", "min dB", "shipped (r_quality.c)");
     int shipped[R_PRESETS];
@@ -457,42 +491,44 @@ int bench_quality(int argc, char **argv)
 
     /* each shipped preset's frame rate per stage, against the old default (2x, every knob at full) */
     int old = config_like(2, &(r_quality){0});
-    if (old >= 0) {
-        printf("\nfps per stage and preset, and the ratio to the old default (2x):\n%-10s", "stage");
-        for (int i = 0; i < R_PRESETS; i++)
-            printf(" %17s", r_presets[i].name);
-        printf(" %9s\n", "old (2x)");
-        for (int d = 0; d < NDEMOS; d++) {
-            if (!use[d])
-                continue;
-            printf("%-10s", demos[d].name);
-            for (int i = 0; i < R_PRESETS; i++) {
-                printf(" %8.1f (%5.2fx)", 1000 / res[d][shipped[i]].ms, res[d][old].ms / res[d][shipped[i]].ms);
-            }
-            printf(" %9.1f\n", 1000 / res[d][old].ms);
+    if (old < 0)
+        return;
+    printf("\nfps per stage and preset, and the ratio to the old default (2x):\n%-10s", "stage");
+    for (int i = 0; i < R_PRESETS; i++)
+        printf(" %17s", r_presets[i].name);
+    printf(" %9s\n", "old (2x)");
+    for (int d = 0; d < NDEMOS; d++) {
+        if (!o->use[d])
+            continue;
+        printf("%-10s", demos[d].name);
+        for (int i = 0; i < R_PRESETS; i++) {
+            printf(" %8.1f (%5.2fx)", 1000 / q->res[d][shipped[i]].ms, q->res[d][old].ms / q->res[d][shipped[i]].ms);
         }
+        printf(" %9.1f\n", 1000 / q->res[d][old].ms);
     }
+}
 
+/* --csv and --chart. */
+static bool write_outputs(const quality_opts *o, const quality_res *q, rs_err *err)
+{
+    const char *csv = o->csv, *chart = o->chart;
     if (csv && *csv) {
-        FILE *f = cli_bench_open("bench", csv, user_csv, overwrite);
-        if (!f) {
-            rs_fail(&err, 1, "%s: not written", csv);
-            goto done;
-        }
+        FILE *f = cli_bench_open("bench", csv, o->user_csv, o->overwrite);
+        if (!f)
+            return rs_fail(err, JOB_ERR_WRITE, "%s: not written", csv);
         fprintf(f, "stage,configuration,scale,aa,shadow_size,sil_size,mask_half,bloom_levels,lspsm_size,fog_size,water_grid,"
                    "ms_per_frame,psnr_db,ssim,frames,w,h\n");
         for (int d = 0; d < NDEMOS; d++)
-            for (int ci = 0; use[d] && ci < NCONFIGS; ci++) {
+            for (int ci = 0; o->use[d] && ci < NCONFIGS; ci++) {
                 const config *cf = &configs[ci];
+                const result *rr = &q->res[d][ci];
                 fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
                         cf->q.aa == R_AA_FXAA ? "fxaa" : "off", cf->q.shadow_size, cf->q.sil_size, cf->q.mask_half,
-                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, res[d][ci].ms,
-                        res[d][ci].psnr, res[d][ci].ssim, frames, w, h);
+                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, rr->ms, rr->psnr, rr->ssim,
+                        o->frames, o->w, o->h);
             }
-        if (cli_fclose(f) != 0) {
-            rs_fail(&err, 1, "%s: cannot write", csv);
-            goto done;
-        }
+        if (cli_fclose(f) != 0)
+            return rs_fail(err, JOB_ERR_WRITE, "%s: cannot write", csv);
     }
     if (chart && *chart) {
         bench_bar bars[MAXCONFIGS];
@@ -501,24 +537,40 @@ int bench_quality(int argc, char **argv)
             if (ci == 0)
                 snprintf(labels[ci], sizeof labels[ci], "%s", configs[ci].name);
             else
-                snprintf(labels[ci], sizeof labels[ci], "%s, %.1f dB", configs[ci].name, min_db[ci]);
-            bars[ci] = (bench_bar){labels[ci], 1000 / mean_ms[ci], configs[ci].kind & 1};
+                snprintf(labels[ci], sizeof labels[ci], "%s, %.1f dB", configs[ci].name, q->min_db[ci]);
+            bars[ci] = (bench_bar){labels[ci], 1000 / q->mean_ms[ci], configs[ci].kind & 1};
         }
         char title[160];
-        snprintf(title, sizeof title, "bench quality: frames per second at %dx%d and the worst stage's PSNR", w, h);
+        snprintf(title, sizeof title, "bench quality: frames per second at %dx%d and the worst stage's PSNR", o->w, o->h);
         bench_chart bc = {title, "frames per second (fps), draw and downscale, higher is better", "fps", bars, NCONFIGS};
-        if (!bench_chart_write(chart, &bc, &err))
-            goto done;
+        if (!bench_chart_write(chart, &bc, err))
+            return false;
     }
-    status = RS_EXIT_OK;
-done:
+    return true;
+}
+
+int bench_quality(int argc, char **argv)
+{
+    quality_opts o;
+    int status = parse_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    status = RS_EXIT_FAIL;
+    rs_err err = {0};
+    plat *p = NULL;
+    quality_res q = {.res = calloc(NDEMOS, sizeof *q.res)};
+    const char *data = rs_data_dir(&err);
+    if (!q.res)
+        rs_fail(&err, JOB_ERR_NOMEM, "out of memory");
+    else if (data && (p = plat_create(&(plat_desc){.hidden = true}, &err)) && measure(&o, data, &q, &err)) {
+        print_configs(&o, &q);
+        print_presets(&o, &q);
+        if (write_outputs(&o, &q, &err))
+            status = RS_EXIT_OK;
+    }
     if (status != RS_EXIT_OK)
         cli_error("bench", "%s", err.msg);
     plat_destroy(p);
-    free(ref);
-    free(px);
-    free(ya);
-    free(yb);
-    free(res);
+    free(q.res);
     return status;
 }

@@ -32,6 +32,7 @@
 #include "../runtime/render/r_target.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 #define MAX_RUNS 15
 #define NFRAMES 8 /* distinct synthetic frames */
@@ -241,7 +242,7 @@ static bool verify(bench *b, mode_res *m, rs_err *err)
     size_t n = (size_t)b->w * 4;
     uint8_t *row = malloc(n);
     if (!row)
-        return rs_fail(err, 1, "out of memory");
+        return rs_fail(err, JOB_ERR_NOMEM, "out of memory");
     rgl_check("bench upload: before verify");
     mv_csp csp;
     mv_csp_make(b->info.matrix, b->info.full_range, &csp);
@@ -249,7 +250,7 @@ static bool verify(bench *b, mode_res *m, rs_err *err)
         show_and_read(b, m, f % NSLOTS, ycc[f], row);
         if (!rgl_check("bench upload: verify")) {
             free(row);
-            return rs_fail(err, 1, "%s upload: GL errors while verifying the picture", mv_up_name(m->mode));
+            return rs_fail(err, JOB_ERR_GL, "%s upload: GL errors while verifying the picture", mv_up_name(m->mode));
         }
         double rgb[3];
         mv_csp_apply(&csp, ycc[f][0], ycc[f][1], ycc[f][2], rgb);
@@ -263,7 +264,7 @@ static bool verify(bench *b, mode_res *m, rs_err *err)
             black &= px[0] < 8 && px[1] < 8 && px[2] < 8;
             for (int ch = 0; ch < 3; ch++)
                 if (abs(px[ch] - want[ch]) > 4) {
-                    rs_fail(err, 1,
+                    rs_fail(err, JOB_ERR_VERIFY,
                             "%s upload: %s: pixel (%d, %d) is %d,%d,%d, expected about %d,%d,%d from Y/Cb/Cr "
                             "%d/%d/%d: the path is broken",
                             mv_up_name(m->mode), black ? "the frame drawn is black" : "wrong picture", x, b->h / 2,
@@ -316,7 +317,25 @@ static bool parse_modes(const char *arg, int *modes, int *n)
     return true;
 }
 
-int bench_upload(int argc, char **argv)
+/* One run of the benchmark: the options, the context, the results. */
+typedef struct upload {
+    bench b;
+    long frames, nrep;
+    int modes[MV_UP_COUNT], nmode;
+    const char *csv, *backend;
+    bool quiet, overwrite;
+    int nsync;                 /* frames of the synced runs */
+    plat *p;
+    mode_res res[MV_UP_COUNT];
+    int navail;
+    mode_res *any;             /* the first mode available (draws the floor), or NULL */
+    const mode_res *direct;    /* direct upload, if measured: the ratios' base */
+    double floor_ms;           /* draw only */
+    rs_err err;
+} upload;
+
+/* The command line into u, checked; -1 to go on, else the exit status. */
+static int parse_options(int argc, char **argv, upload *u)
 {
     static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
                                          {"modes", required_argument, 0, 'm'},  {"runs", required_argument, 0, 'R'},
@@ -324,31 +343,26 @@ int bench_upload(int argc, char **argv)
                                          {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
                                          {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
-    long frames = 300, nrep = 3;
-    bench b = {.w = 1280, .h = 768};
-    int modes[MV_UP_COUNT] = {MV_UP_DIRECT, MV_UP_PBO, MV_UP_PERSISTENT}, nmode = 3;
-    const char *csv = NULL, *backend = NULL;
-    bool quiet = false, overwrite = false;
     int c;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
         switch (c) {
-        case 'f': if (!cli_int("--frames", optarg, 1, 100000, &frames)) return RS_EXIT_USAGE; break;
-        case 's': if (!cli_size("--size", optarg, 8192, &b.w, &b.h)) return RS_EXIT_USAGE; break;
-        case 'm': if (!parse_modes(optarg, modes, &nmode)) return RS_EXIT_USAGE; break;
-        case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &nrep)) return RS_EXIT_USAGE; break;
-        case 'c': csv = optarg; break;
-        case 'y': overwrite = true; break;
-        case 'n': overwrite = false; break;
+        case 'f': if (!cli_int("--frames", optarg, 1, 100000, &u->frames)) return RS_EXIT_USAGE; break;
+        case 's': if (!cli_size("--size", optarg, 8192, &u->b.w, &u->b.h)) return RS_EXIT_USAGE; break;
+        case 'm': if (!parse_modes(optarg, u->modes, &u->nmode)) return RS_EXIT_USAGE; break;
+        case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &u->nrep)) return RS_EXIT_USAGE; break;
+        case 'c': u->csv = optarg; break;
+        case 'y': u->overwrite = true; break;
+        case 'n': u->overwrite = false; break;
         case 'b':
             if (strcmp(optarg, "egl") && strcmp(optarg, "osmesa") && strcmp(optarg, "auto")) {
                 cli_error("bench", "--backend '%s': expected egl or osmesa", optarg);
                 return RS_EXIT_USAGE;
             }
-            backend = optarg;
+            u->backend = optarg;
             break;
-        case 'q': quiet = true; break;
+        case 'q': u->quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }
@@ -357,100 +371,100 @@ int bench_upload(int argc, char **argv)
         cli_error("bench", "unexpected argument '%s'", argv[optind]);
         return cli_usage_error("bench");
     }
-    if (csv && *csv && !cli_out_ok("bench", csv, overwrite))
+    if (u->csv && *u->csv && !cli_out_ok("bench", u->csv, u->overwrite))
         return RS_EXIT_FAIL;
-    int nsync = (int)frames / 4;
-    if (nsync < 30)
-        nsync = 30;
-    if (nsync > frames)
-        nsync = (int)frames;
+    u->nsync = (int)u->frames / 4;
+    if (u->nsync < 30)
+        u->nsync = 30;
+    if (u->nsync > u->frames)
+        u->nsync = (int)u->frames;
+    return -1;
+}
 
-    b.info = (mv_info){.w = b.w, .h = b.h, .sx = 1, .sy = 1, .matrix = MV_BT709, .full_range = false,
-                       .chroma_loc = MV_CHROMA_LEFT, .fps_num = 60, .fps_den = 1, .sar_num = 1, .sar_den = 1,
-                       .frames = NFRAMES};
-    snprintf(b.info.codec, sizeof b.info.codec, "synthetic");
-    snprintf(b.info.pixfmt, sizeof b.info.pixfmt, "yuv420p");
-    mv_info_planes(&b.info);
-    b.bytes = mv_frame_bytes(&b.info);
-
-    rs_err err = {0};
-    int status = RS_EXIT_FAIL;
-    plat *p = NULL;
-    mode_res res[MV_UP_COUNT];
-    memset(res, 0, sizeof res);
+/* The synthetic frames, the context and the target; -1 to go on, else
+ * the exit status. */
+static int setup(upload *u)
+{
+    bench *b = &u->b;
+    b->info = (mv_info){.w = b->w, .h = b->h, .sx = 1, .sy = 1, .matrix = MV_BT709, .full_range = false,
+                        .chroma_loc = MV_CHROMA_LEFT, .fps_num = 60, .fps_den = 1, .sar_num = 1, .sar_den = 1,
+                        .frames = NFRAMES};
+    snprintf(b->info.codec, sizeof b->info.codec, "synthetic");
+    snprintf(b->info.pixfmt, sizeof b->info.pixfmt, "yuv420p");
+    mv_info_planes(&b->info);
+    b->bytes = mv_frame_bytes(&b->info);
     for (int k = 0; k < NFRAMES; k++) {
-        if (!(b.frames[k] = malloc(b.bytes))) {
-            rs_fail(&err, 1, "out of memory for %d frames of %zu bytes", NFRAMES, b.bytes);
-            goto done;
-        }
-        synth(&b.info, k, b.frames[k]);
+        if (!(b->frames[k] = malloc(b->bytes)))
+            return rs_fail(&u->err, JOB_ERR_NOMEM, "out of memory for %d frames of %zu bytes", NFRAMES, b->bytes), RS_EXIT_FAIL;
+        synth(&b->info, k, b->frames[k]);
     }
-    if (!(p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err))) {
-        status = cli_plat_status(&err);
-        goto done;
+    if (!(u->p = plat_create(&(plat_desc){.backend = u->backend, .hidden = true}, &u->err)))
+        return cli_plat_status(&u->err);
+    if (!u->quiet && *plat_fallback_reason(u->p))
+        fprintf(stderr, "ringside bench: egl unavailable, using %s: %s\n", plat_backend_name(u->p),
+                plat_fallback_reason(u->p));
+    if (b->w > glcaps.max_texture_size || b->h > glcaps.max_texture_size) {
+        rs_fail(&u->err, JOB_ERR_LIMIT, "--size %dx%d: this context's textures stop at %d", b->w, b->h,
+                glcaps.max_texture_size);
+        return RS_EXIT_USAGE;
     }
-    if (!quiet && *plat_fallback_reason(p))
-        fprintf(stderr, "ringside bench: egl unavailable, using %s: %s\n", plat_backend_name(p),
-                plat_fallback_reason(p));
-    if (b.w > glcaps.max_texture_size || b.h > glcaps.max_texture_size) {
-        rs_fail(&err, 1, "--size %dx%d: this context's textures stop at %d", b.w, b.h, glcaps.max_texture_size);
-        status = RS_EXIT_USAGE;
-        goto done;
-    }
-    if (!r_target_create(&b.t, b.w, b.h, &err))
-        goto done;
+    return r_target_create(&b->t, b->w, b->h, &u->err) ? -1 : RS_EXIT_FAIL;
+}
 
-    /* every mode: create (persistent may be unavailable), check the picture, warm up */
-    int navail = 0;
-    for (int i = 0; i < nmode; i++) {
-        mode_res *m = &res[i];
-        m->mode = modes[i];
+/* Every mode: create (persistent may be unavailable), check the picture, warm up. */
+static bool prepare_modes(upload *u)
+{
+    for (int i = 0; i < u->nmode; i++) {
+        mode_res *m = &u->res[i];
+        m->mode = u->modes[i];
         rs_err e = {0};
-        if (!(m->u = mv_up_create(&b.info, m->mode, NSLOTS, &e))) {
+        if (!(m->u = mv_up_create(&u->b.info, m->mode, NSLOTS, &e))) {
             if (e.code == MV_ERR_UNSUPPORTED && m->mode == MV_UP_PERSISTENT) {
                 snprintf(m->why, sizeof m->why, "%s", e.msg);
                 continue;
             }
-            err = e;
-            goto done;
+            u->err = e;
+            return false;
         }
-        if (!verify(&b, m, &err))
-            goto done;
-        run_mode(&b, m, 0, WARMUP, false, NULL);
+        if (!verify(&u->b, m, &u->err))
+            return false;
+        run_mode(&u->b, m, 0, WARMUP, false, NULL);
         m->avail = true;
-        navail++;
+        u->navail++;
     }
+    for (int i = 0; i < u->nmode && !u->any; i++)
+        if (u->res[i].avail)
+            u->any = &u->res[i];
+    return true;
+}
 
-    /* the modes interleaved, nrep times; each figure is the median */
-    double floor_each[MAX_RUNS], floor_ms = 0;
-    mode_res *any = NULL;
-    for (int i = 0; i < nmode && !any; i++)
-        if (res[i].avail)
-            any = &res[i];
-    for (int rep = 0; any && rep < nrep; rep++) {
-        floor_each[rep] = draw_only(&b, any, nsync);
-        for (int i = 0; i < nmode; i++) {
-            mode_res *m = &res[i];
+/* The modes interleaved, nrep times; each figure is the median. */
+static bool measure(upload *u)
+{
+    double floor_each[MAX_RUNS];
+    for (int rep = 0; u->any && rep < u->nrep; rep++) {
+        floor_each[rep] = draw_only(&u->b, u->any, u->nsync);
+        for (int i = 0; i < u->nmode; i++) {
+            mode_res *m = &u->res[i];
             if (!m->avail)
                 continue;
-            if (!quiet && isatty(2))
-                fprintf(stderr, "\rbench upload: run %d of %ld, %-10s   ", rep + 1, nrep, mv_up_name(m->mode));
-            run_mode(&b, m, 0, (int)frames, false, &m->s[rep]);
-            m->s[rep].synced = run_mode(&b, m, (int)frames, nsync, true, NULL);
-            if (!rgl_check("bench upload")) {
-                rs_fail(&err, 1, "%s upload: GL errors during the run", mv_up_name(m->mode));
-                goto done;
-            }
+            if (!u->quiet && isatty(2))
+                fprintf(stderr, "\rbench upload: run %d of %ld, %-10s   ", rep + 1, u->nrep, mv_up_name(m->mode));
+            run_mode(&u->b, m, 0, (int)u->frames, false, &m->s[rep]);
+            m->s[rep].synced = run_mode(&u->b, m, (int)u->frames, u->nsync, true, NULL);
+            if (!rgl_check("bench upload"))
+                return rs_fail(&u->err, JOB_ERR_GL, "%s upload: GL errors during the run", mv_up_name(m->mode));
         }
     }
-    if (any) {
+    long nrep = u->nrep;
+    if (u->any) {
         qsort(floor_each, (size_t)nrep, sizeof *floor_each, cmp_double);
-        floor_ms = nrep % 2 ? floor_each[nrep / 2] : (floor_each[nrep / 2 - 1] + floor_each[nrep / 2]) / 2;
+        u->floor_ms = nrep % 2 ? floor_each[nrep / 2] : (floor_each[nrep / 2 - 1] + floor_each[nrep / 2]) / 2;
     }
-    if (!quiet && isatty(2))
+    if (!u->quiet && isatty(2))
         fprintf(stderr, "\r%60s\r", "");
-    for (int i = 0; i < nmode; i++) {
-        mode_res *m = &res[i];
+    for (int i = 0; i < u->nmode; i++) {
+        mode_res *m = &u->res[i];
         if (!m->avail)
             continue;
         int n = (int)nrep;
@@ -459,19 +473,25 @@ int bench_upload(int argc, char **argv)
                           median_of(m->s, n, offsetof(sample, gl)),      median_of(m->s, n, offsetof(sample, fence)),
                           median_of(m->s, n, offsetof(sample, waits))};
     }
-    const mode_res *direct = NULL;
-    for (int i = 0; i < nmode; i++)
-        if (res[i].avail && res[i].mode == MV_UP_DIRECT)
-            direct = &res[i];
+    for (int i = 0; i < u->nmode; i++)
+        if (u->res[i].avail && u->res[i].mode == MV_UP_DIRECT)
+            u->direct = &u->res[i];
+    return true;
+}
 
+/* The table on standard output. */
+static void print_table(const upload *u)
+{
+    const bench *b = &u->b;
+    const mode_res *res = u->res, *direct = u->direct;
     printf("bench upload: %dx%d 4:2:0 (BT.709 limited) at 60 fps, %ld frames x %ld runs (synced: %d frames), "
            "medians\n",
-           b.w, b.h, frames, nrep, nsync);
-    printf("renderer: %s, GL %d.%d, %s (%s)\n", glcaps.renderer, glcaps.major, glcaps.minor, plat_backend_name(p),
-           plat_detail(p));
+           b->w, b->h, u->frames, u->nrep, u->nsync);
+    printf("renderer: %s, GL %d.%d, %s (%s)\n", glcaps.renderer, glcaps.major, glcaps.minor, plat_backend_name(u->p),
+           plat_detail(u->p));
     printf("%-11s %8s %8s %8s %8s %8s %8s %6s %7s %9s\n", "mode", "total", "synced", "produce", "copy", "GL", "fence",
            "waits", "fps", "vs direct");
-    for (int i = 0; i < nmode; i++) {
+    for (int i = 0; i < u->nmode; i++) {
         const mode_res *m = &res[i];
         if (!m->avail) {
             printf("%-11s unavailable: %s\n", mv_up_name(m->mode), m->why);
@@ -489,11 +509,11 @@ int bench_upload(int argc, char **argv)
            " fence = waiting for a busy persistent slot, waits = how often per run; vs direct = total / direct's;\n"
            " 60 fps leaves %.2f ms per frame)\n",
            1000.0 / 60);
-    if (any)
-        printf("draw only (the conversion draw, no upload, glFinish every frame): %.3f ms per frame\n", floor_ms);
-    if (navail > 1) {
+    if (u->any)
+        printf("draw only (the conversion draw, no upload, glFinish every frame): %.3f ms per frame\n", u->floor_ms);
+    if (u->navail > 1) {
         const mode_res *ft = NULL, *fs = NULL;
-        for (int i = 0; i < nmode; i++) {
+        for (int i = 0; i < u->nmode; i++) {
             const mode_res *m = &res[i];
             if (!m->avail)
                 continue;
@@ -505,49 +525,73 @@ int bench_upload(int argc, char **argv)
         printf("fastest: %s by throughput (%.3f ms), %s synced (%.3f ms)\n", mv_up_name(ft->mode), ft->med.total,
                mv_up_name(fs->mode), fs->med.synced);
     }
+}
 
-    if (csv && *csv) {
-        FILE *f = cli_text_open("bench", csv, overwrite);
-        bool ok = f && fprintf(f, "mode,available,width,height,frames,runs,synced_frames,total_ms,synced_ms,"
-                                  "produce_ms,copy_ms,gl_ms,fence_wait_ms,fence_waits,fps,vs_direct,draw_only_ms,backend,"
-                                  "renderer,note\n") > 0;
-        for (int i = 0; ok && i < nmode; i++) {
-            const mode_res *m = &res[i];
-            if (!m->avail) {
-                char fl[32] = "";
-                if (any)
-                    snprintf(fl, sizeof fl, "%.4f", floor_ms);
-                ok = fprintf(f, "%s,0,%d,%d,%ld,%ld,%d,,,,,,,,,,%s,%s,\"%s\",\"%s\"\n", mv_up_name(m->mode), b.w,
-                             b.h, frames, nrep, nsync, fl, plat_backend_name(p), glcaps.renderer, m->why) > 0;
-                continue;
-            }
-            char ratio[16] = "";
-            if (direct)
-                snprintf(ratio, sizeof ratio, "%.4f", m->med.total / direct->med.total);
-            ok = fprintf(f, "%s,1,%d,%d,%ld,%ld,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.0f,%.2f,%s,%.4f,%s,\"%s\",\n",
-                         mv_up_name(m->mode), b.w, b.h, frames, nrep, nsync, m->med.total, m->med.synced,
-                         m->med.produce, m->med.copy, m->med.gl, m->med.fence, m->med.waits, 1000.0 / m->med.total,
-                         ratio, floor_ms, plat_backend_name(p), glcaps.renderer) > 0;
+/* --csv: one row a mode. */
+static bool write_csv(upload *u)
+{
+    const bench *b = &u->b;
+    const char *backend = plat_backend_name(u->p);
+    FILE *f = cli_text_open("bench", u->csv, u->overwrite);
+    bool ok = f && fprintf(f, "mode,available,width,height,frames,runs,synced_frames,total_ms,synced_ms,"
+                              "produce_ms,copy_ms,gl_ms,fence_wait_ms,fence_waits,fps,vs_direct,draw_only_ms,backend,"
+                              "renderer,note\n") > 0;
+    for (int i = 0; ok && i < u->nmode; i++) {
+        const mode_res *m = &u->res[i];
+        if (!m->avail) {
+            char fl[32] = "";
+            if (u->any)
+                snprintf(fl, sizeof fl, "%.4f", u->floor_ms);
+            ok = fprintf(f, "%s,0,%d,%d,%ld,%ld,%d,,,,,,,,,,%s,%s,\"%s\",\"%s\"\n", mv_up_name(m->mode), b->w,
+                         b->h, u->frames, u->nrep, u->nsync, fl, backend, glcaps.renderer, m->why) > 0;
+            continue;
         }
-        if (f && cli_fclose(f) != 0)
-            ok = false;
-        if (!ok) {
-            if (!err.msg[0])
-                rs_fail(&err, 1, "%s: cannot write", csv);
-            goto done;
-        }
+        char ratio[16] = "";
+        if (u->direct)
+            snprintf(ratio, sizeof ratio, "%.4f", m->med.total / u->direct->med.total);
+        ok = fprintf(f, "%s,1,%d,%d,%ld,%ld,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.0f,%.2f,%s,%.4f,%s,\"%s\",\n",
+                     mv_up_name(m->mode), b->w, b->h, u->frames, u->nrep, u->nsync, m->med.total, m->med.synced,
+                     m->med.produce, m->med.copy, m->med.gl, m->med.fence, m->med.waits, 1000.0 / m->med.total,
+                     ratio, u->floor_ms, backend, glcaps.renderer) > 0;
     }
-    status = RS_EXIT_OK;
-done:
-    if (status != RS_EXIT_OK && err.msg[0])
-        cli_error("bench", "%s", err.msg);
-    if (p) {
+    if (f && cli_fclose(f) != 0)
+        ok = false;
+    if (!ok && !u->err.msg[0])
+        rs_fail(&u->err, JOB_ERR_WRITE, "%s: cannot write", u->csv);
+    return ok;
+}
+
+/* The modes measured, the table, the CSV. */
+static int run_modes(upload *u)
+{
+    if (!prepare_modes(u) || !measure(u))
+        return RS_EXIT_FAIL;
+    print_table(u);
+    return u->csv && *u->csv && !write_csv(u) ? RS_EXIT_FAIL : RS_EXIT_OK;
+}
+
+int bench_upload(int argc, char **argv)
+{
+    upload *u = calloc(1, sizeof *u);
+    if (!u)
+        return RS_EXIT_FAIL;
+    *u = (upload){.b = {.w = 1280, .h = 768}, .frames = 300, .nrep = 3,
+                  .modes = {MV_UP_DIRECT, MV_UP_PBO, MV_UP_PERSISTENT}, .nmode = 3};
+    int status = parse_options(argc, argv, u);
+    if (status < 0)
+        status = setup(u);
+    if (status < 0)
+        status = run_modes(u);
+    if (status != RS_EXIT_OK && u->err.msg[0])
+        cli_error("bench", "%s", u->err.msg);
+    if (u->p) {
         for (int i = 0; i < MV_UP_COUNT; i++)
-            mv_up_destroy(res[i].u);
-        r_target_destroy(&b.t);
-        plat_destroy(p);
+            mv_up_destroy(u->res[i].u);
+        r_target_destroy(&u->b.t);
+        plat_destroy(u->p);
     }
     for (int k = 0; k < NFRAMES; k++)
-        free(b.frames[k]);
+        free(u->b.frames[k]);
+    free(u);
     return status;
 }

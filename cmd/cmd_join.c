@@ -13,6 +13,7 @@
 #include "../runtime/util/rs_progress.h"
 #include "cli.h"
 #include "job_audio.h"
+#include "job_out.h"
 
 static void help(void)
 {
@@ -90,169 +91,205 @@ static void report_frames(void *ctx, uint64_t done, uint64_t total)
     cli_progress_fd(r->fd, done, total, &r->last);
 }
 
-int cmd_join(int argc, char **argv)
+static const struct option opts[] = {
+    {"output", required_argument, 0, 'o'},     {"segment", required_argument, 0, 'S'},
+    {"hashes", required_argument, 0, 'H'},     {"first", required_argument, 0, 'f'},
+    {"progress-fd", required_argument, 0, 'G'}, {"quiet", no_argument, 0, 'q'},
+    {"help", no_argument, 0, 'h'},
+    {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
+    {"progress", required_argument, 0, 'g'},   {"replay", required_argument, 0, 'R'},
+    {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
+    {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {0}};
+
+/* What the command line asks for. */
+typedef struct join_opts {
+    const char *out, *key, *hashes, *replay;
+    job_audio audio;
+    uint64_t first;
+    long progress_fd;
+    bool quiet, overwrite;
+    int progress;
+    int n;              /* the segments: paths[0..n-1] */
+    char *const *paths;
+} join_opts;
+
+/* One option; -1 to go on, else the exit status (--help: RS_EXIT_OK). */
+static int join_option(join_opts *o, int c, const char *arg, char **argv)
 {
-    static const struct option opts[] = {
-        {"output", required_argument, 0, 'o'},     {"segment", required_argument, 0, 'S'},
-        {"hashes", required_argument, 0, 'H'},     {"first", required_argument, 0, 'f'},
-        {"progress-fd", required_argument, 0, 'G'}, {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},
-        {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
-        {"progress", required_argument, 0, 'g'},   {"replay", required_argument, 0, 'R'},
-        {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
-        {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {0}};
-    const char *out = NULL, *key = NULL, *hashes = NULL, *replay = NULL;
-    job_audio audio = {0};
-    uint64_t first = 0;
-    long progress_fd = -1;
-    bool quiet = false, overwrite = false;
-    int progress = RS_PROGRESS_AUTO;
-    int c;
+    switch (c) {
+    case 'o': o->out = arg; return -1;
+    case 'S': o->key = arg; return -1;
+    case 'H': o->hashes = arg; return -1;
+    case 'f': return cli_u64("--first", arg, &o->first) ? -1 : RS_EXIT_USAGE;
+    case 'G': return cli_int("--progress-fd", arg, 3, 1023, &o->progress_fd) ? -1 : RS_EXIT_USAGE;
+    case 'q': o->quiet = true; return -1;
+    case 'h': help(); return RS_EXIT_OK;
+    case 'y': o->overwrite = true; return -1;
+    case 'n': o->overwrite = false; return -1;
+    case 'g': return cli_progress_mode("join", arg, &o->progress) ? -1 : RS_EXIT_USAGE;
+    case 'R': o->replay = arg; return -1;
+    case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS:
+        return job_audio_option(&o->audio, "join", c, arg) ? -1 : RS_EXIT_USAGE;
+    default: return cli_bad_option("join", argv);
+    }
+}
+
+/* The command line into o, checked; -1 to go on, else the exit status. */
+static int parse_options(int argc, char **argv, join_opts *o)
+{
+    *o = (join_opts){.progress_fd = -1, .progress = RS_PROGRESS_AUTO};
+    int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
-        switch (c) {
-        case 'o': out = optarg; break;
-        case 'S': key = optarg; break;
-        case 'H': hashes = optarg; break;
-        case 'f': if (!cli_u64("--first", optarg, &first)) return RS_EXIT_USAGE; break;
-        case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
-        case 'q': quiet = true; break;
-        case 'h': help(); return RS_EXIT_OK;
-        case 'y': overwrite = true; break;
-        case 'n': overwrite = false; break;
-        case 'g': if (!cli_progress_mode("join", optarg, &progress)) return RS_EXIT_USAGE; break;
-        case 'R': replay = optarg; break;
-        case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS:
-            if (!job_audio_option(&audio, "join", c, optarg))
-                return RS_EXIT_USAGE;
-            break;
-        default: return cli_bad_option("join", argv);
-        }
-    }
-    if (!key || !cap_seg_key_ok(key)) {
-        cli_error("join", key ? "--segment '%s': expected a key of 1 to 64 characters from A-Z a-z 0-9 . _ : -"
-                              : "--segment KEY is required%s",
-                  key ? key : "");
+    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1)
+        if ((status = join_option(o, c, optarg, argv)) >= 0)
+            return status;
+    if (!o->key || !cap_seg_key_ok(o->key)) {
+        cli_error("join", o->key ? "--segment '%s': expected a key of 1 to 64 characters from A-Z a-z 0-9 . _ : -"
+                                 : "--segment KEY is required%s",
+                  o->key ? o->key : "");
         return RS_EXIT_USAGE;
     }
-    if (!out || !cap_seg_format_of(out)) {
-        cli_error("join", out ? "-o %s: expected .mp4, .mkv or .webm" : "-o OUT is required%s", out ? out : "");
+    if (!o->out || !cap_seg_format_of(o->out)) {
+        cli_error("join", o->out ? "-o %s: expected .mp4, .mkv or .webm" : "-o OUT is required%s", o->out ? o->out : "");
         return RS_EXIT_USAGE;
     }
     if (optind >= argc) {
         cli_error("join", "no segments given");
         return cli_usage_error("join");
     }
-    if (!cli_out_ok("join", out, overwrite) || (hashes && strcmp(hashes, "-") && !cli_out_ok("join", hashes, overwrite)))
+    o->n = argc - optind;
+    o->paths = argv + optind;
+    job_out outs = {.cmd = "join", .overwrite = o->overwrite, .video = o->out, .hashes = o->hashes};
+    if (!job_out_check(&outs))
         return RS_EXIT_FAIL;
-    if (!replay && (audio.bitrate || audio.lufs)) {
+    if (!o->replay && (o->audio.bitrate || o->audio.lufs)) {
         cli_error("join", "--audio-bitrate and --loudness need --replay R (the sound comes from the replay)");
         return RS_EXIT_USAGE;
     }
-    rs_err err = {0};
-    cap_sink asink = {0}; /* the output as a render's sink: which codec, which bitrate */
+    return -1;
+}
+
+/* A join under way. */
+typedef struct join_run {
+    join_opts *o;
+    rs_err err;
+    cap_sink asink;     /* the output as a render's sink: which codec, which bitrate */
+    rp_replay rp;
+    cap_seg *segs;
+    uint64_t total;     /* frames in all segments */
+    join_report rep;
+} join_run;
+
+/* --replay: the segments' replay, and the sound of their ticks given to
+ * the join; -1 to go on, else the exit status. */
+static int join_sound(join_run *run, cap_join *j)
+{
+    join_opts *o = run->o;
+    const char *replay = o->replay;
+    uint64_t replay_fnv = 0;
+    if (!cap_seg_replay_fnv(replay, &replay_fnv, &run->err))
+        return RS_EXIT_FAIL;
+    for (int i = 0; i < o->n; i++)
+        if (run->segs[i].m.has_replay && run->segs[i].m.replay_fnv != replay_fnv) {
+            cli_error("join", "--replay %s: not the replay segment %d (%s) was rendered from (FNV-1a %016" PRIx64
+                              ", the manifest says %016" PRIx64 ")", replay, i, run->segs[i].path, replay_fnv, run->segs[i].m.replay_fnv);
+            return RS_EXIT_USAGE;
+        }
+    /* the whole job's sound, once: ticks first..end of the manifests */
+    uint64_t t0 = run->segs[0].m.first, t1 = t0 + run->total;
+    if (t1 > run->rp.ticks) {
+        cli_error("join", "--replay %s: %" PRIu64 " ticks, but the segments run to tick %" PRIu64 "; not their replay", replay,
+                  run->rp.ticks, t1);
+        return RS_EXIT_USAGE;
+    }
+    if (!job_audio_plan(&o->audio, &run->asink, &run->rp, replay, t0, t1, &run->err))
+        return RS_EXIT_FAIL;
+    cap_join_audio(j, &run->asink);
+    return -1;
+}
+
+/* The output first (a directory that is gone is the output's failure, not
+ * the segments'), then the segments checked, then the copy. */
+static int join_segments(join_run *run)
+{
+    join_opts *o = run->o;
+    cap_join *j = cap_join_open(&(cap_join_desc){.out = o->out, .hashes = o->hashes, .progress = report_frames, .ctx = &run->rep,
+                                                 .stop = &stop_requested},
+                                &run->err);
+    if (!j)
+        return RS_EXIT_FAIL;
+    cap_seg_want want = {.key = o->key, .format = cap_seg_format_of(o->out), .first = o->first, .hashes = o->hashes != NULL};
+    if (cap_seg_verify(run->segs, o->n, &want, report_bad, &run->rep) > 0) {
+        cap_join_close(j, false, NULL);
+        cli_error("join", "%s not written: bad segments", o->out);
+        return RS_EXIT_SEGMENT;
+    }
+    for (int i = 0; i < o->n; i++)
+        run->total += run->segs[i].m.frames;
+    int status = o->replay ? join_sound(run, j) : -1;
+    if (status >= 0) {
+        cap_join_close(j, false, NULL);
+        return status;
+    }
+    rs_progress_start(&run->rep.prog, "join", "frames", run->total, o->quiet ? RS_PROGRESS_OFF : (rs_progress_mode)o->progress);
+    cli_progress_fd(run->rep.fd, 0, run->total, &run->rep.last);
+    int bad = -1;
+    bool ok = cap_join_copy(j, run->segs, o->n, &bad, &run->err);
+    double secs = rs_progress_end(&run->rep.prog);
+    if (!ok && bad >= 0) {
+        report_bad(&run->rep, bad, &run->err);
+        cap_join_close(j, false, NULL);
+        cli_error("join", "%s not written: bad segments", o->out);
+        return RS_EXIT_SEGMENT;
+    }
+    if (!cap_join_close(j, ok, &run->err))
+        return RS_EXIT_FAIL;
+    char said[300];
+    job_audio_describe(&o->audio, &run->asink, said, sizeof said);
+    if (!o->quiet)
+        fprintf(stderr, "ringside join: wrote %s: %" PRIu64 " frames (ticks %" PRIu64 "..%" PRIu64 ") from %d segments in %.2f s%s\n",
+                o->out, run->total, run->segs[0].m.first, run->segs[0].m.first + run->total - 1, o->n, secs, said);
+    return RS_EXIT_OK;
+}
+
+int cmd_join(int argc, char **argv)
+{
+    join_opts o;
+    int status = parse_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    join_run run = {.o = &o, .rep = {.fd = (int)o.progress_fd}};
     bool usage;
-    audio.mode = replay ? JOB_AUDIO_ON : JOB_AUDIO_OFF;
-    if (replay && (!cap_sink_for(out, 16, 16, &asink, &err) || !job_audio_check(&audio, "join", &asink, &usage, &err))) {
-        if (err.msg[0])
-            cli_error("join", "%s", err.msg);
+    o.audio.mode = o.replay ? JOB_AUDIO_ON : JOB_AUDIO_OFF;
+    if (o.replay && (!cap_sink_for(o.out, 16, 16, &run.asink, &run.err) ||
+                     !job_audio_check(&o.audio, "join", &run.asink, &usage, &run.err))) {
+        if (run.err.msg[0])
+            cli_error("join", "%s", run.err.msg);
         return RS_EXIT_USAGE;
     }
-    rp_replay rp = {0};
-    if (replay && !rp_read(replay, &rp, &err)) {
-        cli_error("join", "%s", err.msg);
+    if (o.replay && !rp_read(o.replay, &run.rp, &run.err)) {
+        cli_error("join", "%s", run.err.msg);
         return RS_EXIT_USAGE;
     }
-    int n = argc - optind;
-    char *const *paths = argv + optind;
-    join_report rep = {.fd = (int)progress_fd};
-    cap_seg *segs = calloc((size_t)n, sizeof *segs);
-    if (!segs) {
-        cli_error("join", "out of memory for %d segments", n);
+    if (!(run.segs = calloc((size_t)o.n, sizeof *run.segs))) {
+        cli_error("join", "out of memory for %d segments", o.n);
         return RS_EXIT_FAIL;
     }
-    for (int i = 0; i < n; i++)
-        segs[i].path = paths[i];
-
+    for (int i = 0; i < o.n; i++)
+        run.segs[i].path = o.paths[i];
     stop_requested = 0;
     struct sigaction sa = {0}, old_int, old_term;
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, &old_int);
     sigaction(SIGTERM, &sa, &old_term);
-    int status = RS_EXIT_FAIL;
-    /* the output first: a directory that is gone is the output's failure, not the segments' */
-    cap_join *j = cap_join_open(&(cap_join_desc){.out = out, .hashes = hashes, .progress = report_frames, .ctx = &rep,
-                                                 .stop = &stop_requested},
-                                &err);
-    if (!j)
-        goto done;
-    cap_seg_want want = {.key = key, .format = cap_seg_format_of(out), .first = first, .hashes = hashes != NULL};
-    if (cap_seg_verify(segs, n, &want, report_bad, &rep) > 0) {
-        cap_join_close(j, false, NULL);
-        cli_error("join", "%s not written: bad segments", out);
-        status = RS_EXIT_SEGMENT;
-        goto done;
-    }
-    uint64_t total = 0;
-    for (int i = 0; i < n; i++)
-        total += segs[i].m.frames;
-    uint64_t replay_fnv = 0;
-    if (replay && !cap_seg_replay_fnv(replay, &replay_fnv, &err)) {
-        cap_join_close(j, false, NULL);
-        goto done;
-    }
-    for (int i = 0; replay && i < n; i++)
-        if (segs[i].m.has_replay && segs[i].m.replay_fnv != replay_fnv) {
-            cap_join_close(j, false, NULL);
-            cli_error("join", "--replay %s: not the replay segment %d (%s) was rendered from (FNV-1a %016" PRIx64
-                              ", the manifest says %016" PRIx64 ")", replay, i, segs[i].path, replay_fnv, segs[i].m.replay_fnv);
-            status = RS_EXIT_USAGE;
-            goto done;
-        }
-    if (replay) {
-        /* the whole job's sound, once: ticks first..end of the manifests */
-        uint64_t t0 = segs[0].m.first, t1 = t0 + total;
-        if (t1 > rp.ticks) {
-            cap_join_close(j, false, NULL);
-            cli_error("join", "--replay %s: %" PRIu64 " ticks, but the segments run to tick %" PRIu64 "; not their replay", replay,
-                      rp.ticks, t1);
-            status = RS_EXIT_USAGE;
-            goto done;
-        }
-        if (!job_audio_plan(&audio, &asink, &rp, replay, t0, t1, &err)) {
-            cap_join_close(j, false, NULL);
-            goto done;
-        }
-        cap_join_audio(j, &asink);
-    }
-    rs_progress_start(&rep.prog, "join", "frames", total, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
-    cli_progress_fd(rep.fd, 0, total, &rep.last);
-    int bad = -1;
-    bool ok = cap_join_copy(j, segs, n, &bad, &err);
-    double secs = rs_progress_end(&rep.prog);
-    if (!ok && bad >= 0) {
-        report_bad(&rep, bad, &err);
-        cap_join_close(j, false, NULL);
-        cli_error("join", "%s not written: bad segments", out);
-        status = RS_EXIT_SEGMENT;
-        goto done;
-    }
-    if (!cap_join_close(j, ok, &err))
-        goto done;
-    char said[300];
-    job_audio_describe(&audio, &asink, said, sizeof said);
-    if (!quiet)
-        fprintf(stderr, "ringside join: wrote %s: %" PRIu64 " frames (ticks %" PRIu64 "..%" PRIu64 ") from %d segments in %.2f s%s\n",
-                out, total, segs[0].m.first, segs[0].m.first + total - 1, n, secs, said);
-    status = RS_EXIT_OK;
-done:
+    status = join_segments(&run);
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
     if (status == RS_EXIT_FAIL)
-        cli_error("join", "%s", err.msg);
-    free(segs);
-    job_audio_free(&audio);
-    rp_free(&rp);
+        cli_error("join", "%s", run.err.msg);
+    free(run.segs);
+    job_audio_free(&o.audio);
+    rp_free(&run.rp);
     return status;
 }

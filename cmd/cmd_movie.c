@@ -26,6 +26,7 @@
 #include "../runtime/util/rs_hash.h"
 #include "../runtime/util/rs_img.h"
 #include "../runtime/util/rs_out.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -222,119 +223,136 @@ static void summary(mv_cmd *s, const lp_stats *ls)
     snd_summary("movie", s->out, src);
 }
 
-int cmd_movie(int argc, char **argv)
+static const struct option opts[] = {
+    {"dump", required_argument, 0, 'd'},    {"hashes", required_argument, 0, 'x'},
+    {"headless", no_argument, 0, 'H'},      {"ticks", required_argument, 0, 't'},
+    {"upload", required_argument, 0, 'u'},  {"matrix", required_argument, 0, 'm'},
+    {"range", required_argument, 0, 'r'},   {"size", required_argument, 0, 'z'},
+    {"fullscreen", no_argument, 0, 'f'},    {"loop", no_argument, 0, 'L'},
+    {"quiet", no_argument, 0, 'q'},         {"help", no_argument, 0, 'h'},
+    {"overwrite", no_argument, 0, 'y'},     {"no-overwrite", no_argument, 0, 'n'},
+    {"mute", no_argument, 0, 'M'},          {"volume", required_argument, 0, 'V'},
+    {"audio-out", required_argument, 0, 'A'}, {"audio-device", required_argument, 0, 'D'},
+    {0}};
+
+/* What the command line asks for, beyond what goes straight into mv_cmd. */
+typedef struct movie_opts {
+    bool quiet;
+    const char *hashes;
+    snd_opts snd;
+    plat_desc pd;
+} movie_opts;
+
+/* --upload, --matrix, --range: how the pictures are decoded and uploaded. */
+static bool picture_option(mv_cmd *s, int c, const char *arg)
 {
-    static const struct option opts[] = {
-        {"dump", required_argument, 0, 'd'},    {"hashes", required_argument, 0, 'x'},
-        {"headless", no_argument, 0, 'H'},      {"ticks", required_argument, 0, 't'},
-        {"upload", required_argument, 0, 'u'},  {"matrix", required_argument, 0, 'm'},
-        {"range", required_argument, 0, 'r'},   {"size", required_argument, 0, 'z'},
-        {"fullscreen", no_argument, 0, 'f'},    {"loop", no_argument, 0, 'L'},
-        {"quiet", no_argument, 0, 'q'},         {"help", no_argument, 0, 'h'},
-        {"overwrite", no_argument, 0, 'y'},     {"no-overwrite", no_argument, 0, 'n'},
-        {"mute", no_argument, 0, 'M'},          {"volume", required_argument, 0, 'V'},
-        {"audio-out", required_argument, 0, 'A'}, {"audio-device", required_argument, 0, 'D'},
-        {0}};
-    mv_cmd *s = calloc(1, sizeof *s);
-    if (!s)
-        return RS_EXIT_FAIL;
-    s->last_dumped = -1;
-    int c, status = RS_EXIT_USAGE;
+    if (c == 'u') {
+        if ((s->po.upload = mv_up_parse(arg)) >= 0)
+            return true;
+        cli_error("movie", "--upload '%s': expected pbo, direct or persistent", arg);
+    } else if (c == 'm') {
+        if (!strcmp(arg, "bt601") || !strcmp(arg, "601"))
+            s->po.matrix = MV_OVERRIDE_601;
+        else if (!strcmp(arg, "bt709") || !strcmp(arg, "709"))
+            s->po.matrix = MV_OVERRIDE_709;
+        else {
+            cli_error("movie", "--matrix '%s': expected bt601 or bt709", arg);
+            return false;
+        }
+        return true;
+    } else {
+        if (!strcmp(arg, "limited") || !strcmp(arg, "tv"))
+            s->po.range = MV_OVERRIDE_LIMITED;
+        else if (!strcmp(arg, "full") || !strcmp(arg, "pc"))
+            s->po.range = MV_OVERRIDE_FULL;
+        else {
+            cli_error("movie", "--range '%s': expected limited or full", arg);
+            return false;
+        }
+        return true;
+    }
+    return false;
+}
+
+/* One option; -1 to go on, else the exit status (--help: RS_EXIT_OK). */
+static int movie_option(mv_cmd *s, movie_opts *o, int c, const char *arg, char **argv)
+{
     long n;
-    bool quiet = false, fatal;
-    const char *hashes = NULL;
-    snd_opts snd = {0};
-    plat_desc pd = {.title = "ringside movie"};
+    switch (c) {
+    case 'd': s->dump = arg; s->headless = true; return -1;
+    case 'x': o->hashes = arg; s->headless = true; return -1;
+    case 'H': s->headless = true; return -1;
+    case 't':
+        if (!cli_int("--ticks", arg, 1, 1L << 40, &n))
+            return RS_EXIT_USAGE;
+        s->limit = n;
+        return -1;
+    case 'u': case 'm': case 'r': return picture_option(s, c, arg) ? -1 : RS_EXIT_USAGE;
+    case 'z': return cli_size("--size", arg, 8192, &s->w, &s->h) ? -1 : RS_EXIT_USAGE;
+    case 'f': o->pd.fullscreen = true; return -1;
+    case 'L': s->loop = true; return -1;
+    case 'q': o->quiet = true; return -1;
+    case 'y': s->overwrite = true; return -1;
+    case 'n': s->overwrite = false; return -1;
+    case 'M': o->snd.mute = true; return -1;
+    case 'V': return snd_volume_arg("movie", arg, &o->snd) ? -1 : RS_EXIT_USAGE;
+    case 'A': o->snd.wav = arg; return -1;
+    case 'D': o->snd.device = arg; return -1;
+    case 'h': help(); return RS_EXIT_OK;
+    default: return cli_bad_option("movie", argv);
+    }
+}
+
+/* The command line into s and o; -1 to go on, else the exit status. */
+static int parse_options(int argc, char **argv, mv_cmd *s, movie_opts *o)
+{
+    *o = (movie_opts){.pd = {.title = "ringside movie"}};
+    int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
-        switch (c) {
-        case 'd': s->dump = optarg; s->headless = true; break;
-        case 'x': hashes = optarg; s->headless = true; break;
-        case 'H': s->headless = true; break;
-        case 't':
-            if (!cli_int("--ticks", optarg, 1, 1L << 40, &n))
-                goto done;
-            s->limit = n;
-            break;
-        case 'u':
-            if ((s->po.upload = mv_up_parse(optarg)) < 0) {
-                cli_error("movie", "--upload '%s': expected pbo, direct or persistent", optarg);
-                goto done;
-            }
-            break;
-        case 'm':
-            if (!strcmp(optarg, "bt601") || !strcmp(optarg, "601"))
-                s->po.matrix = MV_OVERRIDE_601;
-            else if (!strcmp(optarg, "bt709") || !strcmp(optarg, "709"))
-                s->po.matrix = MV_OVERRIDE_709;
-            else {
-                cli_error("movie", "--matrix '%s': expected bt601 or bt709", optarg);
-                goto done;
-            }
-            break;
-        case 'r':
-            if (!strcmp(optarg, "limited") || !strcmp(optarg, "tv"))
-                s->po.range = MV_OVERRIDE_LIMITED;
-            else if (!strcmp(optarg, "full") || !strcmp(optarg, "pc"))
-                s->po.range = MV_OVERRIDE_FULL;
-            else {
-                cli_error("movie", "--range '%s': expected limited or full", optarg);
-                goto done;
-            }
-            break;
-        case 'z': if (!cli_size("--size", optarg, 8192, &s->w, &s->h)) goto done; break;
-        case 'f': pd.fullscreen = true; break;
-        case 'L': s->loop = true; break;
-        case 'q': quiet = true; break;
-        case 'y': s->overwrite = true; break;
-        case 'n': s->overwrite = false; break;
-        case 'M': snd.mute = true; break;
-        case 'V': if (!snd_volume_arg("movie", optarg, &snd)) goto done; break;
-        case 'A': snd.wav = optarg; break;
-        case 'D': snd.device = optarg; break;
-        case 'h': help(); status = RS_EXIT_OK; goto done;
-        default:
-            status = cli_bad_option("movie", argv);
-            goto done;
-        }
-    }
+    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1)
+        if ((status = movie_option(s, o, c, optarg, argv)) >= 0)
+            return status;
     if (optind != argc - 1) {
         cli_error("movie", optind >= argc ? "no movie file given" : "unexpected argument '%s'",
                   optind < argc ? argv[optind + 1] : "");
-        status = cli_usage_error("movie");
-        goto done;
+        return cli_usage_error("movie");
     }
     s->path = argv[optind];
     s->po.wait = s->headless;
-    status = RS_EXIT_FAIL;
+    return -1;
+}
+
+/* The outputs, the movie, the sound and the window or context; -1 to go
+ * on, else the exit status (the error in s->err). */
+static int movie_open(mv_cmd *s, movie_opts *o)
+{
     struct stat dst;
+    bool fatal;
     /* --dump DIR is created, as an output is, when the folder it is in exists */
     if (s->dump && stat(s->dump, &dst) != 0 && (!rs_out_check(s->dump, false, &s->err) || mkdir(s->dump, 0777) != 0)) {
         if (!s->err.msg[0])
-            rs_fail(&s->err, 1, "%s: cannot create: %s", s->dump, strerror(errno));
-        goto done;
+            rs_fail(&s->err, JOB_ERR_CREATE, "%s: cannot create: %s", s->dump, strerror(errno));
+        return RS_EXIT_FAIL;
     }
-    if (hashes && !(s->hashes = cli_text_open("movie", hashes, s->overwrite)))
-        goto done;
+    if (o->hashes && !(s->hashes = cli_text_open("movie", o->hashes, s->overwrite)))
+        return RS_EXIT_FAIL;
     /* A file we cannot play is reported as such, before any window opens. */
     mv_src *probe = mv_open(s->path, &s->err);
     if (!probe)
-        goto done;
+        return RS_EXIT_FAIL;
     mv_close(probe);
     /* a --audio-out that cannot be written stops us before anything plays */
-    if (!(s->out = snd_open("movie", &snd, s->headless, s->overwrite, &fatal)) && fatal)
-        goto done;
-    s->po.mute = snd.mute || !s->out; /* nothing to play it on: do not decode it */
-    pd.backend = s->headless ? NULL : "glfw";
-    pd.width = s->w ? s->w : 1280;
-    pd.height = s->h ? s->h : 720;
-    if (!(s->p = plat_create(&pd, &s->err))) {
-        status = cli_plat_status(&s->err);
-        goto done;
-    }
+    if (!(s->out = snd_open("movie", &o->snd, s->headless, s->overwrite, &fatal)) && fatal)
+        return RS_EXIT_FAIL;
+    s->po.mute = o->snd.mute || !s->out; /* nothing to play it on: do not decode it */
+    o->pd.backend = s->headless ? NULL : "glfw";
+    o->pd.width = s->w ? s->w : 1280;
+    o->pd.height = s->h ? s->h : 720;
+    if (!(s->p = plat_create(&o->pd, &s->err)))
+        return cli_plat_status(&s->err);
     if (!(s->mp = mv_player_open(s->path, &s->po, &s->err)))
-        goto done;
+        return RS_EXIT_FAIL;
     if (!s->w) {
         const mv_info *i = mv_player_info(s->mp);
         s->w = (int)((double)i->w * i->sar_num / i->sar_den + 0.5);
@@ -344,31 +362,48 @@ int cmd_movie(int argc, char **argv)
     }
     if (s->headless) {
         if (!r_target_create(&s->target, s->w, s->h, &s->err))
-            goto done;
-        if (!(s->px = malloc((size_t)s->w * s->h * 3))) {
-            rs_fail(&s->err, 1, "out of memory for a %dx%d frame", s->w, s->h);
-            goto done;
-        }
+            return RS_EXIT_FAIL;
+        if (!(s->px = malloc((size_t)s->w * s->h * 3)))
+            return rs_fail(&s->err, JOB_ERR_NOMEM, "out of memory for a %dx%d frame", s->w, s->h), RS_EXIT_FAIL;
     }
+    return -1;
+}
+
+/* The movie played, then the sound and the hash list closed. */
+static int movie_run(mv_cmd *s, const movie_opts *o)
+{
     lp_game g = {s, on_input, on_step, on_render, on_running};
     lp_stats ls;
     lp_run(&(lp_desc){.headless = s->headless}, &g, &ls);
-    if (!quiet && s->mp)
+    if (!o->quiet && s->mp)
         summary(s, &ls);
     if (s->failed)
-        goto done;
+        return RS_EXIT_FAIL;
     bool aok = snd_close("movie", s->out, true);
     s->out = NULL;
     if (!aok)
-        goto done;
+        return RS_EXIT_FAIL;
     if (s->hashes) {
-        bool hok = cli_text_close("movie", hashes, s->hashes);
+        bool hok = cli_text_close("movie", o->hashes, s->hashes);
         s->hashes = NULL;
         if (!hok)
-            goto done;
+            return RS_EXIT_FAIL;
     }
-    status = RS_EXIT_OK;
-done:
+    return RS_EXIT_OK;
+}
+
+int cmd_movie(int argc, char **argv)
+{
+    mv_cmd *s = calloc(1, sizeof *s);
+    if (!s)
+        return RS_EXIT_FAIL;
+    s->last_dumped = -1;
+    movie_opts o;
+    int status = parse_options(argc, argv, s, &o);
+    if (status < 0)
+        status = movie_open(s, &o);
+    if (status < 0)
+        status = movie_run(s, &o);
     if (status == RS_EXIT_FAIL && s->err.msg[0])
         cli_error("movie", "%s", s->err.msg);
     snd_close("movie", s->out, false);

@@ -28,6 +28,7 @@
 #include "../runtime/util/rs_img.h"
 #include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_progress.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -159,7 +160,7 @@ static bool ss_fit(play *s, int w, int h)
     s->ss_w = w, s->ss_h = h;
     while (rw > w || rh > h) {
         if (s->nss == 4 || !r_target_create(&s->ss[s->nss], rw, rh, &s->err))
-            return s->nss == 4 ? rs_fail(&s->err, 1, "%dx%d: too many halvings", rw, rh) : false;
+            return s->nss == 4 ? rs_fail(&s->err, JOB_ERR_LIMIT, "%dx%d: too many halvings", rw, rh) : false;
         s->nss++;
         if (rw <= 2 * w && rh <= 2 * h)
             break;
@@ -224,7 +225,7 @@ static bool screenshot(play *s, const char *path, rs_err *err)
         plat_size(s->p, &w, &h);
     uint8_t *px = malloc((size_t)w * h * 4);
     if (!px)
-        return rs_fail(err, 1, "out of memory for a %dx%d screenshot", w, h);
+        return rs_fail(err, JOB_ERR_NOMEM, "out of memory for a %dx%d screenshot", w, h);
     if (!draw_frame(s, s->target.fbo, 1.0f, w, h)) {
         free(px);
         return false;
@@ -301,194 +302,209 @@ static bool parse_kind(const char *opt, const char *arg, int *kind)
     return true;
 }
 
-int cmd_play(int argc, char **argv)
+static const struct option opts[] = {
+    {"p1", required_argument, 0, '1'},     {"p2", required_argument, 0, '2'},
+    {"stage", required_argument, 0, 't'},  {"seed", required_argument, 0, 'S'},
+    {"level", required_argument, 0, 'l'},  {"record", required_argument, 0, 'r'},
+    {"replay", required_argument, 0, 'R'}, {"seconds", required_argument, 0, 's'},
+    {"screenshot", required_argument, 0, 'o'}, {"size", required_argument, 0, 'z'},
+    {"fullscreen", no_argument, 0, 'f'},   {"no-vsync", no_argument, 0, 'v'},
+    {"headless", no_argument, 0, 'H'},     {"quiet", no_argument, 0, 'q'},
+    {"stage-file", required_argument, 0, 'T'}, {"passes", optional_argument, 0, 'P'},
+    {"hdr-format", required_argument, 0, 'X'},
+    {"audio-out", required_argument, 0, 'A'}, {"mute", no_argument, 0, 'M'},
+    {"volume", required_argument, 0, 'V'}, {"audio-device", required_argument, 0, 'D'},
+    {"quality", required_argument, 0, 'Q'}, {"help", no_argument, 0, 'h'}, {0}};
+
+/* What the command line asks for, beyond what goes straight into play. */
+typedef struct play_opts {
+    int stage;
+    long level, seconds;
+    uint64_t seed;
+    const char *record, *replay, *shot;
+    const char *audio_out, *audio_device;
+    bool headless, quiet, mute;
+    float volume;
+    r_game_opts go;
+    int passes;
+    plat_desc pd;
+} play_opts;
+
+/* One option; -1 to go on, else the exit status (--help: RS_EXIT_OK). */
+static int play_option(play *s, play_opts *o, int c, const char *arg, char **argv)
 {
-    static const struct option opts[] = {
-        {"p1", required_argument, 0, '1'},     {"p2", required_argument, 0, '2'},
-        {"stage", required_argument, 0, 't'},  {"seed", required_argument, 0, 'S'},
-        {"level", required_argument, 0, 'l'},  {"record", required_argument, 0, 'r'},
-        {"replay", required_argument, 0, 'R'}, {"seconds", required_argument, 0, 's'},
-        {"screenshot", required_argument, 0, 'o'}, {"size", required_argument, 0, 'z'},
-        {"fullscreen", no_argument, 0, 'f'},   {"no-vsync", no_argument, 0, 'v'},
-        {"headless", no_argument, 0, 'H'},     {"quiet", no_argument, 0, 'q'},
-        {"stage-file", required_argument, 0, 'T'}, {"passes", optional_argument, 0, 'P'},
-        {"hdr-format", required_argument, 0, 'X'},
-        {"audio-out", required_argument, 0, 'A'}, {"mute", no_argument, 0, 'M'},
-        {"volume", required_argument, 0, 'V'}, {"audio-device", required_argument, 0, 'D'},
-        {"quality", required_argument, 0, 'Q'}, {"help", no_argument, 0, 'h'}, {0}};
-    play *s = calloc(1, sizeof *s);
-    if (!s)
-        return RS_EXIT_FAIL;
+    int k;
+    switch (c) {
+    case '1': return parse_kind("--p1", arg, &s->kind[0]) ? -1 : RS_EXIT_USAGE;
+    case '2': return parse_kind("--p2", arg, &s->kind[1]) ? -1 : RS_EXIT_USAGE;
+    case 't': return cli_stage(arg, &o->stage) ? -1 : RS_EXIT_USAGE;
+    case 'S': return cli_u64("--seed", arg, &o->seed) ? -1 : RS_EXIT_USAGE;
+    case 'l': return cli_int("--level", arg, 0, 3, &o->level) ? -1 : RS_EXIT_USAGE;
+    case 'r': o->record = arg; return -1;
+    case 'R': o->replay = arg; return -1;
+    case 's': return cli_int("--seconds", arg, 1, 7 * 24 * 3600, &o->seconds) ? -1 : RS_EXIT_USAGE;
+    case 'o': o->shot = arg; return -1;
+    case 'z': return cli_out_size("--size", arg, &s->w, &s->h) ? -1 : RS_EXIT_USAGE;
+    case 'Q': return (s->quality = cli_quality("play", arg)) ? -1 : RS_EXIT_USAGE;
+    case 'f': o->pd.fullscreen = true; return -1;
+    case 'v': o->pd.no_vsync = true; return -1;
+    case 'H': o->headless = true; return -1;
+    case 'T': o->go.stage_file = arg; return -1;
+    case 'P': return cli_passes("play", arg, &o->passes) ? -1 : RS_EXIT_USAGE;
+    case 'X':
+        if (!cli_hdr_format(arg, &k))
+            return RS_EXIT_USAGE;
+        o->go.hdr_format = r_game_hdr_of(k);
+        return -1;
+    case 'q': o->quiet = true; return -1;
+    case 'A': o->audio_out = arg; return -1;
+    case 'M': o->mute = true; return -1;
+    case 'V': {
+        snd_opts so = {0}; /* the parsing movie and attract use */
+        if (!snd_volume_arg("play", arg, &so))
+            return RS_EXIT_USAGE;
+        o->volume = so.volume;
+        return -1;
+    }
+    case 'D': o->audio_device = arg; return -1;
+    case 'h': help(); return RS_EXIT_OK;
+    default: return cli_bad_option("play", argv);
+    }
+}
+
+/* The command line into s and o, checked; -1 to go on, else the exit status. */
+static int parse_options(int argc, char **argv, play *s, play_opts *o)
+{
     s->kind[0] = RP_HUMAN;
     s->kind[1] = RP_CPU;
     s->w = 1280;
     s->h = 720;
     s->quality = &r_presets[R_PRESET_DEFAULT];
-    int stage = 0, c, status = RS_EXIT_USAGE;
-    long level = 2, seconds = 0;
-    uint64_t seed = (uint64_t)time(NULL);
-    const char *record = NULL, *replay = NULL, *shot = NULL;
-    const char *audio_out = NULL, *audio_device = NULL;
-    bool headless = false, quiet = false, mute = false;
-    float volume = 1;
-    r_game_opts go = {0};
-    int passes = 0;
-    plat_desc pd = {.title = "ringside"};
-    rp_replay watch = {0};
-    rp_recorder rec;
+    *o = (play_opts){.level = 2, .seed = (uint64_t)time(NULL), .volume = 1, .pd = {.title = "ringside"}};
+    int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
-        switch (c) {
-        case '1': if (!parse_kind("--p1", optarg, &s->kind[0])) goto done; break;
-        case '2': if (!parse_kind("--p2", optarg, &s->kind[1])) goto done; break;
-        case 't': if (!cli_stage(optarg, &stage)) goto done; break;
-        case 'S': if (!cli_u64("--seed", optarg, &seed)) goto done; break;
-        case 'l': if (!cli_int("--level", optarg, 0, 3, &level)) goto done; break;
-        case 'r': record = optarg; break;
-        case 'R': replay = optarg; break;
-        case 's': if (!cli_int("--seconds", optarg, 1, 7 * 24 * 3600, &seconds)) goto done; break;
-        case 'o': shot = optarg; break;
-        case 'z': if (!cli_out_size("--size", optarg, &s->w, &s->h)) goto done; break;
-        case 'Q': if (!(s->quality = cli_quality("play", optarg))) goto done; break;
-        case 'f': pd.fullscreen = true; break;
-        case 'v': pd.no_vsync = true; break;
-        case 'H': headless = true; break;
-        case 'T': go.stage_file = optarg; break;
-        case 'P':
-            if (!cli_passes("play", optarg, &passes)) {
-                status = RS_EXIT_USAGE;
-                goto done;
-            }
-            break;
-        case 'X': {
-            int fmt;
-            if (!cli_hdr_format(optarg, &fmt)) {
-                status = RS_EXIT_USAGE;
-                goto done;
-            }
-            go.hdr_format = r_game_hdr_of(fmt);
-            break;
-        }
-        case 'q': quiet = true; break;
-        case 'A': audio_out = optarg; break;
-        case 'M': mute = true; break;
-        case 'V': {
-            snd_opts so = {0}; /* the parsing movie and attract use */
-            if (!snd_volume_arg("play", optarg, &so))
-                goto done;
-            volume = so.volume;
-            break;
-        }
-        case 'D': audio_device = optarg; break;
-        case 'h': help(); status = RS_EXIT_OK; goto done;
-        default:
-            status = cli_bad_option("play", argv);
-            goto done;
-        }
-    }
+    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1)
+        if ((status = play_option(s, o, c, optarg, argv)) >= 0)
+            return status;
     if (optind < argc) {
         cli_error("play", "unexpected argument '%s'", argv[optind]);
-        status = cli_usage_error("play");
-        goto done;
+        return cli_usage_error("play");
     }
-    if (shot) {
-        const char *dot = strrchr(shot, '.');
-        if (!dot || (strcmp(dot, ".png") && strcmp(dot, ".ppm"))) {
-            cli_error("play", "%s: unknown image extension (expected .png or .ppm)", shot);
-            goto done;
-        }
+    const char *dot = o->shot ? strrchr(o->shot, '.') : NULL;
+    if (o->shot && (!dot || (strcmp(dot, ".png") && strcmp(dot, ".ppm")))) {
+        cli_error("play", "%s: unknown image extension (expected .png or .ppm)", o->shot);
+        return RS_EXIT_USAGE;
     }
-    if (headless && !replay && !seconds) {
+    if (o->headless && !o->replay && !o->seconds) {
         cli_error("play", "--headless needs --seconds N or --replay FILE (nobody can close a headless game)");
-        goto done;
+        return RS_EXIT_USAGE;
     }
-    if (replay && record) {
+    if (o->replay && o->record) {
         cli_error("play", "--replay and --record together: the replay is already recorded");
-        goto done;
+        return RS_EXIT_USAGE;
     }
-    if (audio_out) {
-        const char *dot = strrchr(audio_out, '.');
-        if (!dot || strcmp(dot, ".wav")) {
-            cli_error("play", "--audio-out %s: expected a .wav file", audio_out);
-            goto done;
-        }
+    dot = o->audio_out ? strrchr(o->audio_out, '.') : NULL;
+    if (o->audio_out && (!dot || strcmp(dot, ".wav"))) {
+        cli_error("play", "--audio-out %s: expected a .wav file", o->audio_out);
+        return RS_EXIT_USAGE;
     }
-    status = RS_EXIT_FAIL;
-    if (replay) {
-        if (!rp_read(replay, &watch, &s->err))
-            goto done;
-        s->watch = &watch;
-        stage = watch.stage;
-        seed = watch.seed;
-    }
-    if (audio_out && !audio_open(s, audio_out, mute, volume, audio_device, headless, stage))
-        goto done;
-    pd.backend = headless ? NULL : "glfw";
-    pd.width = s->w;
-    pd.height = s->h;
-    pd.hidden = false;
-    s->p = plat_create(&pd, &s->err);
-    if (!s->p) {
-        status = cli_plat_status(&s->err);
-        goto done;
-    }
-    go.quiet = quiet;
-    go.q = s->quality->q;
-    s->r = r_game_create_opts(&go, &s->err);
-    if (!s->r || !r_game_prepare(s->r, stage, &s->err) ||
-        (headless && !r_target_create(&s->target, s->w, s->h, &s->err)))
-        goto done;
-    if (passes)
-        r_game_passes(s->r, passes == 2, stderr);
-    if (!audio_out && !audio_open(s, NULL, mute, volume, audio_device, headless, stage))
-        goto done;
-    g_init(&s->cur, stage, seed);
-    s->prev = s->cur;
-    g_ai_init(&s->ai[0], 0, (int)level, seed);
-    g_ai_init(&s->ai[1], 1, (int)level, seed + 1);
-    if (record) {
-        rp_rec_init(&rec, stage, seed, s->kind[0], s->kind[1]);
-        s->rec = &rec;
-    }
-    s->limit = seconds ? (uint64_t)seconds * G_HZ : 0;
-    if (!headless && !replay && s->kind[0] == RP_CPU && s->kind[1] == RP_CPU && !seconds && !quiet)
-        fprintf(stderr, "ringside play: CPU vs CPU; Escape quits\n");
+    return -1;
+}
 
+/* The replay watched, the sound, the window or context, the renderer and
+ * the game; -1 to go on, else the exit status (the error in s->err). */
+static int play_setup(play *s, play_opts *o, rp_replay *watch, rp_recorder *rec)
+{
+    if (o->replay) {
+        if (!rp_read(o->replay, watch, &s->err))
+            return RS_EXIT_FAIL;
+        s->watch = watch;
+        o->stage = watch->stage;
+        o->seed = watch->seed;
+    }
+    if (o->audio_out && !audio_open(s, o->audio_out, o->mute, o->volume, o->audio_device, o->headless, o->stage))
+        return RS_EXIT_FAIL;
+    o->pd.backend = o->headless ? NULL : "glfw";
+    o->pd.width = s->w;
+    o->pd.height = s->h;
+    o->pd.hidden = false;
+    if (!(s->p = plat_create(&o->pd, &s->err)))
+        return cli_plat_status(&s->err);
+    o->go.quiet = o->quiet;
+    o->go.q = s->quality->q;
+    s->r = r_game_create_opts(&o->go, &s->err);
+    if (!s->r || !r_game_prepare(s->r, o->stage, &s->err) ||
+        (o->headless && !r_target_create(&s->target, s->w, s->h, &s->err)))
+        return RS_EXIT_FAIL;
+    if (o->passes)
+        r_game_passes(s->r, o->passes == 2, stderr);
+    if (!o->audio_out && !audio_open(s, NULL, o->mute, o->volume, o->audio_device, o->headless, o->stage))
+        return RS_EXIT_FAIL;
+    g_init(&s->cur, o->stage, o->seed);
+    s->prev = s->cur;
+    g_ai_init(&s->ai[0], 0, (int)o->level, o->seed);
+    g_ai_init(&s->ai[1], 1, (int)o->level, o->seed + 1);
+    if (o->record) {
+        rp_rec_init(rec, o->stage, o->seed, s->kind[0], s->kind[1]);
+        s->rec = rec;
+    }
+    s->limit = o->seconds ? (uint64_t)o->seconds * G_HZ : 0;
+    return -1;
+}
+
+/* The game until it ends, then its outputs: the screenshot, the pass
+ * table, the recording, the summary and the WAV. */
+static int play_run(play *s, const play_opts *o)
+{
+    if (!o->headless && !o->replay && s->kind[0] == RP_CPU && s->kind[1] == RP_CPU && !o->seconds && !o->quiet)
+        fprintf(stderr, "ringside play: CPU vs CPU; Escape quits\n");
     /* the first frame compiles shaders and fills caches (a tenth of a
      * second and more): drawn here, it does not hold up the first ticks,
      * which would then come in a burst that the audio queue cannot hold */
-    if (!headless)
+    if (!o->headless)
         on_render(s, 1.0f);
     lp_game g = {s, on_input, on_step, on_render, on_running};
     lp_stats st;
-    lp_run(&(lp_desc){.headless = headless}, &g, &st);
-    if (s->failed)
-        goto done;
-    if (shot && !screenshot(s, shot, &s->err))
-        goto done;
-    if (passes)
+    lp_run(&(lp_desc){.headless = o->headless}, &g, &st);
+    if (s->failed || (o->shot && !screenshot(s, o->shot, &s->err)))
+        return RS_EXIT_FAIL;
+    if (o->passes)
         r_game_report(s->r, stderr);
-    if (s->rec && !rp_rec_save(s->rec, record, &s->err))
-        goto done;
-    if (!quiet) {
+    if (s->rec && !rp_rec_save(s->rec, o->record, &s->err))
+        return RS_EXIT_FAIL;
+    if (!o->quiet) {
         char audio[512];
         audio_summary(s, st.ticks, audio, sizeof audio);
         fprintf(stderr,
                 "ringside play: %" PRIu64 " ticks (%.1f s of game) in %.1f s, %" PRIu64 " frames, %" PRIu64
                 " late ticks, %" PRIu64 " stalls; rounds %d-%d%s%s%s\n",
                 st.ticks, st.ticks / (double)G_HZ, st.seconds, st.frames, st.late_ticks, st.stalls,
-                s->cur.f[0].rounds_won, s->cur.f[1].rounds_won, record ? "; recorded " : "", record ? record : "",
+                s->cur.f[0].rounds_won, s->cur.f[1].rounds_won, o->record ? "; recorded " : "", o->record ? o->record : "",
                 audio);
     }
     if (s->out) {
-        au_out *o = s->out;
+        au_out *out = s->out;
         s->out = NULL;
-        if (!au_out_close(o, true, &s->err))
-            goto done;
+        if (!au_out_close(out, true, &s->err))
+            return RS_EXIT_FAIL;
     }
-    status = RS_EXIT_OK;
-done:
+    return RS_EXIT_OK;
+}
+
+int cmd_play(int argc, char **argv)
+{
+    play *s = calloc(1, sizeof *s);
+    if (!s)
+        return RS_EXIT_FAIL;
+    play_opts o;
+    rp_replay watch = {0};
+    rp_recorder rec;
+    int status = parse_options(argc, argv, s, &o);
+    if (status < 0)
+        status = play_setup(s, &o, &watch, &rec);
+    if (status < 0)
+        status = play_run(s, &o);
     if (status == RS_EXIT_FAIL || (status == RS_EXIT_USAGE && s->err.msg[0]))
         cli_error("play", "%s", s->err.msg);
     if (s->p) {

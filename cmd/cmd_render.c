@@ -14,6 +14,7 @@
 #include "cli.h"
 #include "job_audio.h"
 #include "job_poster.h"
+#include "job_out.h"
 #include "job_render.h"
 #include "job_split.h"
 #include "../runtime/gl/rgl.h"
@@ -26,6 +27,7 @@
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_progress.h"
 #include "../runtime/util/rs_version.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -195,229 +197,493 @@ static void on_signal(int sig)
     stop_requested = 1;
 }
 
-int cmd_render(int argc, char **argv)
+static const struct option opts[] = {
+    {"output", required_argument, 0, 'o'},     {"size", required_argument, 0, 's'},
+    {"render-size", required_argument, 0, 'r'}, {"capture", required_argument, 0, 'c'},
+    {"downscale", required_argument, 0, 'd'},  {"pbo", required_argument, 0, 'p'},
+    {"queue", required_argument, 0, 'Q'},      {"hashes", required_argument, 0, 'H'},
+    {"backend", required_argument, 0, 'b'},    {"quiet", no_argument, 0, 'q'},
+    {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
+    {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
+    {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
+    {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
+    {"segment", required_argument, 0, 'S'},    {"help", no_argument, 0, 'h'},
+    {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
+    {"format", required_argument, 0, 'f'},     {"progress", required_argument, 0, 'g'},
+    {"codec", required_argument, 0, OPT_CODEC}, {"crf", required_argument, 0, OPT_CRF},
+    {"bitrate", required_argument, 0, OPT_BITRATE}, {"preset", required_argument, 0, OPT_PRESET},
+    {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
+    {"poster", required_argument, 0, 'O'},     {"quality", required_argument, 0, 'L'},
+    {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
+    {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
+    {"jobs", required_argument, 0, OPT_JOBS}, {0}};
+
+/* What the command line asks for. */
+typedef struct render_opts {
+    const char *replay, *out, *hashes, *backend, *segment, *format, *poster;
+    bool overwrite, quiet;
+    int progress;             /* rs_progress_mode, or RS_PROGRESS_AUTO */
+    cap_desc cd;
+    cap_enc enc;
+    job_audio audio;
+    const r_preset *quality;
+    r_game_opts go;
+    int passes;               /* 1 summary, 2 per frame */
+    long first, end;          /* --ticks; end -1: the whole replay */
+    long progress_fd;
+    int jobs;                 /* 0: auto */
+    cap_pixfmt fmt;           /* RGBA for an image pattern, else I420 */
+    char seg_hashes[1100], seg_manifest[1100];
+} render_opts;
+
+/* Picks one of two words for an option: *out = the value of the one given. */
+static bool word2(const char *opt, const char *arg, const char *a, int va, const char *b, int vb, int *out)
 {
-    static const struct option opts[] = {
-        {"output", required_argument, 0, 'o'},     {"size", required_argument, 0, 's'},
-        {"render-size", required_argument, 0, 'r'}, {"capture", required_argument, 0, 'c'},
-        {"downscale", required_argument, 0, 'd'},  {"pbo", required_argument, 0, 'p'},
-        {"queue", required_argument, 0, 'Q'},      {"hashes", required_argument, 0, 'H'},
-        {"backend", required_argument, 0, 'b'},    {"quiet", no_argument, 0, 'q'},
-        {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
-        {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
-        {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
-        {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
-        {"segment", required_argument, 0, 'S'},    {"help", no_argument, 0, 'h'},
-        {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
-        {"format", required_argument, 0, 'f'},     {"progress", required_argument, 0, 'g'},
-        {"codec", required_argument, 0, OPT_CODEC}, {"crf", required_argument, 0, OPT_CRF},
-        {"bitrate", required_argument, 0, OPT_BITRATE}, {"preset", required_argument, 0, OPT_PRESET},
-        {"pix-fmt", required_argument, 0, OPT_PIXFMT}, {"hw", required_argument, 0, OPT_HW},
-        {"poster", required_argument, 0, 'O'},     {"quality", required_argument, 0, 'L'},
-        {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
-        {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
-        {"jobs", required_argument, 0, OPT_JOBS}, {0}};
-    cap_enc enc = {0};
-    job_audio audio = {0};
-    const char *out = NULL, *hashes = NULL, *backend = NULL, *segment = NULL, *format = NULL, *poster_path = NULL;
-    bool overwrite = false;
-    int progress = RS_PROGRESS_AUTO;
-    cap_desc cd = {.w = 640, .h = 360};
-    const r_preset *quality = &r_presets[R_PRESET_DEFAULT];
-    bool quiet = false;
-    r_game_opts go = {0};
-    int passes = 0; /* 1 summary, 2 per frame */
-    long first = 0, end = -1; /* --ticks; end -1: the whole replay */
-    long progress_fd = -1;
+    if (!strcmp(arg, a))
+        *out = va;
+    else if (!strcmp(arg, b))
+        *out = vb;
+    else {
+        cli_error("render", "%s '%s': expected %s or %s", opt, arg, a, b);
+        return false;
+    }
+    return true;
+}
+
+/* --ticks A:B */
+static bool parse_ticks(render_opts *o, const char *arg)
+{
+    char *colon = strchr(arg, ':'), a[32];
+    if (!colon || (size_t)(colon - arg) >= sizeof a) {
+        cli_error("render", "--ticks '%s': expected A:B, such as 600:660", arg);
+        return false;
+    }
+    memcpy(a, arg, (size_t)(colon - arg));
+    a[colon - arg] = 0;
+    if (!cli_int("--ticks start", a, 0, 100000000, &o->first) || !cli_int("--ticks end", colon + 1, 1, 100000000, &o->end))
+        return false;
+    if (o->end <= o->first) {
+        cli_error("render", "--ticks '%s': the end must be after the start", arg);
+        return false;
+    }
+    return true;
+}
+
+/* The encoder's options (long only). */
+static bool encoder_option(cap_enc *enc, int c, const char *arg)
+{
     long v;
-    int c, jobs = 0; /* 0: auto */
-    optind = 1;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
-        switch (c) {
-        case 'o': out = optarg; break;
-        case 's': if (!cli_out_size("--size", optarg, &cd.w, &cd.h)) return RS_EXIT_USAGE; break;
-        case 'r': if (!cli_size("--render-size", optarg, R_RENDER_MAX, &cd.src_w, &cd.src_h)) return RS_EXIT_USAGE; break;
-        case 'L': if (!(quality = cli_quality("render", optarg))) return RS_EXIT_USAGE; break;
-        case 'c':
-            if (!strcmp(optarg, "async"))
-                cd.mode = CAP_ASYNC;
-            else if (!strcmp(optarg, "sequential"))
-                cd.mode = CAP_SEQUENTIAL;
-            else {
-                cli_error("render", "--capture '%s': expected async or sequential", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case 'd':
-            if (!strcmp(optarg, "gpu"))
-                cd.downscale = CAP_DS_GPU;
-            else if (!strcmp(optarg, "cpu"))
-                cd.downscale = CAP_DS_CPU;
-            else {
-                cli_error("render", "--downscale '%s': expected gpu or cpu", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case 'p': if (!cli_int("--pbo", optarg, 1, CAP_MAX_PBO, &v)) return RS_EXIT_USAGE; cd.pbo = (int)v; break;
-        case 'Q':
-            if (!cli_int("--queue", optarg, 0, 1000, &v))
-                return RS_EXIT_USAGE;
-            cd.queue = (int)v;
-            cd.no_writer = v == 0;
-            break;
-        case 'F':
-            if (!cap_filter_parse(optarg, &cd.filter)) {
-                cli_error("render", "--filter '%s': expected box, bilinear, nearest or lanczos3", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case 'T': go.stage_file = optarg; break;
-        case 'P':
-            if (!cli_passes("render", optarg, &passes))
-                return RS_EXIT_USAGE;
-            break;
-        case 'M': go.mask = true; break;
-        case 'U': go.no_hud = true; break;
-        case 'X': {
-            int fmt;
-            if (!cli_hdr_format(optarg, &fmt))
-                return RS_EXIT_USAGE;
-            go.hdr_format = r_game_hdr_of(fmt);
-            break;
-        }
-        case 'K': {
-            char *colon = strchr(optarg, ':'), a[32];
-            if (!colon || (size_t)(colon - optarg) >= sizeof a) {
-                cli_error("render", "--ticks '%s': expected A:B, such as 600:660", optarg);
-                return RS_EXIT_USAGE;
-            }
-            memcpy(a, optarg, (size_t)(colon - optarg));
-            a[colon - optarg] = 0;
-            if (!cli_int("--ticks start", a, 0, 100000000, &first) ||
-                !cli_int("--ticks end", colon + 1, 1, 100000000, &end))
-                return RS_EXIT_USAGE;
-            if (end <= first) {
-                cli_error("render", "--ticks '%s': the end must be after the start", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        }
-        case 'H': hashes = optarg; break;
-        case 'S':
-            if (!cap_seg_key_ok(optarg)) {
-                cli_error("render", "--segment '%s': expected a key of 1 to %d characters from A-Z a-z 0-9 . _ : -", optarg,
-                          CAP_SEG_KEY_MAX);
-                return RS_EXIT_USAGE;
-            }
-            segment = optarg;
-            break;
-        case 'b': backend = optarg; break;
-        case 'q': quiet = true; break;
-        case 'G': if (!cli_int("--progress-fd", optarg, 3, 1023, &progress_fd)) return RS_EXIT_USAGE; break;
-        case 'h': help(); return RS_EXIT_OK;
-        case 'y': overwrite = true; break;
-        case 'n': overwrite = false; break;
-        case 'f': format = optarg; break;
-        case 'g': if (!cli_progress_mode("render", optarg, &progress)) return RS_EXIT_USAGE; break;
-        case OPT_CODEC:
-            if (!cap_codec_parse(optarg, &enc.codec)) {
-                cli_error("render", "--codec '%s': expected h264, hevc, vp9 or av1", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case OPT_CRF: if (!cli_int("--crf", optarg, 1, 255, &v)) return RS_EXIT_USAGE; enc.crf = (int)v; break;
-        case OPT_BITRATE:
-            if (!cap_bitrate_parse(optarg, &enc.bitrate)) {
-                cli_error("render", "--bitrate '%s': expected bits a second such as 4M, 800k or 2500000 (10k..1000M)", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case OPT_PRESET: snprintf(enc.preset, sizeof enc.preset, "%s", optarg); break;
-        case OPT_PIXFMT:
-            if (!cap_chroma_parse(optarg, &enc.chroma)) {
-                cli_error("render", "--pix-fmt '%s': expected yuv420p or yuv444p", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case OPT_HW:
-            if (!cap_hw_parse(optarg, &enc.hw)) {
-                cli_error("render", "--hw '%s': expected auto, off, nvenc or vaapi", optarg);
-                return RS_EXIT_USAGE;
-            }
-            break;
-        case 'O': poster_path = optarg; break;
-        case OPT_JOBS:
-            if (!strcmp(optarg, "auto"))
-                jobs = 0;
-            else if (!cli_int("--jobs", optarg, 1, JOB_SPLIT_MAX, &v))
-                return RS_EXIT_USAGE;
-            else
-                jobs = (int)v;
-            break;
-        case JOB_AUDIO_OPT_AUDIO: case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS: case JOB_AUDIO_OPT_WAV:
-            if (!job_audio_option(&audio, "render", c, optarg))
-                return RS_EXIT_USAGE;
-            break;
-        default: return cli_bad_option("render", argv);
-        }
+    switch (c) {
+    case OPT_CODEC:
+        if (cap_codec_parse(arg, &enc->codec))
+            return true;
+        cli_error("render", "--codec '%s': expected h264, hevc, vp9 or av1", arg);
+        return false;
+    case OPT_CRF: if (!cli_int("--crf", arg, 1, 255, &v)) return false; enc->crf = (int)v; return true;
+    case OPT_BITRATE:
+        if (cap_bitrate_parse(arg, &enc->bitrate))
+            return true;
+        cli_error("render", "--bitrate '%s': expected bits a second such as 4M, 800k or 2500000 (10k..1000M)", arg);
+        return false;
+    case OPT_PRESET: snprintf(enc->preset, sizeof enc->preset, "%s", arg); return true;
+    case OPT_PIXFMT:
+        if (cap_chroma_parse(arg, &enc->chroma))
+            return true;
+        cli_error("render", "--pix-fmt '%s': expected yuv420p or yuv444p", arg);
+        return false;
+    default: /* OPT_HW */
+        if (cap_hw_parse(arg, &enc->hw))
+            return true;
+        cli_error("render", "--hw '%s': expected auto, off, nvenc or vaapi", arg);
+        return false;
     }
-    if (optind + 1 != argc) {
-        cli_error("render", optind >= argc ? "a REPLAY file is required" : "unexpected argument '%s'",
-                  argv[argc - 1]);
-        return cli_usage_error("render");
+}
+
+/* How the frames are drawn and captured. */
+static bool picture_option(render_opts *o, int c, const char *arg)
+{
+    cap_desc *cd = &o->cd;
+    long v;
+    int k;
+    switch (c) {
+    case 's': return cli_out_size("--size", arg, &cd->w, &cd->h);
+    case 'r': return cli_size("--render-size", arg, R_RENDER_MAX, &cd->src_w, &cd->src_h);
+    case 'L': return (o->quality = cli_quality("render", arg)) != NULL;
+    case 'c':
+        if (!word2("--capture", arg, "async", CAP_ASYNC, "sequential", CAP_SEQUENTIAL, &k))
+            return false;
+        cd->mode = (cap_mode)k;
+        return true;
+    case 'd':
+        if (!word2("--downscale", arg, "gpu", CAP_DS_GPU, "cpu", CAP_DS_CPU, &k))
+            return false;
+        cd->downscale = (cap_downscale)k;
+        return true;
+    case 'p': if (!cli_int("--pbo", arg, 1, CAP_MAX_PBO, &v)) return false; cd->pbo = (int)v; return true;
+    case 'Q':
+        if (!cli_int("--queue", arg, 0, 1000, &v))
+            return false;
+        cd->queue = (int)v;
+        cd->no_writer = v == 0;
+        return true;
+    case 'F':
+        if (cap_filter_parse(arg, &cd->filter))
+            return true;
+        cli_error("render", "--filter '%s': expected box, bilinear, nearest or lanczos3", arg);
+        return false;
+    case 'T': o->go.stage_file = arg; return true;
+    case 'P': return cli_passes("render", arg, &o->passes);
+    case 'M': o->go.mask = true; return true;
+    case 'U': o->go.no_hud = true; return true;
+    default: /* 'X' */
+        if (!cli_hdr_format(arg, &k))
+            return false;
+        o->go.hdr_format = r_game_hdr_of(k);
+        return true;
     }
-    if (!out) {
+}
+
+/* One option; -1 to go on, else the exit status (--help: RS_EXIT_OK). */
+static int render_option(render_opts *o, int c, const char *arg, char **argv)
+{
+    long v;
+    switch (c) {
+    case 's': case 'r': case 'L': case 'c': case 'd': case 'p': case 'Q': case 'F': case 'T': case 'P': case 'M': case 'U':
+    case 'X':
+        return picture_option(o, c, arg) ? -1 : RS_EXIT_USAGE;
+    case OPT_CODEC: case OPT_CRF: case OPT_BITRATE: case OPT_PRESET: case OPT_PIXFMT: case OPT_HW:
+        return encoder_option(&o->enc, c, arg) ? -1 : RS_EXIT_USAGE;
+    case JOB_AUDIO_OPT_AUDIO: case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS: case JOB_AUDIO_OPT_WAV:
+        return job_audio_option(&o->audio, "render", c, arg) ? -1 : RS_EXIT_USAGE;
+    case 'o': o->out = arg; return -1;
+    case 'K': return parse_ticks(o, arg) ? -1 : RS_EXIT_USAGE;
+    case 'H': o->hashes = arg; return -1;
+    case 'S':
+        if (!cap_seg_key_ok(arg)) {
+            cli_error("render", "--segment '%s': expected a key of 1 to %d characters from A-Z a-z 0-9 . _ : -", arg,
+                      CAP_SEG_KEY_MAX);
+            return RS_EXIT_USAGE;
+        }
+        o->segment = arg;
+        return -1;
+    case 'b': o->backend = arg; return -1;
+    case 'q': o->quiet = true; return -1;
+    case 'G': return cli_int("--progress-fd", arg, 3, 1023, &o->progress_fd) ? -1 : RS_EXIT_USAGE;
+    case 'h': help(); return RS_EXIT_OK;
+    case 'y': o->overwrite = true; return -1;
+    case 'n': o->overwrite = false; return -1;
+    case 'f': o->format = arg; return -1;
+    case 'g': return cli_progress_mode("render", arg, &o->progress) ? -1 : RS_EXIT_USAGE;
+    case 'O': o->poster = arg; return -1;
+    case OPT_JOBS:
+        if (!strcmp(arg, "auto"))
+            o->jobs = 0;
+        else if (!cli_int("--jobs", arg, 1, JOB_SPLIT_MAX, &v))
+            return RS_EXIT_USAGE;
+        else
+            o->jobs = (int)v;
+        return -1;
+    default: return cli_bad_option("render", argv);
+    }
+}
+
+/* What can be refused from the options alone; -1 to go on, else the exit status. */
+static int check_options(render_opts *o)
+{
+    rs_err err = {0};
+    if (!o->out) {
         cli_error("render", "-o OUT is required");
         return RS_EXIT_USAGE;
     }
-    const char *replay = argv[optind];
-    rs_err err = {0};
-    if (!strcmp(out, "-") && hashes && !strcmp(hashes, "-")) {
+    if (!strcmp(o->out, "-") && o->hashes && !strcmp(o->hashes, "-")) {
         cli_error("render", "-o - and --hashes - both write to standard output: give --hashes a file");
         return RS_EXIT_USAGE;
     }
-    if (!strcmp(out, "-") && isatty(1)) {
+    if (!strcmp(o->out, "-") && isatty(1)) {
         cli_error("render", "-o -: standard output is a terminal; pipe it into a program or a file");
         return RS_EXIT_USAGE;
     }
-    cap_pixfmt fmt = strchr(out, '%') ? CAP_RGBA : CAP_I420;
-    if (go.mask && fmt != CAP_RGBA) {
-        cli_error("render", "--mask writes RGBA images: give -o an image pattern such as cut/f%%04d.png, not %s", out);
+    o->fmt = strchr(o->out, '%') ? CAP_RGBA : CAP_I420;
+    if (o->go.mask && o->fmt != CAP_RGBA) {
+        cli_error("render", "--mask writes RGBA images: give -o an image pattern such as cut/f%%04d.png, not %s", o->out);
         return RS_EXIT_USAGE;
     }
-    char seg_hashes[1100], seg_manifest[1100];
-    if (segment) {
+    if (o->segment) {
         /* join finds a segment's list by name, so there is one name for it */
-        cap_seg_hashes_path(out, seg_hashes, sizeof seg_hashes);
-        cap_seg_manifest_path(out, seg_manifest, sizeof seg_manifest);
-        if (!cap_seg_format_of(out)) {
-            cli_error("render", "--segment writes .mp4, .mkv or .webm, not %s", out);
+        cap_seg_hashes_path(o->out, o->seg_hashes, sizeof o->seg_hashes);
+        cap_seg_manifest_path(o->out, o->seg_manifest, sizeof o->seg_manifest);
+        if (!cap_seg_format_of(o->out)) {
+            cli_error("render", "--segment writes .mp4, .mkv or .webm, not %s", o->out);
             return RS_EXIT_USAGE;
         }
-        if (hashes && strcmp(hashes, seg_hashes) != 0) {
-            cli_error("render", "--segment: --hashes must be %s (where join looks for it), not %s", seg_hashes, hashes);
+        if (o->hashes && strcmp(o->hashes, o->seg_hashes) != 0) {
+            cli_error("render", "--segment: --hashes must be %s (where join looks for it), not %s", o->seg_hashes, o->hashes);
             return RS_EXIT_USAGE;
         }
     }
-    go.quiet = quiet;
-    go.q = quality->q;
-    if (!cd.src_w) /* the quality's scale, unless --render-size said */
-        r_preset_render_size(quality, cd.w, cd.h, R_RENDER_MAX, &cd.src_w, &cd.src_h);
-    if (!cap_check_sizes_for(fmt, cd.src_w, cd.src_h, cd.w, cd.h, &err)) {
+    o->go.quiet = o->quiet;
+    o->go.q = o->quality->q;
+    if (!o->cd.src_w) /* the quality's scale, unless --render-size said */
+        r_preset_render_size(o->quality, o->cd.w, o->cd.h, R_RENDER_MAX, &o->cd.src_w, &o->cd.src_h);
+    if (!cap_check_sizes_for(o->fmt, o->cd.src_w, o->cd.src_h, o->cd.w, o->cd.h, &err)) {
         cli_error("render", "%s", err.msg);
         return RS_EXIT_USAGE;
     }
+    return -1;
+}
 
-    int status = RS_EXIT_FAIL;
-    rp_replay rp = {0};
+/* The command line into o; -1 to go on, else the exit status. */
+static int parse_options(int argc, char **argv, render_opts *o)
+{
+    *o = (render_opts){.progress = RS_PROGRESS_AUTO, .cd = {.w = 640, .h = 360}, .quality = &r_presets[R_PRESET_DEFAULT],
+                       .end = -1, .progress_fd = -1};
+    int c, status;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1)
+        if ((status = render_option(o, c, optarg, argv)) >= 0)
+            return status;
+    if (optind + 1 != argc) {
+        cli_error("render", optind >= argc ? "a REPLAY file is required" : "unexpected argument '%s'", argv[argc - 1]);
+        return cli_usage_error("render");
+    }
+    o->replay = argv[optind];
+    return check_options(o);
+}
+
+/* A render under way: what it holds, released by render_free. */
+typedef struct render_run {
+    render_opts *o;
+    rs_err err;
+    rp_replay rp;
+    uint64_t first, end;      /* the ticks drawn */
     cap_sink sink;
-    plat *p = NULL;
-    r_game *r = NULL;
-    r_target t = {0};
-    FILE *hf = NULL;
-    char hpart[1100] = "";
-    job_poster poster = {0};
+    job_poster poster;
+    job_out outs;
+    plat *p;
+    r_game *r;
+    r_target t;
+    int split;                /* segments drawn at once (--jobs), 1: this process draws */
+} render_run;
+
+/* --jobs: how many segments; may create the context (kept in run->p). */
+static int plan_split(render_run *run)
+{
+    render_opts *o = run->o;
+    bool splittable = o->fmt == CAP_I420 && !o->format && !o->segment && !o->passes && !o->audio.wav && cap_seg_format_of(o->out);
+    if (o->jobs > 1 && !splittable) {
+        cli_error("render", "--jobs %d: only a .mp4, .mkv or .webm file is rendered in segments at once (not %s%s)", o->jobs,
+                  o->segment ? "with --segment" : o->passes ? "with --passes" : o->audio.wav ? "with --wav" : o->format ? "with --format" : o->out,
+                  "");
+        return RS_EXIT_USAGE;
+    }
+    run->split = 1;
+    if (splittable && o->jobs != 1) {
+        uint64_t frames = run->end - run->first;
+        run->split = o->jobs ? (frames < (uint64_t)o->jobs ? (int)frames : o->jobs) : job_split_auto(frames);
+        if (o->jobs == 0 && run->split > 1) {
+            /* auto: a software rasteriser gains, a GPU does not need it; the
+             * context this render would draw with says which (and is kept if so) */
+            if (!(run->p = plat_create(&(plat_desc){.backend = o->backend, .hidden = true}, &run->err)))
+                return cli_plat_status(&run->err);
+            if (!software_gl())
+                run->split = 1;
+            else
+                plat_destroy(run->p), run->p = NULL;
+        }
+    }
+    return -1;
+}
+
+/* Everything that can be checked without rendering, first; -1 to go on. */
+static int prepare(render_run *run)
+{
+    render_opts *o = run->o;
+    rs_err *err = &run->err;
+    if (!rp_read(o->replay, &run->rp, err))
+        return RS_EXIT_FAIL;
+    if (o->end > (long)run->rp.ticks) {
+        rs_fail(err, JOB_ERR_TICKS, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", o->replay, o->first,
+                o->end, run->rp.ticks);
+        return RS_EXIT_USAGE;
+    }
+    run->first = (uint64_t)o->first, run->end = o->end < 0 ? run->rp.ticks : (uint64_t)o->end;
+    if (!job_poster_plan(&run->poster, o->poster, &run->rp, run->first, run->end, err) ||
+        !cap_sink_for_format(o->out, o->format, o->cd.w, o->cd.h, &run->sink, err))
+        return RS_EXIT_FAIL;
+    /* every output this render writes, checked before anything is touched */
+    run->outs.pattern = run->sink.fmt == CAP_RGBA;
+    run->outs.first = run->first, run->outs.end = run->end;
+    if (!job_out_check(&run->outs)) {
+        err->msg[0] = 0; /* said */
+        return RS_EXIT_FAIL;
+    }
+    run->sink.index_base = run->first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
+    run->sink.segment = o->segment != NULL;
+    bool usage;
+    if (!job_audio_check(&o->audio, "render", &run->sink, &usage, err))
+        return usage ? RS_EXIT_USAGE : RS_EXIT_FAIL;
+    render_meta(&run->sink, o->replay, &run->rp);
+    if (!cap_sink_encoder(&run->sink, &o->enc, err))
+        return err->code == CAP_ERR_ENC_SETTING ? RS_EXIT_USAGE : RS_EXIT_FAIL;
+    if (run->sink.enc_note[0])
+        fprintf(stderr, "ringside render: %s\n", run->sink.enc_note); /* once: the choice is made here, for the whole run */
+    /* --jobs: segments drawn at once by processes of their own, then joined
+     * (job_split.h), where the output can be joined */
+    return plan_split(run);
+}
+
+/* The segments of a parallel render, each a process of its own, joined. */
+static int render_split(render_run *run, int argc, char **argv)
+{
+    render_opts *o = run->o;
+    /* what every segment would refuse, refused once here: the look */
+    r_stage look;
+    if (o->go.stage_file ? !r_stage_load(&look, o->go.stage_file, &run->err) : !r_stage_for_game(&look, run->rp.stage, &run->err))
+        return RS_EXIT_FAIL;
+    /* the user's options that decide the pictures and the encoding, for every segment */
+    const char *pass[96];
+    int np = 0, c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1 && np < 94) {
+        if (!for_segments(c))
+            continue;
+        for (const struct option *op = opts; op->name; op++)
+            if (op->val == c) {
+                static char name[96][40];
+                snprintf(name[np], sizeof name[np], "--%s", op->name);
+                pass[np] = name[np];
+                np++;
+                if (op->has_arg == required_argument)
+                    pass[np++] = optarg;
+                break;
+            }
+    }
+    pass[np] = NULL;
+    char exe[1100], what[160];
+    ssize_t ne = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (ne <= 0)
+        return rs_fail(&run->err, JOB_ERR_PROCESS, "cannot find this program (/proc/self/exe): %s", strerror(errno)), RS_EXIT_FAIL;
+    exe[ne] = 0;
+    const cap_desc *cd = &o->cd;
+    snprintf(what, sizeof what, "%dx%d (drawn at %dx%d, quality %s)", cd->w, cd->h, cd->src_w, cd->src_h, o->quality->name);
+    job_split_desc jd = {.exe = exe, .replay = o->replay, .out = o->out, .first = run->first, .end = run->end, .jobs = run->split,
+                         .pass = pass, .rp = &run->rp, .sink = &run->sink, .audio = &o->audio, .hashes = o->hashes,
+                         .poster = run->poster.due ? o->poster : NULL, .overwrite = o->overwrite,
+                         .progress = o->quiet ? RS_PROGRESS_OFF : (rs_progress_mode)o->progress, .progress_fd = (int)o->progress_fd,
+                         .quiet = o->quiet, .what = what, .said = run->sink.enc_note, .stop = &stop_requested};
+    return job_split_run(&jd, &run->err);
+}
+
+/* The frames, one a tick, into the capture; false with run->err filled. */
+static bool draw_frames(render_run *run, cap *cp, job_render *j, double *secs)
+{
+    render_opts *o = run->o;
+    rs_err *err = &run->err;
+    uint64_t total = run->end - run->first;
+    int pfd = (int)o->progress_fd;
+    rs_progress prog;
+    rs_progress_start(&prog, "render", "frames", total, o->quiet ? RS_PROGRESS_OFF : (rs_progress_mode)o->progress);
+    double last_report = 0;
+    cli_progress_fd(pfd, 0, total, &last_report);
+    bool ok = job_render_begin(j, &(job_render_desc){.rp = &run->rp, .game = run->r, .target = &run->t, .cap = cp,
+                                                     .name = o->replay, .first = run->first, .end = run->end},
+                               err);
+    while (ok && j->tick < run->end) {
+        uint64_t tick = j->tick; /* every tick is a frame */
+        if (stop_requested) {
+            ok = false;
+            rs_fail(err, JOB_ERR_INTERRUPTED, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
+                    o->out, tick, run->end);
+            break;
+        }
+        ok = job_render_next(j, err) > 0 && job_poster_frame(&run->poster, tick, &run->t, o->cd.w, o->cd.h, err);
+        if (j->desync)
+            break;
+        rs_progress_update(&prog, tick + 1 - run->first);
+        cli_progress_fd(pfd, tick + 1 - run->first, total, &last_report);
+    }
+    if (j->desync) {
+        /* the render's own words: the replay's message, and that no output is left */
+        ok = false;
+        size_t n = strlen(err->msg);
+        snprintf(err->msg + n, sizeof err->msg - n, "; nothing written");
+        if (pfd >= 0)
+            dprintf(pfd, "desync %" PRIu64 "\n", j->desync);
+    }
+    *secs = rs_progress_end(&prog);
+    return ok;
+}
+
+/* The lines a finished render prints (not with --quiet). */
+static void summary(const render_run *run, const cap_stats *st, const job_render *j, double secs)
+{
+    const render_opts *o = run->o;
+    const cap_desc *cd = &o->cd;
+    char said[300];
+    job_audio_describe(&o->audio, &run->sink, said, sizeof said);
+    fprintf(stderr,
+            "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d, quality %s) in %.1f s, %.1f fps; %s capture, "
+            "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n", /* the encoder last */
+            o->out, st->frames, cd->w, cd->h, cd->src_w, cd->src_h, o->quality->name, secs, secs > 0 ? st->frames / secs : 0.0,
+            cd->mode == CAP_SEQUENTIAL ? "sequential" : "async",
+            (cd->downscale ? cd->downscale : (cd->mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
+            cd->pbo ? cd->pbo : CAP_DEFAULT_PBO, cd->no_writer || cd->mode == CAP_SEQUENTIAL ? 0 : cd->queue ? cd->queue : CAP_DEFAULT_QUEUE,
+            st->high_water, st->fence_waits, said, run->sink.enc_name[0] ? "; encoder " : "", run->sink.enc_name);
+    if (run->poster.due)
+        fprintf(stderr, "ringside render: poster %s: frame %" PRIu64 " (%s)\n", run->poster.path, run->poster.tick,
+                job_poster_why_name(run->poster.why));
+    if (run->first > 0)
+        fprintf(stderr,
+                "ringside render: warm-up for tick %" PRIu64 ": the effects' history from tick %" PRIu64 " (%" PRIu64
+                " ticks advanced, %" PRIu64 " of them drawn) in %.2f s; the frames took %.2f s (docs/effects.md, History)\n",
+                run->first, j->warm_from, run->first - j->warm_from, j->warm_drawn, j->ms_warm / 1e3, j->ms_draw / 1e3);
+}
+
+/* This process draws every frame: the outputs opened, the frames, then
+ * the outputs in place together. */
+static int render_here(render_run *run)
+{
+    render_opts *o = run->o;
+    rs_err *err = &run->err;
+    if (!job_out_open(&run->outs, err))
+        return RS_EXIT_FAIL;
+    o->cd.hashes = run->outs.hash_file;
+    if (!job_audio_plan(&o->audio, &run->sink, &run->rp, o->replay, run->first, run->end, err))
+        return RS_EXIT_FAIL;
+    if (!run->p && !(run->p = plat_create(&(plat_desc){.backend = o->backend, .hidden = true}, err)))
+        return cli_plat_status(err);
+    if (!(run->r = r_game_create_opts(&o->go, err)) || !r_game_prepare(run->r, run->rp.stage, err) ||
+        !r_target_create(&run->t, o->cd.src_w, o->cd.src_h, err))
+        return RS_EXIT_FAIL;
+    if (o->passes)
+        r_game_passes(run->r, o->passes == 2, stderr);
+    cap *cp = cap_open(&o->cd, &run->sink, err);
+    if (!cp)
+        return RS_EXIT_FAIL;
+    job_render j;
+    double secs;
+    bool ok = draw_frames(run, cp, &j, &secs);
+    if (o->passes)
+        r_game_report(run->r, stderr);
+    cap_stats st;
+    if (!cap_close(cp, ok, &st, err) || !job_out_commit(&run->outs, err))
+        return RS_EXIT_FAIL;
+    if (!o->quiet)
+        summary(run, &st, &j, secs);
+    return RS_EXIT_OK;
+}
+
+int cmd_render(int argc, char **argv)
+{
+    render_opts o;
+    int status = parse_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    render_run run = {.o = &o};
+    run.outs = (job_out){.cmd = "render", .overwrite = o.overwrite, .video = o.out, .hashes = o.hashes,
+                         .manifest = o.segment ? o.seg_manifest : NULL, .key = o.segment, .replay = o.replay,
+                         .poster = &run.poster, .audio = &o.audio};
     /* Ctrl-C and SIGTERM from here on end the render cleanly (nothing
      * partial left), also during start-up: the GL context, shaders and the
      * IBL prefilter can take seconds, and outputs are created before the
@@ -428,252 +694,20 @@ int cmd_render(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, &old_int);
     sigaction(SIGTERM, &sa, &old_term);
-    /* everything that can be checked without rendering, first */
-    if (!rp_read(replay, &rp, &err))
-        goto done;
-    if (end > (long)rp.ticks) {
-        rs_fail(&err, 1, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", replay, first, end,
-                rp.ticks);
-        status = RS_EXIT_USAGE;
-        goto done;
-    }
-    uint64_t t_first = (uint64_t)first, t_end = end < 0 ? rp.ticks : (uint64_t)end;
-    if (!job_poster_plan(&poster, poster_path, &rp, t_first, t_end, &err))
-        goto done;
-    if (!cap_sink_for_format(out, format, cd.w, cd.h, &sink, &err))
-        goto done;
-    /* every output this render writes, checked before anything is touched */
-    if (!(sink.fmt == CAP_RGBA ? cli_pattern_ok("render", out, t_first, t_end, overwrite)
-                               : cli_out_ok("render", out, overwrite)) ||
-        (hashes && strcmp(hashes, "-") && !cli_out_ok("render", hashes, overwrite)) ||
-        (segment && !cli_out_ok("render", seg_manifest, overwrite)) ||
-        (poster.due && !cli_out_ok("render", poster.path, overwrite))) {
-        err.msg[0] = 0; /* said */
-        goto done;
-    }
-    sink.index_base = t_first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
-    sink.segment = segment != NULL;
-    audio.overwrite = overwrite;
-    bool usage;
-    if (!job_audio_check(&audio, "render", &sink, &usage, &err)) {
-        status = usage ? RS_EXIT_USAGE : RS_EXIT_FAIL;
-        goto done;
-    }
-    render_meta(&sink, replay, &rp);
-    if (!cap_sink_encoder(&sink, &enc, &err)) {
-        status = err.code == CAP_ERR_ENC_SETTING ? RS_EXIT_USAGE : RS_EXIT_FAIL;
-        goto done;
-    }
-    if (sink.enc_note[0])
-        fprintf(stderr, "ringside render: %s\n", sink.enc_note); /* once: the choice is made here, for the whole run */
-    /* --jobs: segments drawn at once by processes of their own, then joined
-     * (job_split.h), where the output can be joined */
-    bool splittable = fmt == CAP_I420 && !format && !segment && !passes && !audio.wav && cap_seg_format_of(out);
-    if (jobs > 1 && !splittable) {
-        cli_error("render", "--jobs %d: only a .mp4, .mkv or .webm file is rendered in segments at once (not %s%s)", jobs,
-                  segment ? "with --segment" : passes ? "with --passes" : audio.wav ? "with --wav" : format ? "with --format" : out,
-                  "");
-        status = RS_EXIT_USAGE;
-        goto done;
-    }
-    int split = 1;
-    if (splittable && jobs != 1) {
-        uint64_t frames = t_end - t_first;
-        split = jobs ? (frames < (uint64_t)jobs ? (int)frames : jobs) : job_split_auto(frames);
-        if (jobs == 0 && split > 1) {
-            /* auto: a software rasteriser gains, a GPU does not need it; the
-             * context this render would draw with says which (and is kept if so) */
-            if (!(p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err))) {
-                status = cli_plat_status(&err);
-                goto done;
-            }
-            if (!software_gl())
-                split = 1;
-            else
-                plat_destroy(p), p = NULL;
-        }
-    }
-    if (split > 1) {
-        /* what every segment would refuse, refused once here: the look */
-        r_stage look;
-        if (go.stage_file ? !r_stage_load(&look, go.stage_file, &err) : !r_stage_for_game(&look, rp.stage, &err))
-            goto done;
-        /* the user's options that decide the pictures and the encoding, for every segment */
-        const char *pass[96];
-        int np = 0;
-        optind = 1;
-        while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1 && np < 94) {
-            if (!for_segments(c))
-                continue;
-            for (const struct option *o = opts; o->name; o++)
-                if (o->val == c) {
-                    static char name[96][40];
-                    snprintf(name[np], sizeof name[np], "--%s", o->name);
-                    pass[np] = name[np];
-                    np++;
-                    if (o->has_arg == required_argument)
-                        pass[np++] = optarg;
-                    break;
-                }
-        }
-        pass[np] = NULL;
-        char exe[1100], what[160];
-        ssize_t ne = readlink("/proc/self/exe", exe, sizeof exe - 1);
-        if (ne <= 0) {
-            rs_fail(&err, 1, "cannot find this program (/proc/self/exe): %s", strerror(errno));
-            goto done;
-        }
-        exe[ne] = 0;
-        snprintf(what, sizeof what, "%dx%d (drawn at %dx%d, quality %s)", cd.w, cd.h, cd.src_w, cd.src_h, quality->name);
-        job_split_desc jd = {.exe = exe, .replay = replay, .out = out, .first = t_first, .end = t_end, .jobs = split,
-                             .pass = pass, .rp = &rp, .sink = &sink, .audio = &audio, .hashes = hashes,
-                             .poster = poster.due ? poster_path : NULL, .overwrite = overwrite,
-                             .progress = quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress, .progress_fd = (int)progress_fd,
-                             .quiet = quiet, .what = what, .said = sink.enc_note, .stop = &stop_requested};
-        status = job_split_run(&jd, &err);
-        goto done;
-    }
-    /* a manifest says "complete": an older one must not vouch for the files this render replaces */
-    if (segment && unlink(seg_manifest) != 0 && errno != ENOENT) {
-        rs_fail(&err, 1, "%s: cannot remove the old manifest: %s", seg_manifest, strerror(errno));
-        goto done;
-    }
-    if (hashes && !strcmp(hashes, "-")) {
-        cd.hashes = stdout;
-    } else if (hashes) {
-        snprintf(hpart, sizeof hpart, "%s.part", hashes);
-        if (!(hf = fopen(hpart, "w"))) {
-            rs_fail(&err, 1, "%s: cannot create: %s", hpart, strerror(errno));
-            goto done;
-        }
-        cd.hashes = hf;
-    }
-    if (!job_audio_plan(&audio, &sink, &rp, replay, t_first, t_end, &err))
-        goto done;
-    if (!p && !(p = plat_create(&(plat_desc){.backend = backend, .hidden = true}, &err))) {
-        status = cli_plat_status(&err);
-        goto done;
-    }
-    if (!(r = r_game_create_opts(&go, &err)) || !r_game_prepare(r, rp.stage, &err) ||
-        !r_target_create(&t, cd.src_w, cd.src_h, &err))
-        goto done;
-    if (passes)
-        r_game_passes(r, passes == 2, stderr);
-    cap *cp = cap_open(&cd, &sink, &err);
-    if (!cp)
-        goto done;
-
-    rs_progress prog;
-    rs_progress_start(&prog, "render", "frames", t_end - t_first, quiet ? RS_PROGRESS_OFF : (rs_progress_mode)progress);
-    double last_report = 0;
-    cli_progress_fd((int)progress_fd, 0, t_end - t_first, &last_report);
-    job_render j;
-    bool ok = job_render_begin(
-        &j, &(job_render_desc){.rp = &rp, .game = r, .target = &t, .cap = cp, .name = replay, .first = t_first, .end = t_end},
-        &err);
-    while (ok && j.tick < t_end) {
-        uint64_t tick = j.tick; /* every tick is a frame */
-        if (stop_requested) {
-            ok = false;
-            rs_fail(&err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed",
-                    out, tick, t_end);
-            break;
-        }
-        ok = job_render_next(&j, &err) > 0 && job_poster_frame(&poster, tick, &t, cd.w, cd.h, &err);
-        if (j.desync)
-            break;
-        rs_progress_update(&prog, tick + 1 - t_first);
-        cli_progress_fd((int)progress_fd, tick + 1 - t_first, t_end - t_first, &last_report);
-    }
-    if (j.desync) {
-        /* the render's own words: the replay's message, and that no output is left */
-        ok = false;
-        size_t n = strlen(err.msg);
-        snprintf(err.msg + n, sizeof err.msg - n, "; nothing written");
-        if (progress_fd >= 0)
-            dprintf((int)progress_fd, "desync %" PRIu64 "\n", j.desync);
-    }
-    double secs = rs_progress_end(&prog);
-    if (passes)
-        r_game_report(r, stderr);
-    cap_stats st;
-    if (!cap_close(cp, ok, &st, &err))
-        goto done;
-    if (cd.hashes == stdout && fflush(stdout) != 0) {
-        rs_fail(&err, 1, "--hashes -: write failed");
-        goto done;
-    }
-    if (hf) {
-        bool hok = fclose(hf) == 0;
-        hf = NULL;
-        if (!hok || rename(hpart, hashes) != 0) {
-            /* the video and its hash list go together: without the list, no video */
-            struct stat vst;
-            if (stat(out, &vst) == 0 && S_ISREG(vst.st_mode))
-                unlink(out);
-            rs_fail(&err, 1, "%s: write failed; %s removed with it", hashes, out);
-            goto done;
-        }
-        hpart[0] = 0;
-    }
-    if (!job_audio_commit(&audio, &err)) {
-        /* the video and its WAV go together, as with the hash list */
-        struct stat vst;
-        if (stat(out, &vst) == 0 && S_ISREG(vst.st_mode))
-            unlink(out);
-        goto done;
-    }
-    if (!job_poster_commit(&poster, &err))
-        goto done;
-    uint64_t replay_fnv = 0; /* the manifest names the replay: join --replay checks it is the segments' */
-    if (segment && (!cap_seg_replay_fnv(replay, &replay_fnv, &err) ||
-                    !cap_seg_seal(out, segment, t_first, t_end, hashes, &replay_fnv, &err))) {
-        /* no manifest, no segment: the files go too */
-        unlink(out);
-        if (hashes)
-            unlink(hashes);
-        if (poster.due)
-            unlink(poster.path);
-        if (audio.wav)
-            unlink(audio.wav);
-        goto done;
-    }
-    char said[300];
-    job_audio_describe(&audio, &sink, said, sizeof said);
-    if (!quiet)
-        fprintf(stderr,
-                "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d, quality %s) in %.1f s, %.1f fps; %s capture, "
-                "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n", /* the encoder last */
-                out, st.frames, cd.w, cd.h, cd.src_w, cd.src_h, quality->name, secs, secs > 0 ? st.frames / secs : 0.0,
-                cd.mode == CAP_SEQUENTIAL ? "sequential" : "async",
-                (cd.downscale ? cd.downscale : (cd.mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
-                cd.pbo ? cd.pbo : CAP_DEFAULT_PBO, cd.no_writer || cd.mode == CAP_SEQUENTIAL ? 0 : cd.queue ? cd.queue : CAP_DEFAULT_QUEUE,
-                st.high_water, st.fence_waits, said, sink.enc_name[0] ? "; encoder " : "", sink.enc_name);
-    if (!quiet && poster.due)
-        fprintf(stderr, "ringside render: poster %s: frame %" PRIu64 " (%s)\n", poster.path, poster.tick,
-                job_poster_why_name(poster.why));
-    if (!quiet && t_first > 0)
-        fprintf(stderr,
-                "ringside render: warm-up for tick %" PRIu64 ": the effects' history from tick %" PRIu64 " (%" PRIu64
-                " ticks advanced, %" PRIu64 " of them drawn) in %.2f s; the frames took %.2f s (docs/effects.md, History)\n",
-                t_first, j.warm_from, t_first - j.warm_from, j.warm_drawn, j.ms_warm / 1e3, j.ms_draw / 1e3);
-    status = RS_EXIT_OK;
-done:
+    status = prepare(&run);
+    if (status < 0)
+        status = run.split > 1 ? render_split(&run, argc, argv) : render_here(&run);
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
-    if (status != RS_EXIT_OK && err.msg[0])
-        cli_error("render", "%s", err.msg);
-    if (hf)
-        fclose(hf);
-    if (hpart[0])
-        unlink(hpart);
-    job_poster_abandon(&poster);
-    job_audio_free(&audio);
-    if (p) {
-        r_target_destroy(&t);
-        r_game_destroy(r);
-        plat_destroy(p);
+    if (status != RS_EXIT_OK && run.err.msg[0])
+        cli_error("render", "%s", run.err.msg);
+    job_out_abandon(&run.outs);
+    job_audio_free(&o.audio);
+    if (run.p) {
+        r_target_destroy(&run.t);
+        r_game_destroy(run.r);
+        plat_destroy(run.p);
     }
-    rp_free(&rp);
+    rp_free(&run.rp);
     return status;
 }

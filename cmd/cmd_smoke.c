@@ -10,6 +10,7 @@
 #include "../runtime/render/r_smoke.h"
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_img.h"
+#include "job_err.h"
 
 static void help(void)
 {
@@ -95,7 +96,7 @@ int cmd_smoke(int argc, char **argv)
     px = malloc((size_t)w * h * 4);
     ref = malloc((size_t)w * h * 4);
     if (!px || !ref) {
-        rs_fail(&err, 1, "out of memory for a %dx%d picture", w, h);
+        rs_fail(&err, JOB_ERR_NOMEM, "out of memory for a %dx%d picture", w, h);
         goto fail;
     }
     r_smoke_draw(s);
@@ -105,7 +106,7 @@ int cmd_smoke(int argc, char **argv)
         r_smoke_reference(w, h, ref);
         size_t first, bad = r_smoke_compare(px, ref, w, h, &first);
         if (bad) {
-            rs_fail(&err, 1,
+            rs_fail(&err, JOB_ERR_VERIFY,
                     "%s: not written: %zu of %zu pixels differ from the reference (first at x=%zu y=%zu: got "
                     "%u,%u,%u want %u,%u,%u)",
                     out, bad, (size_t)w * h, first % w, first / w, px[4 * first], px[4 * first + 1], px[4 * first + 2],

@@ -11,6 +11,7 @@
 #include "../capture/cap.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/util/rs_img.h"
+#include "job_err.h"
 
 uint64_t job_poster_tick(const rp_replay *rp, int *why)
 {
@@ -59,7 +60,7 @@ bool job_poster_write(const char *path, const r_target *t, int w, int h, rs_err 
     uint8_t *src = malloc(full), *dst = malloc(small);
     bool ok = false;
     if (!src || !dst) {
-        rs_fail(err, 1, "%s: out of memory for the poster", path);
+        rs_fail(err, JOB_ERR_NOMEM, "%s: out of memory for the poster", path);
         goto done;
     }
     /* one synchronous read for one frame: the stall is a few milliseconds once per render */
@@ -92,7 +93,7 @@ bool job_poster_plan(job_poster *p, const char *path, const rp_replay *rp, uint6
         slash[slash == dir] = 0; /* "/x.png" -> "/" */
         struct stat st;
         if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-            return rs_fail(err, 1, "%s: the folder %s does not exist (--poster)", path, dir);
+            return rs_fail(err, JOB_ERR_CREATE, "%s: the folder %s does not exist (--poster)", path, dir);
     }
     p->tick = job_poster_tick(rp, &p->why);
     p->due = p->tick >= first && p->tick < end;
@@ -117,7 +118,7 @@ bool job_poster_commit(job_poster *p, rs_err *err)
     if (rename(p->part, p->path) != 0) {
         int e = errno;
         job_poster_abandon(p);
-        return rs_fail(err, 1, "%s: cannot put the poster in place: %s", p->path, strerror(e));
+        return rs_fail(err, JOB_ERR_WRITE, "%s: cannot put the poster in place: %s", p->path, strerror(e));
     }
     p->written = false;
     return true;

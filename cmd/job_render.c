@@ -4,6 +4,7 @@
 
 #include "../runtime/gl/rgl.h"
 #include "../runtime/util/rs_progress.h" /* rs_now */
+#include "job_err.h"
 
 /* One tick: inputs, then the replay's proof of it. */
 static bool step(job_render *j, rs_err *err)
@@ -21,7 +22,7 @@ bool job_render_begin(job_render *j, const job_render_desc *desc, rs_err *err)
     *j = (job_render){.d = *desc};
     job_render_desc *d = &j->d;
     if (!d->rp || !d->game || !d->target)
-        return rs_fail(err, 1, "job_render: the replay, the renderer and the target are required");
+        return rs_fail(err, JOB_ERR_ARG, "job_render: the replay, the renderer and the target are required");
     if (!d->name)
         d->name = "replay";
     if (!d->end)
@@ -29,7 +30,7 @@ bool job_render_begin(job_render *j, const job_render_desc *desc, rs_err *err)
     if (!d->every)
         d->every = 1;
     if (d->end > d->rp->ticks)
-        return rs_fail(err, 1, "%s: tick %" PRIu64 " is past the replay's end (%" PRIu64 " ticks)", d->name, d->end,
+        return rs_fail(err, JOB_ERR_TICKS, "%s: tick %" PRIu64 " is past the replay's end (%" PRIu64 " ticks)", d->name, d->end,
                        d->rp->ticks);
     g_init(&j->cur, d->rp->stage, d->rp->seed);
     j->warm_from = d->first;

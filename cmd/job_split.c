@@ -28,6 +28,7 @@
 #include "../capture/cap_seg.h"
 #include "../runtime/util/rs_file.h"
 #include "cli.h"
+#include "job_err.h"
 
 typedef struct child {
     pid_t pid;
@@ -157,7 +158,7 @@ static bool spawn(child *c, const char *exe, char *const *argv, bool want_prog, 
         int e = errno;
         if (pp[0] >= 0)
             close(pp[0]), close(pp[1]);
-        return rs_fail(err, 1, "cannot make a pipe: %s", strerror(e));
+        return rs_fail(err, JOB_ERR_PROCESS, "cannot make a pipe: %s", strerror(e));
     }
     pid_t pid = fork();
     if (pid < 0) {
@@ -165,7 +166,7 @@ static bool spawn(child *c, const char *exe, char *const *argv, bool want_prog, 
         if (pp[0] >= 0)
             close(pp[0]), close(pp[1]);
         close(ep[0]), close(ep[1]);
-        return rs_fail(err, 1, "cannot start a process: %s", strerror(e));
+        return rs_fail(err, JOB_ERR_PROCESS, "cannot start a process: %s", strerror(e));
     }
     if (pid == 0) {
         prctl(PR_SET_PDEATHSIG, SIGTERM); /* a render killed outright takes its segments with it */
@@ -345,14 +346,14 @@ int job_split_run(const job_split_desc *d, rs_err *err)
     int n = d->jobs;
     uint64_t total = d->end - d->first;
     if (n < 2 || n > JOB_SPLIT_MAX || total < (uint64_t)n)
-        return rs_fail(err, 1, "cannot split %" PRIu64 " frames into %d segments", total, n), RS_EXIT_FAIL;
+        return rs_fail(err, JOB_ERR_ARG, "cannot split %" PRIu64 " frames into %d segments", total, n), RS_EXIT_FAIL;
     const char *ext = cap_seg_format_of(d->out);
     /* the folder beside the output: the same file system, so nothing is copied */
     char dir[1100];
     const char *slash = strrchr(d->out, '/');
     snprintf(dir, sizeof dir, "%.*s.ringside-render-XXXXXX", slash ? (int)(slash - d->out + 1) : 0, d->out);
     if (!mkdtemp(dir))
-        return rs_fail(err, 1, "%s: cannot make a folder for the segments: %s", dir, strerror(errno)), RS_EXIT_FAIL;
+        return rs_fail(err, JOB_ERR_CREATE, "%s: cannot make a folder for the segments: %s", dir, strerror(errno)), RS_EXIT_FAIL;
     char key[40], poster[1200];
     snprintf(key, sizeof key, "render-%d", (int)getpid());
     snprintf(poster, sizeof poster, "%s/poster.png", dir);
@@ -413,7 +414,7 @@ int job_split_run(const job_split_desc *d, rs_err *err)
         uint64_t done = 0;
         for (int i = 0; i < started; i++)
             done += cs[i].done;
-        rs_fail(err, 1, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed", d->out, done,
+        rs_fail(err, JOB_ERR_INTERRUPTED, "%s: interrupted at frame %" PRIu64 " of %" PRIu64 "; the partial output was removed", d->out, done,
                 total);
         goto done;
     }
@@ -424,10 +425,10 @@ int job_split_run(const job_split_desc *d, rs_err *err)
         if (c->desync && d->progress_fd >= 0)
             dprintf(d->progress_fd, "desync %" PRIu64 "\n", c->desync);
         if (WIFEXITED(c->status))
-            rs_fail(err, 1, "%s: segment %d of %d (ticks %" PRIu64 "..%" PRIu64 "): %s", d->out, failed + 1, n, c->first,
+            rs_fail(err, JOB_ERR_SEGMENT, "%s: segment %d of %d (ticks %" PRIu64 "..%" PRIu64 "): %s", d->out, failed + 1, n, c->first,
                     c->end - 1, msg[0] ? msg : "its render failed");
         else
-            rs_fail(err, 1, "%s: segment %d of %d (ticks %" PRIu64 "..%" PRIu64 "): its render ended by signal %d%s%s", d->out,
+            rs_fail(err, JOB_ERR_SEGMENT, "%s: segment %d of %d (ticks %" PRIu64 "..%" PRIu64 "): its render ended by signal %d%s%s", d->out,
                     failed + 1, n, c->first, c->end - 1, WTERMSIG(c->status), msg[0] ? ": " : "", msg);
         if (WIFEXITED(c->status) && WEXITSTATUS(c->status) == RS_EXIT_USAGE)
             status = RS_EXIT_USAGE;
@@ -442,7 +443,7 @@ int job_split_run(const job_split_desc *d, rs_err *err)
     if (d->poster) {
         if (access(poster, F_OK) == 0) {
             if (rename(poster, d->poster) != 0) {
-                rs_fail(err, 1, "%s: cannot put the poster in place: %s; %s removed with it", d->poster, strerror(errno),
+                rs_fail(err, JOB_ERR_WRITE, "%s: cannot put the poster in place: %s; %s removed with it", d->poster, strerror(errno),
                         d->out);
                 unlink(d->out);
                 goto done;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "../cmd/bench_chart.h"
+#include "../cmd/job_err.h"
 #include "../runtime/util/rs_oiio.h"
 #include "t.h"
 
@@ -91,7 +92,30 @@ static void t_refusals(void)
     T_ASSERT(access(path, F_OK) != 0);
 }
 
+/* The command layer's ids (cmd/job_err.h): every one has a text of its
+ * own and belongs to the "job" block, as the chart's refusals do. */
+static void t_job_error_ids(void)
+{
+    T_EQ(RS_ERR_MODULE(JOB_ERR_BASE + 1), RS_ERR_MOD_JOB);
+    T_EQ(RS_ERR_MODULE(JOB_ERR_END - 1), RS_ERR_MOD_JOB);
+    for (int a = JOB_ERR_BASE + 1; a < JOB_ERR_END; a++) {
+        const char *t = job_error_text(a);
+        T_ASSERTF(t[0] && strcmp(t, "?") && strcmp(t, "ok"), "id %d has no text", a);
+        T_ASSERTF(!strcmp(rs_err_module_name(a), "job"), "id %d is in module %s", a, rs_err_module_name(a));
+        for (int b = JOB_ERR_BASE + 1; b < a; b++)
+            T_ASSERTF(strcmp(t, job_error_text(b)), "ids %d and %d share the text \"%s\"", b, a, t);
+    }
+    T_ASSERT(!strcmp(job_error_text(JOB_ERR_END), "?"));
+    T_ASSERT(!strcmp(job_error_text(0), "ok"));
+    rs_err e = {0};
+    char path[512];
+    snprintf(path, sizeof path, "%s/c.jpg", t_tmpdir());
+    T_ASSERT(!bench_chart_check(path, &e));
+    T_EQ(e.code, JOB_ERR_CHART);
+}
+
 T_MAIN(
+    {"job_error_ids", t_job_error_ids},
 #ifdef RS_HAVE_CAIRO
     {"png_and_svg", t_png_and_svg},
 #endif

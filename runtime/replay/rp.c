@@ -183,17 +183,22 @@ static bool rd_varint(rbuf *r, size_t end, uint64_t *v)
 
 #define BAD(...) rs_fail(err, RP_ERR_FIELD, __VA_ARGS__)
 
-bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, rs_err *err)
+/* The magic, the format version and the checksum over the whole file,
+ * checked before any field is trusted; then r->n ends where the checksum
+ * begins. */
+static bool rd_frame(rbuf *r, rp_replay *rp)
 {
-    memset(rp, 0, sizeof *rp);
-    rbuf r = {buf, len, 0, name, err};
+    const uint8_t *buf = r->p;
+    size_t len = r->n;
+    const char *name = r->name;
+    rs_err *err = r->err;
     uint64_t v;
     if (len > RP_MAX_FILE)
         return rs_fail(err, RP_ERR_TOO_BIG, "%s: %zu bytes is larger than the %u-byte limit for replays", name, len,
                        RP_MAX_FILE);
     if (len < 4 || memcmp(buf, RP_MAGIC, 4) != 0)
         return rs_fail(err, RP_ERR_MAGIC, "%s: not a ringside replay: expected \"RSRP\" at byte 0", name);
-    if (!rd_u(&r, 4, &v, "magic") || !rd_u(&r, 2, &v, "format version"))
+    if (!rd_u(r, 4, &v, "magic") || !rd_u(r, 2, &v, "format version"))
         return false;
     if (v != 1 && v != RP_VERSION)
         return rs_fail(err, RP_ERR_VERSION, "%s: format version %llu at byte 4 is not supported (this build reads 1 and %d)",
@@ -211,137 +216,163 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
         return rs_fail(err, RP_ERR_CHECKSUM,
                        "%s: checksum mismatch at byte %zu: stored %08x, computed %08x (file damaged or truncated)",
                        name, len - 4, stored, crc);
-    r.n = len - 4; /* from here on, fields end where the checksum begins */
-    if (!rd_u(&r, 2, &v, "flags"))
+    r->n = len - 4; /* from here on, fields end where the checksum begins */
+    return true;
+}
+
+/* The header after the version: flags, stage, seed, ticks, checkpoint
+ * interval, the players, the result and (version 2) the game version,
+ * each against its range. */
+static bool rd_header(rbuf *r, rp_replay *rp)
+{
+    const char *name = r->name;
+    rs_err *err = r->err;
+    uint64_t v;
+    if (!rd_u(r, 2, &v, "flags"))
         return false;
     if (v != 0)
         return BAD("%s: unknown flags 0x%llx at byte 6 (expected 0)", name, (unsigned long long)v);
-    if (!rd_u(&r, 4, &v, "stage id"))
+    if (!rd_u(r, 4, &v, "stage id"))
         return false;
     if (v >= G_STAGES)
         return BAD("%s: stage id %llu at byte 8 does not exist (expected 0..%d)", name, (unsigned long long)v,
                    G_STAGES - 1);
     rp->stage = (int)v;
-    if (!rd_u(&r, 8, &rp->seed, "seed") || !rd_u(&r, 8, &rp->ticks, "tick count"))
+    if (!rd_u(r, 8, &rp->seed, "seed") || !rd_u(r, 8, &rp->ticks, "tick count"))
         return false;
     if (rp->ticks == 0 || rp->ticks > RP_MAX_TICKS)
         return BAD("%s: tick count %llu at byte 20 is out of range (expected 1..%llu)", name,
                    (unsigned long long)rp->ticks, (unsigned long long)RP_MAX_TICKS);
-    if (!rd_u(&r, 2, &v, "checkpoint interval"))
+    if (!rd_u(r, 2, &v, "checkpoint interval"))
         return false;
     if (v < 1 || v > 3600)
         return BAD("%s: checkpoint interval %llu at byte 28 is out of range (expected 1..3600)", name,
                    (unsigned long long)v);
     rp->interval = (int)v;
     for (int i = 0; i < 2; i++) {
-        if (!rd_u(&r, 1, &v, "player kind"))
+        if (!rd_u(r, 1, &v, "player kind"))
             return false;
         if (v > RP_CPU)
             return BAD("%s: player %d kind %llu at byte %zu is unknown (expected 0 human or 1 cpu)", name, i + 1,
-                       (unsigned long long)v, r.o - 1);
+                       (unsigned long long)v, r->o - 1);
         rp->kind[i] = (int)v;
     }
-    if (!rd_u(&r, 1, &v, "winner"))
+    if (!rd_u(r, 1, &v, "winner"))
         return false;
     if (v != 0xff && v > 2)
         return BAD("%s: winner %llu at byte 32 is invalid (expected 0, 1, 2 or 255)", name, (unsigned long long)v);
     rp->winner = v == 0xff ? -1 : (int)v;
     for (int i = 0; i < 2; i++) {
-        if (!rd_u(&r, 1, &v, "rounds won"))
+        if (!rd_u(r, 1, &v, "rounds won"))
             return false;
         if (v > G_MAX_ROUNDS)
-            return BAD("%s: rounds won %llu at byte %zu is more than %d", name, (unsigned long long)v, r.o - 1,
+            return BAD("%s: rounds won %llu at byte %zu is more than %d", name, (unsigned long long)v, r->o - 1,
                        G_MAX_ROUNDS);
         rp->rounds[i] = (int)v;
     }
-    if (!rd_u(&r, 1, &v, "reserved byte"))
+    if (!rd_u(r, 1, &v, "reserved byte"))
         return false;
     if (v != 0)
         return BAD("%s: reserved byte 35 is %llu (expected 0)", name, (unsigned long long)v);
     if (rp->version >= 2) {
-        if (!rd_u(&r, 4, &v, "game version"))
+        if (!rd_u(r, 4, &v, "game version"))
             return false;
         if (v == 0)
             return BAD("%s: game version 0 at byte 36 (expected 1 or more)", name);
         rp->game_version = (uint32_t)v;
     }
-    size_t len_at = r.o;
-    if (!rd_u(&r, 4, &v, "input section length"))
+    return true;
+}
+
+/* The input section: its length, then runs of (tick count, P1's input,
+ * P2's input) that cover the ticks exactly, into rp->inputs. */
+static bool rd_inputs(rbuf *r, rp_replay *rp)
+{
+    const char *name = r->name;
+    rs_err *err = r->err;
+    uint64_t v;
+    size_t len_at = r->o;
+    if (!rd_u(r, 4, &v, "input section length"))
         return false;
-    size_t body_end = len - 4;
-    if (v > body_end - r.o)
+    size_t body_end = r->n;
+    if (v > body_end - r->o)
         return BAD("%s: input section length %llu at byte %zu runs past the end of the file (%zu bytes left)", name,
-                   (unsigned long long)v, len_at, body_end - r.o);
+                   (unsigned long long)v, len_at, body_end - r->o);
     /* each run is at least 3 bytes and covers at least one tick */
     if (v < 3 || v > 3 * rp->ticks)
         return BAD("%s: input section length %llu at byte %zu does not fit %llu ticks", name, (unsigned long long)v,
                    len_at, (unsigned long long)rp->ticks);
     rp->input_bytes = (size_t)v;
-    size_t in_end = r.o + (size_t)v;
+    size_t in_end = r->o + (size_t)v;
     rp->inputs = malloc((size_t)rp->ticks * 2);
     if (!rp->inputs)
         return rs_fail(err, RP_ERR_NOMEM, "%s: out of memory for %llu ticks", name, (unsigned long long)rp->ticks);
     uint64_t t = 0;
-    while (r.o < in_end) {
-        size_t at = r.o;
+    while (r->o < in_end) {
+        size_t at = r->o;
         uint64_t run = 0;
-        if (!rd_varint(&r, in_end, &run))
-            goto fail;
-        if (run == 0 || run > rp->ticks - t) {
-            BAD("%s: run of %llu ticks at byte %zu goes past the tick count %llu (at tick %llu)", name,
-                (unsigned long long)run, at, (unsigned long long)rp->ticks, (unsigned long long)t);
-            goto fail;
-        }
-        if (in_end - r.o < 2) {
-            rs_fail(err, RP_ERR_TRUNCATED, "%s: truncated input run at byte %zu: expected two input bytes", name, r.o);
-            goto fail;
-        }
-        g_input a = r.p[r.o], b = r.p[r.o + 1];
+        if (!rd_varint(r, in_end, &run))
+            return false;
+        if (run == 0 || run > rp->ticks - t)
+            return BAD("%s: run of %llu ticks at byte %zu goes past the tick count %llu (at tick %llu)", name,
+                       (unsigned long long)run, at, (unsigned long long)rp->ticks, (unsigned long long)t);
+        if (in_end - r->o < 2)
+            return rs_fail(err, RP_ERR_TRUNCATED, "%s: truncated input run at byte %zu: expected two input bytes", name,
+                           r->o);
+        g_input a = r->p[r->o], b = r->p[r->o + 1];
         for (int i = 0; i < 2; i++) {
             g_input x = i ? b : a;
-            if (!g_input_valid(x)) {
-                BAD("%s: player %d input 0x%02x at byte %zu (tick %llu) holds opposite directions", name, i + 1, x,
-                    r.o + (size_t)i, (unsigned long long)t + 1);
-                goto fail;
-            }
+            if (!g_input_valid(x))
+                return BAD("%s: player %d input 0x%02x at byte %zu (tick %llu) holds opposite directions", name, i + 1, x,
+                           r->o + (size_t)i, (unsigned long long)t + 1);
         }
-        r.o += 2;
+        r->o += 2;
         for (uint64_t k = 0; k < run; k++) {
             rp->inputs[2 * (t + k)] = a;
             rp->inputs[2 * (t + k) + 1] = b;
         }
         t += run;
     }
-    if (t != rp->ticks) {
-        BAD("%s: input runs cover %llu ticks, the header says %llu (input section ends at byte %zu)", name,
-            (unsigned long long)t, (unsigned long long)rp->ticks, in_end);
-        goto fail;
-    }
-    if (!rd_u(&r, 4, &v, "checkpoint count"))
-        goto fail;
+    if (t != rp->ticks)
+        return BAD("%s: input runs cover %llu ticks, the header says %llu (input section ends at byte %zu)", name,
+                   (unsigned long long)t, (unsigned long long)rp->ticks, in_end);
+    return true;
+}
+
+/* The checkpoint hashes, one an interval, and the final hash: the body's end. */
+static bool rd_checkpoints(rbuf *r, rp_replay *rp)
+{
+    const char *name = r->name;
+    rs_err *err = r->err;
+    uint64_t v;
+    if (!rd_u(r, 4, &v, "checkpoint count"))
+        return false;
     uint64_t want = rp->ticks / (uint64_t)rp->interval;
-    if (v != want) {
-        BAD("%s: %llu checkpoints at byte %zu, expected %llu (ticks / interval)", name, (unsigned long long)v, r.o - 4,
-            (unsigned long long)want);
-        goto fail;
-    }
-    if (!need(&r, (size_t)v * 8 + 8, "checkpoint hashes and the final hash"))
-        goto fail;
+    if (v != want)
+        return BAD("%s: %llu checkpoints at byte %zu, expected %llu (ticks / interval)", name, (unsigned long long)v,
+                   r->o - 4, (unsigned long long)want);
+    if (!need(r, (size_t)v * 8 + 8, "checkpoint hashes and the final hash"))
+        return false;
     rp->ncheck = (size_t)v;
     rp->checkpoints = malloc(rp->ncheck ? rp->ncheck * 8 : 1);
-    if (!rp->checkpoints) {
-        rs_fail(err, RP_ERR_NOMEM, "%s: out of memory", name);
-        goto fail;
-    }
+    if (!rp->checkpoints)
+        return rs_fail(err, RP_ERR_NOMEM, "%s: out of memory", name);
     for (size_t k = 0; k < rp->ncheck; k++)
-        rd_u(&r, 8, &rp->checkpoints[k], "checkpoint");
-    rd_u(&r, 8, &rp->final_hash, "final hash");
-    if (r.o != body_end) {
-        BAD("%s: %zu unexpected bytes at byte %zu before the checksum", name, body_end - r.o, r.o);
-        goto fail;
-    }
+        rd_u(r, 8, &rp->checkpoints[k], "checkpoint");
+    rd_u(r, 8, &rp->final_hash, "final hash");
+    if (r->o != r->n)
+        return BAD("%s: %zu unexpected bytes at byte %zu before the checksum", name, r->n - r->o, r->o);
     return true;
-fail:
+}
+
+bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, rs_err *err)
+{
+    memset(rp, 0, sizeof *rp);
+    rbuf r = {buf, len, 0, name, err};
+    if (!rd_frame(&r, rp) || !rd_header(&r, rp))
+        return false;
+    if (rd_inputs(&r, rp) && rd_checkpoints(&r, rp))
+        return true;
     rp_free(rp);
     return false;
 }
