@@ -1,5 +1,5 @@
 #!/bin/sh
-# End-to-end: the command-line conventions users' tools expect (issue 22):
+# End-to-end: the command-line conventions users' tools expect (README.md and the man pages):
 # `-o -` streams (Y4M, NUT, Matroska) and nothing else reaches stdout;
 # `-` for text outputs; ffmpeg's overwrite rules (-y / -n) on every kind of
 # output; a missing folder named, never created; extensions in any case;

@@ -1,4 +1,4 @@
-/* The fog map (techniques A8): runtime/fx/fx_fog_sim.c (the mist,
+/* The fog map (docs/effects.md, "Fog map"): runtime/fx/fx_fog_sim.c (the mist,
  * pure C) and fx_fog.c with shaders/fog_*.glsl (the map and the scene's
  * height fog), on llvmpipe.
  *

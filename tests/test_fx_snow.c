@@ -1,4 +1,4 @@
-/* runtime/fx/fx_snow: the snow effect (techniques A7) — its
+/* runtime/fx/fx_snow: the snow effect (docs/effects.md, "Snow") — its
  * procedural textures, the displacement map's footprints (lowered where a
  * bone dips in, never below the trampled minimum, restored by a reset),
  * that it shows, and that it keeps the HDR buffer finite. */

@@ -1,4 +1,4 @@
-/* runtime/fx/fx_water*: the water effect (techniques A6).
+/* runtime/fx/fx_water*: the water effect (docs/effects.md, "Water").
  *
  *   - the CPU automaton stays bounded for a million forced steps at the
  *     default Courant number, and blows up above the cap when the cap is

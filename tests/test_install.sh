@@ -83,7 +83,7 @@ t_install_and_uninstall() {
 
 t_unit_file() {
     u=$SRC/dist/ringside.service
-    # the keys issue 22 asks for, and the two that must stay off (why: in the file)
+    # the unit keys the service relies on, and the two that must stay off (why: in the file)
     for k in DynamicUser=yes StateDirectory=ringside KillMode=mixed ProtectSystem=strict ProtectHome=yes \
         PrivateTmp=yes NoNewPrivileges=yes SystemCallFilter=@system-service PrivateDevices=no \
         MemoryDenyWriteExecute=no; do

@@ -1,5 +1,5 @@
 /* runtime/render/r_tone and shaders/tonemap.frag: the YCbCr tone curve
- * (techniques A3), its lookup table, and the shader that uses it. */
+ * (docs/renderer.md, "Tone map, bloom, flare"), its lookup table, and the shader that uses it. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

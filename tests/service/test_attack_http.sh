@@ -1,5 +1,5 @@
 #!/bin/sh
-# The HTTP server under attack (issue 21): floods of idle and slow
+# The HTTP server under attack (docs/service.md, "On a network"): floods of idle and slow
 # connections, endless and stalled uploads, malformed requests, foreign
 # Host and Origin headers.  Loopback only (127.0.0.x); every case is
 # bounded to seconds.  The clients are tests/service/attack.py.

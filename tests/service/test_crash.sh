@@ -1,5 +1,5 @@
 #!/bin/sh
-# Crash bookkeeping (issue 21, item 6): daemons killed with SIGKILL at
+# Crash bookkeeping (docs/service.md): daemons killed with SIGKILL at
 # random moments charge no attempt and leave no file behind; a render that
 # always fails still ends in the dead letter; retention and DELETE remove
 # finished jobs' files.

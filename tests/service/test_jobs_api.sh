@@ -1,5 +1,5 @@
 #!/bin/sh
-# The job API the dashboard reads (issue 22): a poster per job, the render
+# The job API the dashboard reads (docs/service.md, "HTTP API"): a poster per job, the render
 # log, retry of a failed job, paging, the replay's header, queue position
 # and ETA.  Real HTTP over loopback (curl), the real SQLite queue.
 . "$(dirname "$0")/../lib.sh"
