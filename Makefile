@@ -3,7 +3,8 @@
 #   make            build (installs missing Debian packages first)
 #   make test       build and run every test; ends with "N passed, N failed, N skipped"
 #   make test-service  the service end to end (PostgreSQL, Chromium; docs/service.md)
-#   make check-layers  fail if a lower layer includes a higher one (make test runs it too)
+#   make check-layers  fail if a lower layer includes a higher one, or a function or a
+#                      service file outgrows its size (make test runs it too)
 #   make asan       the suites and cases of tests/asan.tier under AddressSanitizer +
 #                   UBSan (build-asan/; docs/testing.md); make asan-all: every suite
 #   make debug      -O0 build with GL error checks in build-debug/
@@ -96,6 +97,7 @@ MAIN_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(MAIN_SRC))
 # make test runs the same check as tests/test_layers.sh, planted violations too
 check-layers:
 	@tools/check-layers.sh
+	@tools/check-length.sh
 
 .PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
 .DEFAULT_GOAL := all

@@ -39,6 +39,31 @@ t_core_names_effect() {
     plant runtime/render/r_graph.c "#include \"../fx/$(basename "$fx")\"" 'the render core names no effect'
 }
 
-t_run tree_follows_layers engine_includes_capture engine_includes_cmd util_includes_render capture_includes_player \
+# tools/check-length.sh: the tree's functions and service files are within
+# their sizes, and a long function or a long service file planted in a copy
+# is named
+LENGTH=$ROOT/tools/check-length.sh
+copy_src() {
+    rm -rf src && mkdir src || return 1
+    (cd "$ROOT" && find runtime capture player service cmd -type f \( -name '*.c' -o -name '*.h' \) \
+        -exec cp --parents {} "$OLDPWD/src" \;)
+}
+t_tree_within_sizes() { "$LENGTH" "$ROOT"; }
+t_long_function_named() {
+    copy_src || return 1
+    { printf 'static int planted(void)\n{\n'; i=0; while [ $i -lt 150 ]; do echo '    ;'; i=$((i + 1)); done; printf '}\n'; } \
+        >>src/cmd/cli.c
+    "$LENGTH" src >out.txt && { echo "a 152-line function passed"; return 1; }
+    grep -q '^cmd/cli.c:[0-9]*: static int planted(void) is 152 lines' out.txt || { cat out.txt; return 1; }
+    [ "$(wc -l <out.txt)" = 1 ] || { cat out.txt; return 1; }
+}
+t_long_service_file_named() {
+    copy_src || return 1
+    i=0; while [ $i -lt 800 ]; do echo; i=$((i + 1)); done >>src/service/svc_log.c
+    "$LENGTH" src >out.txt && { echo "an 840-line service file passed"; return 1; }
+    grep -q '^service/svc_log.c: [0-9]* lines' out.txt || { cat out.txt; return 1; }
+}
+
+t_run tree_within_sizes long_function_named long_service_file_named tree_follows_layers engine_includes_capture engine_includes_cmd util_includes_render capture_includes_player \
     service_includes_cmd private_header effects_see_the_core_contract core_names_effect
 t_done
