@@ -1,7 +1,10 @@
 /* Image sequences through OpenImageIO: name%06d.png, .exr or .tif, one
- * RGBA file per frame.  Each file is written as "<name>.part" and renamed,
- * so no half-written image ever carries a final name; a failed render
- * removes the frames it wrote, so no partial sequence looks finished. */
+ * RGBA file per frame.  Each file is encoded in memory and written as
+ * "<name>.part" with every write checked (rs_oiio_write), then renamed, so
+ * no half-written image ever carries a final name; a failed render removes
+ * the frames it wrote, so no partial sequence looks finished. */
+#include <errno.h>
+#include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,11 +87,16 @@ static bool img_write(cap_sink *s, const uint8_t *frame, uint64_t index, rs_err 
     rs_err oerr = {0};
     if (!rs_oiio_write(part, q->ext, s->w, s->h, frame, &oerr)) {
         unlink(part);
-        return rs_fail(err, CAP_ERR_WRITE, "%s", oerr.msg);
+        /* the frame's own name first, then the reason and the temporary it was written as */
+        size_t k = strlen(part);
+        bool named = !strncmp(oerr.msg, part, k) && !strncmp(oerr.msg + k, ": ", 2);
+        return rs_fail(err, CAP_ERR_WRITE, "%s: cannot write frame %" PRIu64 ": %s (writing %s)", path, index,
+                       named ? oerr.msg + k + 2 : oerr.msg, part);
     }
     if (rename(part, path) != 0) {
+        int e = errno;
         unlink(part);
-        return rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename into place", path);
+        return rs_fail(err, CAP_ERR_WRITE, "%s: cannot rename into place: %s", path, strerror(e));
     }
     s->frames = index + 1;
     return true;

@@ -137,5 +137,37 @@ t_quality_and_sizes() {
     expect_fail 2 "--quality 'ultra'" "$RS_BIN" play --headless --quality ultra || return 1
 }
 
-t_run passes_summary_and_frames quality_and_sizes ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
+# An output that cannot be written fails the render and leaves nothing: an
+# image sequence on a full filesystem (a 160 KiB tmpfs, most of it filled),
+# in a read-only folder and in a missing one, the video beside it for
+# comparison.  What was there before stays as it was.
+t_outputs_on_a_full_disk() {
+    short_replay || return 1
+    mkdir -p full && mount -t tmpfs -o size=160k tmpfs full 2>mount.err ||
+        { t_skip_env "cannot mount a tmpfs here ($(head -c 120 mount.err))"; return 0; }
+    echo keep >full/keep.txt
+    head -c 110k /dev/zero >full/filler # about 50 KiB left: a frame or two
+    for out in full/f%04d.png full/f%04d.exr full/f%04d.tif full/v.mp4 full/v.y4m; do
+        case $out in *%*) what="--ticks 0:40 --size 320x180" ;; *) what="--ticks 0:120 --size 640x360" ;; esac
+        "$RS_BIN" render short.rsr $what -q -o "$out" 2>err.txt
+        rc=$?
+        left=$(ls -A full | grep -Ev '^(keep.txt|filler)$' | tr '\n' ' ')
+        if [ $rc = 0 ] || [ -n "$left" ] || [ "$(cat full/keep.txt)" != keep ]; then
+            echo "$out on a full disk: exit $rc, left: '$left'"; cat err.txt; umount full; return 1
+        fi
+        case $out in *%*) grep -q "^ringside render: full/f00[0-9][0-9]\.[a-z]*: cannot write frame [0-9]*: No space left on device" err.txt ||
+            { echo "$out:"; cat err.txt; umount full; return 1; } ;; esac
+    done
+    umount full
+    # read-only for root too: a read-only mount, not a mode
+    mkdir ro && mount -t tmpfs -o ro,size=16k tmpfs ro || { echo "cannot mount a read-only tmpfs"; return 1; }
+    for out in ro/f%04d.png nowhere/f%04d.png; do
+        "$RS_BIN" render short.rsr --ticks 0:4 --size 160x90 -q -o "$out" 2>err.txt && { echo "$out: exit 0"; return 1; }
+        [ -z "$(ls -A ro)" ] || { echo "$out left: $(ls -A ro)"; umount ro; return 1; }
+        grep -q "${out%%/*}" err.txt || { echo "$out: the error does not name the folder:"; cat err.txt; umount ro; return 1; }
+    done
+    umount ro
+}
+
+t_run outputs_on_a_full_disk passes_summary_and_frames quality_and_sizes ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
 t_done

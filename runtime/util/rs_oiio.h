@@ -51,7 +51,10 @@ const char *rs_oiio_error_text(rs_oiio_error e);
 bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int h, rs_err *err);
 
 /* Writes an RGBA8 image (rows top-down) in the format of the extension
- * `ext` (".png", ".exr", ".tif") to `path`, whatever path's own name. */
+ * `ext` (".png", ".exr", ".tif") to `path`, whatever path's own name.
+ * Encoded in memory, then written with every write() and the close()
+ * checked: false, with the path and the system's reason ("No space left on
+ * device"), and no file left, when any fails. */
 bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err);
 
 /* Reads the first subimage of an image file as float RGB (rows top-down):
@@ -72,7 +75,7 @@ bool rs_oiio_ready(rs_err *err);
 const char *rs_oiio_version(void);
 
 /* The plugin's interface version: rs_oiio_plugin_abi() must return it. */
-#define RS_OIIO_PLUGIN_ABI 1
+#define RS_OIIO_PLUGIN_ABI 2
 
 #ifdef __cplusplus
 }

@@ -14,6 +14,8 @@
 
 #ifdef RS_HAVE_OIIO
 #include <dlfcn.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
 #include <unistd.h>
@@ -27,7 +29,7 @@ static struct {
     char version[64];
     int (*abi)(void);
     bool (*resize)(const uint8_t *, int, int, float *, int, int, rs_err *);
-    bool (*write)(const char *, const char *, int, int, const uint8_t *, rs_err *);
+    bool (*encode)(const char *, int, int, const uint8_t *, uint8_t **, size_t *, rs_err *);
     bool (*read_float)(const char *, int *, int *, float **, rs_err *);
     const char *(*version_of)(void);
 } P = {.once = PTHREAD_ONCE_INIT};
@@ -84,10 +86,10 @@ static void load(void)
     }
     *(void **)&P.abi = dlsym(h, "rs_oiio_plugin_abi");
     *(void **)&P.resize = dlsym(h, "rs_oiio_plugin_resize");
-    *(void **)&P.write = dlsym(h, "rs_oiio_plugin_write");
+    *(void **)&P.encode = dlsym(h, "rs_oiio_plugin_encode");
     *(void **)&P.read_float = dlsym(h, "rs_oiio_plugin_read_float");
     *(void **)&P.version_of = dlsym(h, "rs_oiio_plugin_version");
-    if (!P.abi || !P.resize || !P.write || !P.read_float || !P.version_of) {
+    if (!P.abi || !P.resize || !P.encode || !P.read_float || !P.version_of) {
         snprintf(P.why, sizeof P.why, "%s is not ringside's OpenImageIO plugin (an entry point is missing)", path);
         return;
     }
@@ -122,10 +124,42 @@ bool rs_oiio_resize(const uint8_t *rgba, int sw, int sh, float *out, int w, int 
     return loaded(err) && pass_on(P.resize(rgba, sw, sh, out, w, h, &e), &e, err);
 }
 
+/* n bytes to a new file at path, every write() and the close() checked
+ * (a full disk, a quota, a network filesystem that fails at close); on
+ * failure the file is removed and the message gives the system's reason. */
+static bool write_all(const char *path, const uint8_t *p, size_t n, rs_err *err)
+{
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0)
+        return rs_fail(err, RS_OIIO_ERR_WRITE, "%s: %s", path, strerror(errno));
+    int e = 0;
+    while (n > 0 && !e) {
+        ssize_t k = write(fd, p, n);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            e = k < 0 ? errno : EIO;
+        else
+            p += k, n -= (size_t)k;
+    }
+    if (close(fd) != 0 && !e)
+        e = errno;
+    if (!e)
+        return true;
+    unlink(path);
+    return rs_fail(err, RS_OIIO_ERR_WRITE, "%s: %s", path, strerror(e));
+}
+
 bool rs_oiio_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
 {
     rs_err e = {0};
-    return loaded(err) && pass_on(P.write(path, ext, w, h, rgba, &e), &e, err);
+    uint8_t *bytes = NULL;
+    size_t n = 0;
+    if (!loaded(err) || !pass_on(P.encode(ext, w, h, rgba, &bytes, &n, &e), &e, err))
+        return false;
+    bool ok = write_all(path, bytes, n, err);
+    free(bytes);
+    return ok;
 }
 
 bool rs_oiio_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)

@@ -20,8 +20,10 @@ extern "C" { /* rs_err.h and rs_img.h are C headers without their own extern "C"
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 
 #ifdef RS_HAVE_OIIO
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -52,11 +54,20 @@ extern "C" bool rs_oiio_plugin_resize(const uint8_t *rgba, int sw, int sh, float
     return true;
 }
 
-extern "C" bool rs_oiio_plugin_write(const char *path, const char *ext, int w, int h, const uint8_t *rgba, rs_err *err)
+/* Encodes into memory (an IOVecOutput): OpenImageIO's own file writers do
+ * not report every failed write or close (a full disk left a truncated PNG
+ * and "success"), so the bytes are written by the loader, which checks each
+ * system call. */
+extern "C" bool rs_oiio_plugin_encode(const char *ext, int w, int h, const uint8_t *rgba, uint8_t **out, size_t *n,
+                                      rs_err *err)
 {
-    auto o = ImageOutput::create(ext + 1); /* by format name: path may end in .part */
+    *out = nullptr;
+    *n = 0;
+    auto o = ImageOutput::create(ext + 1); /* by format name */
     if (!o)
-        return fail(err, RS_OIIO_ERR_WRITE, path, "OpenImageIO cannot write " + std::string(ext) + ": " + OIIO::geterror());
+        return fail(err, RS_OIIO_ERR_WRITE, ext, "OpenImageIO cannot write this format: " + OIIO::geterror());
+    if (!o->supports("ioproxy"))
+        return fail(err, RS_OIIO_ERR_WRITE, ext, "this OpenImageIO cannot write the format to memory");
     ImageSpec spec(w, h, 4, TypeDesc::UINT8);
     if (!std::strcmp(ext, ".exr"))
         spec.set_format(TypeDesc::HALF);
@@ -65,15 +76,26 @@ extern "C" bool rs_oiio_plugin_write(const char *path, const char *ext, int w, i
         spec.attribute("png:compressionLevel", RS_PNG_LEVEL);
         spec.attribute("png:filter", PNG_FILTER_NONE);
     }
-    if (!o->open(path, spec))
-        return fail(err, RS_OIIO_ERR_WRITE, path, o->geterror());
+    std::vector<unsigned char> buf;
+    Filesystem::IOVecOutput vec(buf);
+    if (!o->set_ioproxy(&vec) || !o->open(std::string("frame") + ext, spec))
+        return fail(err, RS_OIIO_ERR_WRITE, ext, o->geterror());
     bool ok = o->write_image(TypeDesc::UINT8, rgba);
     std::string e = ok ? "" : o->geterror();
     if (!o->close() && ok) {
         ok = false;
         e = o->geterror();
     }
-    return ok ? true : fail(err, RS_OIIO_ERR_WRITE, path, e.empty() ? "write failed" : e);
+    if (!ok)
+        return fail(err, RS_OIIO_ERR_WRITE, ext, e.empty() ? "encoding failed" : e);
+    if (buf.empty())
+        return fail(err, RS_OIIO_ERR_WRITE, ext, "OpenImageIO encoded no bytes");
+    *out = static_cast<uint8_t *>(std::malloc(buf.size()));
+    if (!*out)
+        return fail(err, RS_OIIO_ERR_MEMORY, ext, "out of memory");
+    std::memcpy(*out, buf.data(), buf.size());
+    *n = buf.size();
+    return true;
 }
 
 extern "C" bool rs_oiio_plugin_read_float(const char *path, int *w, int *h, float **rgb, rs_err *err)
