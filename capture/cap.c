@@ -14,6 +14,7 @@
  *   - sequential path: glReadPixels into client memory waits for the GPU. */
 #include "cap.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -381,10 +382,13 @@ bool cap_close(cap *c, bool ok, cap_stats *stats, rs_err *err)
     if (c->writer)
         wok = cap_writer_finish(c->writer, &ws, &werr);
     /* the hash list belongs to this output: it must be whole before the output is committed */
+    const char *hname = c->d.hashes_name ? c->d.hashes_name : "the frame hash list";
+    errno = 0;
     if (wok && c->d.hashes && (fflush(c->d.hashes) != 0 || ferror(c->d.hashes))) {
         wok = false;
-        rs_fail(&werr, CAP_ERR_WRITE, "the frame hash list: write failed");
-    }
+        rs_fail(&werr, CAP_ERR_WRITE, "%s: write failed: %s", hname, errno ? strerror(errno) : "I/O error");
+    } else if (!wok && c->d.hashes_name && !strncmp(werr.msg, "writing the frame hash list", 27))
+        rs_err_prefix(&werr, "%s", hname);
     bool good = ok && !c->failed && wok;
     rs_err cerr = {0};
     bool cok = true;

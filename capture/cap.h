@@ -42,6 +42,7 @@ typedef struct cap_desc {
     bool no_writer;          /* write on the game thread: no writer thread, no queue
                               * (always so in sequential mode) */
     FILE *hashes;            /* optional: "index hash" per output frame */
+    const char *hashes_name; /* its name as the user gave it, for messages (NULL: "the frame hash list") */
 } cap_desc;
 
 typedef struct cap_stats {

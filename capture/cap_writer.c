@@ -18,6 +18,7 @@
  * reference, and the benchmark's queue=0 case). */
 #include "cap_writer.h"
 
+#include <errno.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,8 +51,8 @@ static bool write_one(cap_writer *w, const uint8_t *frame, uint64_t index, rs_er
     double t0 = rs_now();
     if (w->hashes && fprintf(w->hashes, "%llu %016llx\n", (unsigned long long)(index + w->sink->index_base),
                              (unsigned long long)rs_fnv1a64(frame, w->frame_bytes)) < 0)
-        return rs_fail(err, CAP_ERR_WRITE, "writing the frame hash list failed at frame %llu",
-                       (unsigned long long)(index + w->sink->index_base));
+        return rs_fail(err, CAP_ERR_WRITE, "writing the frame hash list failed at frame %llu: %s",
+                       (unsigned long long)(index + w->sink->index_base), strerror(errno));
     bool ok = w->sink->ops->write(w->sink, frame, index, err);
     w->st.write_ms += (rs_now() - t0) * 1e3;
     if (ok)

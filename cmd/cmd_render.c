@@ -649,6 +649,7 @@ static int render_here(render_run *run)
     if (!job_out_open(&run->outs, err))
         return RS_EXIT_FAIL;
     o->cd.hashes = run->outs.hash_file;
+    o->cd.hashes_name = o->hashes;
     if (!job_audio_plan(&o->audio, &run->sink, &run->rp, o->replay, run->first, run->end, err))
         return RS_EXIT_FAIL;
     if (!run->p && !(run->p = plat_create(&(plat_desc){.backend = o->backend, .hidden = true}, err)))

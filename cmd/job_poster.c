@@ -2,6 +2,7 @@
 #include "job_poster.h"
 
 #include <errno.h>
+#include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -105,8 +106,17 @@ bool job_poster_frame(job_poster *p, uint64_t tick, const r_target *t, int w, in
 {
     if (!p->due || p->written || tick != p->tick)
         return true;
-    if (!job_poster_write(p->part, t, w, h, err))
+    if (!job_poster_write(p->part, t, w, h, err)) {
+        unlink(p->part);
+        /* the poster's own name, as the user gave it */
+        size_t k = strlen(p->part);
+        if (err && !strncmp(err->msg, p->part, k) && !strncmp(err->msg + k, ": ", 2)) {
+            char why[sizeof err->msg];
+            snprintf(why, sizeof why, "%s", err->msg + k + 2);
+            snprintf(err->msg, sizeof err->msg, "%s: %s (the poster, tick %" PRIu64 ")", p->path, why, tick);
+        }
         return false;
+    }
     p->written = true;
     return true;
 }

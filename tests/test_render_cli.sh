@@ -158,6 +158,18 @@ t_outputs_on_a_full_disk() {
         case $out in *%*) grep -q "^ringside render: full/f00[0-9][0-9]\.[a-z]*: cannot write frame [0-9]*: No space left on device" err.txt ||
             { echo "$out:"; cat err.txt; umount full; return 1; } ;; esac
     done
+    # a side output that cannot be written takes the video with it
+    : >full/filler2
+    head -c 200k /dev/zero >>full/filler2 2>/dev/null # now nothing is left
+    for side in "--hashes full/h.txt" "--wav full/a.wav" "--poster full/p.png"; do # the poster is tick 150
+        rm -f v.mp4
+        "$RS_BIN" render short.rsr --ticks 140:160 --size 160x90 -q -o v.mp4 $side 2>err.txt && { echo "$side: exit 0"; umount full; return 1; }
+        name=${side#* }
+        [ ! -e v.mp4 ] && [ -z "$(ls -A full | grep -Ev '^(keep.txt|filler2?)$')" ] ||
+            { echo "$side left: $(ls v.mp4 full 2>&1)"; umount full; return 1; }
+        grep -q "^ringside render: $name: .*No space left on device" err.txt ||
+            { echo "$side:"; cat err.txt; umount full; return 1; }
+    done
     umount full
     # read-only for root too: a read-only mount, not a mode
     mkdir ro && mount -t tmpfs -o ro,size=16k tmpfs ro || { echo "cannot mount a read-only tmpfs"; return 1; }
