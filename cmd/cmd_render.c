@@ -79,7 +79,8 @@ static void help(void)
            "  --poster FILE.png  also write one frame worth showing, at the output size: the\n"
            "                     last knock-out or ring-out (%d ticks on), else the match end,\n"
            "                     else the middle; chosen by simulating the replay first.  With\n"
-           "                     --ticks, written only by the render whose range holds it\n"
+           "                     --ticks, written only by the render whose range holds it (another\n"
+           "                     says it wrote none, unless it is a --segment)\n"
            "  --backend B        GL backend (default egl, falling back to osmesa)\n"
            "  --stage-file FILE  the look to use instead of stages/<replay's stage>.stage\n"
            "                     (docs/stages.md)\n"
@@ -672,6 +673,13 @@ static int render_here(render_run *run)
         return RS_EXIT_FAIL;
     if (!o->quiet)
         summary(run, &st, &j, secs);
+    /* a poster asked for and not written says so, even with --quiet (a
+     * segment's is skipped on purpose: the segment that draws it writes it) */
+    if (o->poster && !run->poster.due && !o->segment)
+        fprintf(stderr,
+                "ringside render: --poster %s: not written: its frame, tick %" PRIu64 " (%s), is outside --ticks %" PRIu64
+                ":%" PRIu64 "\n",
+                o->poster, run->poster.tick, job_poster_why_name(run->poster.why), run->first, run->end);
     return RS_EXIT_OK;
 }
 
