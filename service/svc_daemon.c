@@ -121,6 +121,31 @@ static size_t log_text(const worker *w, char *out, size_t n)
     return k;
 }
 
+/* line into out with the unit's temporary file names replaced by the names
+ * the client knows: a whole job's or the join's video, hash list and poster
+ * (OUTPUT/N.EXT) instead of OUTPUT/.jobN-PID-aK.EXT.  A segment's files keep
+ * their names: they are the segment's own. */
+static void client_names(const svc_daemon *d, const worker *w, const char *line, char *out, size_t n)
+{
+    snprintf(out, n, "%s", line);
+    if (w->job.unit.kind == SVC_UNIT_SEGMENT)
+        return;
+    char video[1100], hashes[1100], poster[1100];
+    svc_job_file(&d->cfg, w->job.id, w->job.format, video, sizeof video);
+    svc_job_file(&d->cfg, w->job.id, "hashes", hashes, sizeof hashes);
+    svc_job_file(&d->cfg, w->job.id, "png", poster, sizeof poster);
+    const char *const from[] = {w->f.out, w->f.hashes, w->f.poster}, *const to[] = {video, hashes, poster};
+    for (int i = 0; i < 3; i++) {
+        size_t k = strlen(from[i]);
+        char *at;
+        if (!k || !(at = strstr(out, from[i])))
+            continue;
+        char tail[SVC_LOG_LINE];
+        snprintf(tail, sizeof tail, "%s", at + k);
+        snprintf(at, n - (size_t)(at - out), "%s%s", to[i], tail);
+    }
+}
+
 /* A stderr line into the ring, and the ring to the HTTP threads. */
 static void log_line(svc_daemon *d, worker *w, const char *line)
 {
@@ -129,7 +154,7 @@ static void log_line(svc_daemon *d, worker *w, const char *line)
         w->log_head = (w->log_head + 1) % SVC_LOG_LINES;
     else
         w->log_n++;
-    snprintf(w->log[at], SVC_LOG_LINE, "%s", line);
+    client_names(d, w, line, w->log[at], SVC_LOG_LINE);
     pthread_mutex_lock(&d->mu);
     log_text(w, d->live[w->slot].log, sizeof d->live[w->slot].log);
     pthread_mutex_unlock(&d->mu);

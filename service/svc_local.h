@@ -24,9 +24,10 @@
 #include "svc_store.h"
 
 /* A unit's render log: its last SVC_LOG_LINES lines of stderr, each cut
- * at SVC_LOG_LINE - 1 bytes (GET /jobs/N/log). */
+ * at SVC_LOG_LINE - 1 bytes, as long as the line reader's buffer (GET
+ * /jobs/N/log; the render's summary line runs to about 300). */
 #define SVC_LOG_LINES 40
-#define SVC_LOG_LINE 200
+#define SVC_LOG_LINE 1024
 
 typedef struct svc_live {
     int64_t job;     /* 0: idle */

@@ -31,8 +31,12 @@ t_poster_log_and_fields() {
     [ "$(code GET "/jobs/$id/log" -D h.txt)" = 200 ] || { cat body.txt; return 1; }
     grep -qi '^content-type: text/plain' h.txt || { cat h.txt; return 1; }
     grep -q "^== render, attempt 1, process [0-9]*: exit status 0 after" body.txt || { cat body.txt; return 1; }
-    grep -q "^ringside render: wrote .*job$id-.*: 120 frames 160x90" body.txt || { cat body.txt; return 1; }
-    grep -q "^ringside render: poster .*: frame [0-9]* (" body.txt || { cat body.txt; return 1; }
+    # whole lines (the summary runs past 200 characters), under the names the
+    # client knows: the job's video and poster, never the render's temporaries
+    grep -q "^ringside render: wrote .*/videos/$id\.mp4: 120 frames 160x90 .*; encoder [a-z0-9]*$" body.txt ||
+        { cat body.txt; return 1; }
+    grep -q "^ringside render: poster .*/videos/$id\.png: frame [0-9]* (" body.txt || { cat body.txt; return 1; }
+    ! grep -q '\.job[0-9]' body.txt || { echo "the log names temporary files:"; cat body.txt; return 1; }
     # the fields the dashboard shows
     curl -sf "$SVC_URL/jobs/$id" >j.json || return 1
     for f in stage:temple players.0:cpu players.1:cpu length_s:2.0 codec:h264 format:mp4 queue_position:null \
