@@ -18,9 +18,9 @@ static const cli_cmd commands[] = {
     {"record", cmd_record, "record a CPU-vs-CPU match headless to a replay"},
     {"attract", cmd_attract, "the cabinet's attract loop: movies and demos until a button starts a match"},
     {"movie", cmd_movie, "play a movie (Y4M or anything FFmpeg decodes) on the 60 Hz tick"},
-    {"replay", cmd_replay, "replay info FILE, replay verify FILE"},
+    {"replay", cmd_replay, "a replay file: replay info, verify, sound (its track as a WAV), events"},
     {"serve", cmd_serve, "the replay-to-video daemon: HTTP API, dashboard, queue, workers"},
-    {"bench", cmd_bench, "run a benchmark: bench platform, sim, capture, accuracy or upload"},
+    {"bench", cmd_bench, "benchmarks: platform, sim, capture, accuracy, upload, encode, audio, quality"},
 };
 
 /* DESIGN: this text is also the source of ringside(1) (tools/man.sh) and of

@@ -172,7 +172,23 @@ t_oiio_loaded_when_used() {
         "$RS_BIN" render $r -o "h%02d.png" || return 1
 }
 
-t_run oiio_loaded_when_used help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
+
+# `ringside --help` names every subcommand: the words after "ringside CMD" on
+# the usage lines of each command with subcommands
+t_help_lists_every_subcommand() {
+    "$RS_BIN" --help >top.txt || return 1
+    for cmd in replay bench; do
+        "$RS_BIN" $cmd --help >sub.txt || return 1
+        subs=$(sed -n "s/^ *\(usage: \)\{0,1\}ringside $cmd \([a-z]*\).*/\2/p" sub.txt | sort -u)
+        [ -n "$subs" ] || { echo "no subcommands read from '$cmd --help'"; return 1; }
+        line=$(grep "^  $cmd " top.txt) || { echo "no '$cmd' in ringside --help"; return 1; }
+        for w in $subs; do
+            printf '%s\n' "$line" | grep -qw "$w" || { echo "ringside --help: '$cmd $w' missing from: $line"; return 1; }
+        done
+    done
+}
+
+t_run help_lists_every_subcommand oiio_loaded_when_used help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
     smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
     bench_platform
 t_done
