@@ -140,10 +140,9 @@ static int verify(const char *path, const char *hashes_path, bool overwrite, rs_
                 "rounds %d-%d (byte 32; the inputs themselves verify)\n",
                 path, rp.winner, rp.rounds[0], rp.rounds[1], res.winner, res.rounds[0], res.rounds[1]);
     } else if (!res.ok) {
-        fprintf(stderr,
-                "ringside replay: %s: desync at tick %" PRIu64 ": state hash %016" PRIx64 ", recorded %016" PRIx64
-                " (last matching checkpoint: tick %" PRIu64 "; the inputs diverge in ticks %" PRIu64 "..%" PRIu64 ")\n",
-                path, res.desync_tick, res.got, res.want, res.last_good_tick, res.last_good_tick + 1, res.desync_tick);
+        char what[400];
+        rp_desync_text(&res, what, sizeof what);
+        fprintf(stderr, "ringside replay: %s: %s\n", path, what);
     } else {
         char win[64];
         winner_text(res.winner, res.rounds, win, sizeof win);

@@ -173,13 +173,11 @@ static bool verify_upload(const rp_replay *rp, const char *name, rs_err *err)
         return rs_fail(err, SVC_ERR_DESYNC,
                        "%s: the header says winner %d, rounds %d-%d, but the simulation gives winner %d, rounds %d-%d",
                        name, rp->winner, rp->rounds[0], rp->rounds[1], res.winner, res.rounds[0], res.rounds[1]);
-    if (!res.ok)
-        return rs_fail(err, SVC_ERR_DESYNC,
-                       "%s: desync at tick %" PRIu64 ": state hash %016" PRIx64 ", recorded %016" PRIx64
-                       " (last matching checkpoint: tick %" PRIu64 "; the inputs diverge in ticks %" PRIu64
-                       "..%" PRIu64 ")",
-                       name, res.desync_tick, res.got, res.want, res.last_good_tick, res.last_good_tick + 1,
-                       res.desync_tick);
+    if (!res.ok) {
+        char what[400];
+        rp_desync_text(&res, what, sizeof what);
+        return rs_fail(err, SVC_ERR_DESYNC, "%s: %s", name, what);
+    }
     return true;
 }
 

@@ -82,6 +82,21 @@ t_flipped_bit_reports_tick() {
     [ "$(wc -l <err.txt)" = 1 ] || { cat err.txt; return 1; }
 }
 
+t_final_hash_alone_damaged() {
+    # the state at tick 180 matched its checkpoint: only the recorded final
+    # hash (the 8 bytes before the CRC) is wrong, and the message says so
+    "$RS_BIN" record --ai --quiet --seconds 3 --seed 5 -o f.rsr 2>/dev/null || return 1
+    python3 -c "
+import sys, zlib
+b = bytearray(open('f.rsr', 'rb').read())
+b[len(b) - 12] ^= 1
+b[-4:] = (zlib.crc32(bytes(b[:-4])) & 0xffffffff).to_bytes(4, 'little')
+open('fbad.rsr', 'wb').write(b)" || return 1
+    expect_fail 1 "fbad.rsr: the final hash at tick 180 is .*though the checkpoint at tick 180 matched: the recorded final hash is damaged" \
+        "$RS_BIN" replay verify --quiet fbad.rsr || return 1
+    ! grep -q "diverge" err.txt || { cat err.txt; return 1; }
+}
+
 t_bad_files() {
     cp "$SRC/demos/dojo.rsr" good.rsr
     head -c 100 good.rsr >trunc.rsr
@@ -149,6 +164,6 @@ t_bench_sim_short() {
     [ "$(wc -l <b.csv)" = 2 ] || return 1
 }
 
-t_run record_is_reproducible demos_are_current info seconds_exact hashes_same_at_O0_O2_and_in_ringside \
+t_run final_hash_alone_damaged record_is_reproducible demos_are_current info seconds_exact hashes_same_at_O0_O2_and_in_ringside \
     hashes_same_with_clang header_tampering_is_reported flipped_bit_reports_tick bad_files format1_verifies game_version_told_apart usage disk_full_keeps_nothing bench_sim_short
 t_done

@@ -1,6 +1,8 @@
 #include "rp.h"
 
 #include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
@@ -601,4 +603,19 @@ bool rp_peek_ticks(const uint8_t *buf, size_t len, uint64_t *ticks)
     for (int k = 0; k < 8; k++)
         *ticks |= (uint64_t)buf[TICKS_AT + k] << (8 * k);
     return true;
+}
+
+void rp_desync_text(const rp_verify_result *res, char *out, size_t n)
+{
+    if (res->desync_tick <= res->last_good_tick) /* the same state matched a checkpoint: the final hash is bad */
+        snprintf(out, n,
+                 "the final hash at tick %" PRIu64 " is %016" PRIx64 ", recorded %016" PRIx64
+                 ", though the checkpoint at tick %" PRIu64 " matched: the recorded final hash is damaged",
+                 res->desync_tick, res->got, res->want, res->last_good_tick);
+    else
+        snprintf(out, n,
+                 "desync at tick %" PRIu64 ": state hash %016" PRIx64 ", recorded %016" PRIx64
+                 " (last matching checkpoint: tick %" PRIu64 "; the inputs diverge in ticks %" PRIu64 "..%" PRIu64 ")",
+                 res->desync_tick, res->got, res->want, res->last_good_tick, res->last_good_tick + 1,
+                 res->desync_tick);
 }

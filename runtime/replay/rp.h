@@ -114,6 +114,13 @@ typedef struct rp_verify_result {
     bool header_mismatch;   /* every hash matched, but the header's winner or rounds do not */
 } rp_verify_result;
 
+/* What a failed verification found, as one clause for a message: "desync
+ * at tick T: state hash X, recorded Y (last matching checkpoint: tick L;
+ * the inputs diverge in ticks L+1..T)", or, when only the final hash
+ * differs though the checkpoint at its tick matched, that the recorded
+ * final hash is what is damaged. */
+void rp_desync_text(const rp_verify_result *res, char *out, size_t n);
+
 /* Checks the game version (rp_check_game: returns false, nothing
  * simulated), then steps the game through every tick; checks every
  * checkpoint and the final hash.  hashes (optional) gets "tick hash" per tick.  progress (optional)
