@@ -79,7 +79,7 @@ cap_join *cap_join_open(const cap_join_desc *d, rs_err *err)
     } else if (d->hashes) {
         snprintf(j->hpart, sizeof j->hpart, "%s.part", d->hashes);
         if (!(j->hf = fopen(j->hpart, "w"))) {
-            rs_fail(err, CAP_ERR_CREATE, "%s: cannot create: %s", j->hpart, strerror(errno));
+            rs_fail(err, CAP_ERR_CREATE, "%s: cannot create (as %s): %s", d->hashes, j->hpart, strerror(errno));
             goto fail;
         }
     }

@@ -35,7 +35,7 @@ bool cap_out_open(cap_out *o, const char *path, rs_err *err)
         o->f = fopen(o->tmp, "wb");
     }
     if (!o->f)
-        return rs_fail(err, CAP_ERR_CREATE, "%s: cannot create: %s", o->tmp, strerror(errno));
+        return rs_fail(err, CAP_ERR_CREATE, "%s: cannot create (as %s): %s", o->path, o->tmp, strerror(errno));
     setvbuf(o->f, NULL, _IOFBF, 1 << 20);
     return true;
 }

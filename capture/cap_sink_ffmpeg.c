@@ -130,7 +130,9 @@ static bool ff_open(cap_sink *s, rs_err *err)
     for (int i = 0; i < s->n_meta; i++)
         av_dict_set(&f->fmt->metadata, s->meta[i].key, s->meta[i].value, 0);
     if ((r = avio_open(&f->fmt->pb, f->part, AVIO_FLAG_WRITE)) < 0) {
-        fail_av(err, CAP_ERR_CREATE, f->part, "cannot create", r);
+        char what[1200];
+        snprintf(what, sizeof what, "cannot create (as %s)", f->part);
+        fail_av(err, CAP_ERR_CREATE, s->path, what, r);
         goto fail;
     }
     AVDictionary *mux = NULL;

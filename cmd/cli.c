@@ -16,6 +16,20 @@
 #include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_progress.h"
 
+const char *cli_command;
+
+/* A bad option value: "ringside CMD: message" (just "ringside:" outside a command). */
+static void opt_error(const char *fmt, ...) RS_PRINTF(1, 2);
+static void opt_error(const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, cli_command ? "ringside %s: " : "ringside: ", cli_command);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
 void cli_error(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
@@ -55,7 +69,7 @@ bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out)
     errno = 0;
     long v = strtol(arg, &end, 10);
     if (errno || end == arg || *end || v < lo || v > hi) {
-        fprintf(stderr, "ringside: %s '%s': expected a whole number from %ld to %ld\n", opt, arg, lo, hi);
+        opt_error("%s '%s': expected a whole number from %ld to %ld", opt, arg, lo, hi);
         return false;
     }
     *out = v;
@@ -68,14 +82,15 @@ bool cli_u64(const char *opt, const char *arg, uint64_t *out)
     errno = 0;
     unsigned long long v = strtoull(arg, &end, 0);
     if (errno || end == arg || *end || arg[0] == '-') {
-        fprintf(stderr, "ringside: %s '%s': expected a non-negative whole number\n", opt, arg);
+        opt_error("%s '%s': expected a non-negative whole number", opt, arg);
         return false;
     }
     *out = v;
     return true;
 }
 
-bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
+/* WxH with each side in min..max. */
+static bool size_in(const char *opt, const char *arg, int min, int max, int *w, int *h)
 {
     char *x;
     errno = 0;
@@ -86,8 +101,8 @@ bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
         b = strtol(x + 1, &end, 10);
         ok = !errno && end != x + 1 && !*end;
     }
-    if (!ok || a < 1 || b < 1 || a > max || b > max) {
-        fprintf(stderr, "ringside: %s '%s': expected WIDTHxHEIGHT, each from 1 to %d (e.g. 1280x720)\n", opt, arg, max);
+    if (!ok || a < min || b < min || a > max || b > max) {
+        opt_error("%s '%s': expected WIDTHxHEIGHT, each from %d to %d (e.g. 1280x720)", opt, arg, min, max);
         return false;
     }
     *w = (int)a;
@@ -95,15 +110,14 @@ bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
     return true;
 }
 
+bool cli_size(const char *opt, const char *arg, int max, int *w, int *h)
+{
+    return size_in(opt, arg, 1, max, w, h);
+}
+
 bool cli_out_size(const char *opt, const char *arg, int *w, int *h)
 {
-    if (!cli_size(opt, arg, R_RENDER_MAX, w, h))
-        return false;
-    if (*w < CLI_SIZE_MIN || *h < CLI_SIZE_MIN) {
-        fprintf(stderr, "ringside: %s '%s': the smallest output is %dx%d\n", opt, arg, CLI_SIZE_MIN, CLI_SIZE_MIN);
-        return false;
-    }
-    return true;
+    return size_in(opt, arg, CLI_SIZE_MIN, R_RENDER_MAX, w, h);
 }
 
 const struct r_preset *cli_quality(const char *cmd, const char *arg)
@@ -136,7 +150,8 @@ bool cli_stage(const char *arg, int *stage)
             return true;
         }
     }
-    fprintf(stderr, "ringside: --stage '%s': unknown stage (expected", arg);
+    fprintf(stderr, cli_command ? "ringside %s: " : "ringside: ", cli_command);
+    fprintf(stderr, "--stage '%s': unknown stage (expected", arg);
     for (int i = 0; i < G_STAGES; i++)
         fprintf(stderr, "%s %d/%s", i ? "," : "", i, g_stages[i].name);
     fprintf(stderr, ")\n");
@@ -155,7 +170,7 @@ bool cli_hdr_format(const char *arg, int *fmt)
     else if (!strcmp(arg, "r11g11b10f"))
         *fmt = R_HDR_R11G11B10F;
     else {
-        fprintf(stderr, "ringside: --hdr-format '%s': expected rgba16f or r11g11b10f\n", arg);
+        opt_error("--hdr-format '%s': expected rgba16f or r11g11b10f", arg);
         return false;
     }
     return true;

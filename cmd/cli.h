@@ -35,6 +35,9 @@ bool cli_u64(const char *opt, const char *arg, uint64_t *out);
 bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out);
 /* "ringside CMD: message" on stderr. */
 void cli_error(const char *cmd, const char *fmt, ...);
+/* The command running now ("render"), set by main before it runs one: the
+ * option parsers above name it in their messages. */
+extern const char *cli_command;
 /* Unknown option or missing argument: prints the hint to --help; returns RS_EXIT_USAGE. */
 int cli_usage_error(const char *cmd);
 /* The tail of every option loop, for getopt_long's '?' (opterr 0, so it

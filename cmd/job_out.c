@@ -29,7 +29,7 @@ bool job_out_open(job_out *o, rs_err *err)
     } else if (o->hashes) {
         snprintf(o->hpart, sizeof o->hpart, "%s.part", o->hashes);
         if (!(o->hf = fopen(o->hpart, "w")))
-            return rs_fail(err, JOB_ERR_CREATE, "%s: cannot create: %s", o->hpart, strerror(errno));
+            return rs_fail(err, JOB_ERR_CREATE, "%s: cannot create (as %s): %s", o->hashes, o->hpart, strerror(errno));
         o->hash_file = o->hf;
     }
     return true;

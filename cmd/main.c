@@ -75,8 +75,10 @@ int main(int argc, char **argv)
         return RS_EXIT_OK;
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (!strcmp(commands[i].name, name))
+        if (!strcmp(commands[i].name, name)) {
+            cli_command = name;
             return commands[i].run(argc - 1, argv + 1);
+        }
     fprintf(stderr, "ringside: unknown command '%s' (see 'ringside --help')\n", name);
     return RS_EXIT_USAGE;
 }

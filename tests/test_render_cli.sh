@@ -125,7 +125,8 @@ t_quality_and_sizes() {
     grep -q "^fxaa  *0  *2 " r.txt || { echo "high draws no FXAA"; cat r.txt; return 1; }
     expect_fail 2 "--quality 'ultra': expected draft, standard, high or reference" "$RS_BIN" render short.rsr --quality ultra \
         -o x.y4m || return 1
-    expect_fail 2 "--size '8x8': the smallest output is 16x16" "$RS_BIN" render short.rsr --size 8x8 -o x.y4m || return 1
+    expect_fail 2 "^ringside render: --size '8x8': expected WIDTHxHEIGHT, each from 16 to 8192" "$RS_BIN" render short.rsr --size 8x8 -o x.y4m || return 1
+    expect_fail 2 "^ringside render: --size '0x0': expected WIDTHxHEIGHT, each from 16 to 8192" "$RS_BIN" render short.rsr --size 0x0 -o x.y4m || return 1
     expect_fail 2 "larger than the render size" "$RS_BIN" render short.rsr --size 640x360 --render-size 320x180 \
         -o x.y4m || return 1
     # play: the same presets, a larger drawing averaged down to the frame
@@ -173,10 +174,16 @@ t_outputs_on_a_full_disk() {
     umount full
     # read-only for root too: a read-only mount, not a mode
     mkdir ro && mount -t tmpfs -o ro,size=16k tmpfs ro || { echo "cannot mount a read-only tmpfs"; return 1; }
-    for out in ro/f%04d.png nowhere/f%04d.png; do
+    # the error names what the user wrote (the frame's name for a sequence) and the system's reason
+    for out in ro/f%04d.png ro/x.mp4 ro/x.y4m nowhere/f%04d.png nowhere/x.mp4; do
         "$RS_BIN" render short.rsr --ticks 0:4 --size 160x90 -q -o "$out" 2>err.txt && { echo "$out: exit 0"; return 1; }
         [ -z "$(ls -A ro)" ] || { echo "$out left: $(ls -A ro)"; umount ro; return 1; }
-        grep -q "${out%%/*}" err.txt || { echo "$out: the error does not name the folder:"; cat err.txt; umount ro; return 1; }
+        name=$(printf '%s' "$out" | sed 's/%04d/0000/')
+        case $out in
+        ro/*) want="^ringside render: $name: cannot \(create\|write frame 0\).*: Read-only file system" ;;
+        *) want="^ringside render: $name: folder nowhere does not exist" ;;
+        esac
+        grep -q "$want" err.txt || { echo "$out: want '$want':"; cat err.txt; umount ro; return 1; }
     done
     umount ro
 }

@@ -188,7 +188,7 @@ t_output_failures_exit_1() {
     # a read-only directory (root writes anyway: then there is nothing to test)
     mkdir ro && chmod 555 ro
     if ! touch ro/probe 2>/dev/null; then
-        expect_fail 1 "ro/jx.mp4.part: cannot create: Permission denied" "$RS_BIN" join --segment job7 -o ro/jx.mp4 "$@" || return 1
+        expect_fail 1 "ro/jx.mp4: cannot create (as ro/jx.mp4.part): Permission denied" "$RS_BIN" join --segment job7 -o ro/jx.mp4 "$@" || return 1
     fi
     rm -rf ro
     # usage errors

@@ -179,7 +179,7 @@ au_wav *au_wav_open(const char *path, bool float32, rs_err *err)
     uint8_t h[64];
     size_t hn = header(h, float32, 0);
     if (!w->f || fwrite(h, 1, hn, w->f) != hn) {
-        rs_fail(err, AU_ERR_WAV_OPEN, "%s: cannot create: %s", w->part, strerror(errno));
+        rs_fail(err, AU_ERR_WAV_OPEN, "%s: cannot create (as %s): %s", w->path, w->part, strerror(errno));
         if (w->f) {
             fclose(w->f);
             unlink(w->part);

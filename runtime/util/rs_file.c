@@ -127,7 +127,7 @@ bool rs_write_part(const char *path, const void *data, size_t n, rs_err *err)
     rs_part_path(path, part, sizeof part);
     FILE *f = fopen(part, "wb");
     if (!f)
-        return rs_fail(err, RS_FILE_ERR_WRITE, "%s: cannot create: %s", part, strerror(errno));
+        return rs_fail(err, RS_FILE_ERR_WRITE, "%s: cannot create (as %s): %s", path, part, strerror(errno));
     errno = 0;
     bool ok = fwrite(data, 1, n, f) == n;
     int saved = errno;
