@@ -39,7 +39,7 @@ static void help(void)
            "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
-           "                       [--ticks A:B] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
+           "                       [--ticks A:B|A:] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
            "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
            "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n"
            "                       [--audio on|off] [--audio-bitrate RATE] [--loudness LUFS] [--wav FILE]\n"
@@ -90,7 +90,8 @@ static void help(void)
            "                     needs an image pattern output (.png)\n"
            "  --no-hud           leave out bars, timer and announcements\n"
            "  --hdr-format F     the HDR buffer: rgba16f (default) or r11g11b10f (no alpha)\n"
-           "  --ticks A:B        write only ticks A to B-1, bit for bit the frames a full render\n"
+           "  --ticks A:B        write only ticks A to B-1 (A: to the end; an end past the replay's\n"
+           "                     is clamped to it, with a note), bit for bit the frames a full render\n"
            "                     writes there: the game runs from tick 0 and the effects that\n"
            "                     carry history (water, snow, mist, LSPSM) are warmed up first;\n"
            "                     image names and --hashes lines are numbered A..B-1\n"
@@ -251,19 +252,22 @@ static bool word2(const char *opt, const char *arg, const char *a, int va, const
     return true;
 }
 
-/* --ticks A:B */
+/* --ticks A:B, or A: (to the end) */
 static bool parse_ticks(render_opts *o, const char *arg)
 {
     char *colon = strchr(arg, ':'), a[32];
     if (!colon || (size_t)(colon - arg) >= sizeof a) {
-        cli_error("render", "--ticks '%s': expected A:B, such as 600:660", arg);
+        cli_error("render", "--ticks '%s': expected A:B or A:, such as 600:660", arg);
         return false;
     }
     memcpy(a, arg, (size_t)(colon - arg));
     a[colon - arg] = 0;
-    if (!cli_int("--ticks start", a, 0, 100000000, &o->first) || !cli_int("--ticks end", colon + 1, 1, 100000000, &o->end))
+    if (!cli_int("--ticks start", a, 0, 100000000, &o->first))
         return false;
-    if (o->end <= o->first) {
+    o->end = -1; /* "A:": to the replay's end */
+    if (colon[1] && !cli_int("--ticks end", colon + 1, 1, 100000000, &o->end))
+        return false;
+    if (o->end >= 0 && o->end <= o->first) {
         cli_error("render", "--ticks '%s': the end must be after the start", arg);
         return false;
     }
@@ -503,10 +507,16 @@ static int prepare(render_run *run)
     rs_err *err = &run->err;
     if (!rp_read(o->replay, &run->rp, err))
         return RS_EXIT_FAIL;
-    if (o->end > (long)run->rp.ticks) {
-        rs_fail(err, JOB_ERR_TICKS, "%s: --ticks %ld:%ld is past the replay's end (%" PRIu64 " ticks)", o->replay, o->first,
-                o->end, run->rp.ticks);
+    if (o->first >= (long)run->rp.ticks) {
+        rs_fail(err, JOB_ERR_TICKS, "%s: --ticks %ld: starts past the replay's end (%" PRIu64 " ticks)", o->replay,
+                o->first, run->rp.ticks);
         return RS_EXIT_USAGE;
+    }
+    if (o->end > (long)run->rp.ticks) { /* as ffmpeg's -t past the end: clamped, with a word */
+        fprintf(stderr, "ringside render: --ticks %ld:%ld: the replay ends at tick %" PRIu64 ", so ticks %ld:%" PRIu64
+                        " are drawn\n",
+                o->first, o->end, run->rp.ticks, o->first, run->rp.ticks);
+        o->end = (long)run->rp.ticks;
     }
     run->first = (uint64_t)o->first, run->end = o->end < 0 ? run->rp.ticks : (uint64_t)o->end;
     if (!job_poster_plan(&run->poster, o->poster, &run->rp, run->first, run->end, err) ||

@@ -54,9 +54,16 @@ t_ticks_errors() {
     expect_fail 2 "--ticks '5:3': the end must be after the start" "$RS_BIN" render short.rsr --ticks 5:3 -o x.y4m || return 1
     expect_fail 2 "--ticks '7': expected A:B" "$RS_BIN" render short.rsr --ticks 7 -o x.y4m || return 1
     expect_fail 2 "--ticks start" "$RS_BIN" render short.rsr --ticks x:9 -o x.y4m || return 1
-    expect_fail 2 "short.rsr: --ticks 10:301 is past the replay's end \(300 ticks\)" \
-        "$RS_BIN" render short.rsr --ticks 10:301 -o x.y4m || return 1
+    expect_fail 2 "short.rsr: --ticks 300: starts past the replay's end \(300 ticks\)" \
+        "$RS_BIN" render short.rsr --ticks 300:310 -o x.y4m || return 1
     [ ! -e x.y4m ] || { echo "output written on error"; return 1; }
+    # an end past the replay is clamped with a note; A: runs to the end; both the same frames
+    "$RS_BIN" render short.rsr --ticks 290:999999 --size 160x90 -q --hashes a.txt -o a.y4m 2>note.txt || { cat note.txt; return 1; }
+    grep -q "^ringside render: --ticks 290:999999: the replay ends at tick 300, so ticks 290:300 are drawn$" note.txt ||
+        { cat note.txt; return 1; }
+    "$RS_BIN" render short.rsr --ticks 290: --size 160x90 -q --hashes b.txt -o b.y4m 2>note.txt || { cat note.txt; return 1; }
+    [ ! -s note.txt ] || { cat note.txt; return 1; }
+    [ "$(wc -l <a.txt)" = 10 ] && cmp a.txt b.txt || { echo "290:999999 and 290: differ"; cat a.txt b.txt; return 1; }
 }
 
 t_bad_stage_files() {
