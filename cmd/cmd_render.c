@@ -521,7 +521,7 @@ static int prepare(render_run *run)
     run->first = (uint64_t)o->first, run->end = o->end < 0 ? run->rp.ticks : (uint64_t)o->end;
     if (!job_poster_plan(&run->poster, o->poster, &run->rp, run->first, run->end, err) ||
         !cap_sink_for_format(o->out, o->format, o->cd.w, o->cd.h, &run->sink, err))
-        return RS_EXIT_FAIL;
+        return err->code == CAP_ERR_OUTPUT ? RS_EXIT_USAGE : RS_EXIT_FAIL; /* a name we cannot write is bad usage */
     /* every output this render writes, checked before anything is touched */
     run->outs.pattern = run->sink.fmt == CAP_RGBA;
     run->outs.first = run->first, run->outs.end = run->end;

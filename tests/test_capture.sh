@@ -70,7 +70,7 @@ t_bad_input() {
     expect_fail 2 "must be even for 4:2:0" "$RS_BIN" render short.rsr -o x.y4m --size 161x90 || return 1
     expect_fail 2 "larger than the render size" "$RS_BIN" render short.rsr -o x.y4m --size 1920x1080 \
         --render-size 1280x720 || return 1
-    expect_fail 1 "x.avi: unknown output type '.avi'" "$RS_BIN" render short.rsr -o x.avi || return 1
+    expect_fail 2 "x.avi: unknown output type '.avi'" "$RS_BIN" render short.rsr -o x.avi || return 1
     expect_fail 1 "nope.rsr: cannot open" "$RS_BIN" render nope.rsr -o x.y4m || return 1
     expect_fail 2 "--capture 'fast'" "$RS_BIN" render short.rsr -o x.y4m --capture fast || return 1
     expect_fail 2 "--pbo '9'" "$RS_BIN" render short.rsr -o x.y4m --pbo 9 || return 1
