@@ -104,7 +104,7 @@ t_streams_and_signals() {
     mkdir hd
     expect_fail 1 "hd: exists and is not a regular file" "$RS_BIN" render short.rsr -o v.y4m --hashes hd || return 1
     [ ! -e v.y4m ] || return 1
-    expect_fail 1 "in the file name" "$RS_BIN" render short.rsr -o "d%02d/f.png" || return 1
+    expect_fail 2 "in the file name" "$RS_BIN" render short.rsr -o "d%02d/f.png" || return 1
 }
 
 t_queue_cap_in_report() {
@@ -211,10 +211,10 @@ t_image_sequences() {
     [ $? = 1 ] || { echo "want exit 1"; cat err.txt; return 1; }
     grep -q "cut/f0005.tif.part" err.txt || { cat err.txt; return 1; }
     [ "$(ls cut)" = "f0005.tif.part" ] || { echo "partial sequence left:"; ls cut | head; return 1; }
-    expect_fail 1 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%s.png" || return 1
-    expect_fail 1 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%04d.jpg" || return 1
-    expect_fail 1 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%0999999d.png" || return 1
-    expect_fail 1 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%n.png" || return 1
+    expect_fail 2 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%s.png" || return 1
+    expect_fail 2 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%04d.jpg" || return 1
+    expect_fail 2 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%0999999d.png" || return 1
+    expect_fail 2 "needs one %d or %0Nd" "$RS_BIN" render short.rsr -o "f%n.png" || return 1
 }
 
 t_run streams_and_signals image_sequences filters bench_accuracy_small bench_quality_small bench_capture_small async_equals_sequential y4m_plays mp4_exact_timing disk_full bad_input queue_cap_in_report
