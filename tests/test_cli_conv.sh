@@ -51,9 +51,9 @@ t_stream_nut_and_mkv() {
     # --format names the container where the name does not
     "$RS_BIN" render r.rsr $S -q -o clip.video --format mkv || return 1
     [ "$(frames matroska clip.video)" = "h264 12" ] || return 1
-    expect_fail 1 "MP4 cannot be written to a pipe .*use --format mkv" "$RS_BIN" render r.rsr $S -q -o - --format mp4 || return 1
+    expect_fail 2 "MP4 cannot be written to a pipe .*use --format mkv" "$RS_BIN" render r.rsr $S -q -o - --format mp4 || return 1
     [ ! -s out.txt ] || { echo "bytes on stdout after the refusal"; return 1; }
-    expect_fail 1 "--format 'avi': expected y4m, nut, mkv, mp4 or webm" "$RS_BIN" render r.rsr $S -o - --format avi
+    expect_fail 2 "--format 'avi': expected y4m, nut, mkv, mp4 or webm" "$RS_BIN" render r.rsr $S -o - --format avi
 }
 
 t_stdout_holds_only_the_stream() {
@@ -121,9 +121,9 @@ t_extensions_any_case() {
     [ "$(head -c 9 z.Y4M)" = YUV4MPEG2 ] || return 1
     "$RS_BIN" render r.rsr $S -q -o F%04d.PNG || return 1
     [ "$(head -c 8 F0011.PNG | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || { echo "not a PNG"; return 1; }
-    expect_fail 1 "^ringside render: f.png: a single image name; use a pattern such as f%06d.png$" \
+    expect_fail 2 "^ringside render: f.png: a single image name; use a pattern such as f%06d.png$" \
         "$RS_BIN" render r.rsr $S -q -o f.png || return 1
-    expect_fail 1 "shot.TIF: a single image name; use a pattern such as shot%06d.TIF" "$RS_BIN" render r.rsr $S -q -o shot.TIF
+    expect_fail 2 "shot.TIF: a single image name; use a pattern such as shot%06d.TIF" "$RS_BIN" render r.rsr $S -q -o shot.TIF
 }
 
 t_missing_folder_named() {
