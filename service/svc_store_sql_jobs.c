@@ -102,24 +102,52 @@ int sq_list(svc_store *bs, int64_t token_id, int64_t before, int limit, svc_job 
                     ARGS(I(before == 0 ? INT64_MAX : before), I(limit), I(token_id)), sq_job_row, out, limit, err);
 }
 
-int sq_cancel(svc_store *bs, int64_t id, rs_err *err)
+/* A change to one job in one transaction, under the store's lock: the job
+ * row locked, its state asked whether the change applies (allowed), then
+ * change() run.  0: no such job; 2: its state refuses the change; 1: done;
+ * -1: the queue failed (err).  cancel, remove and retry are this frame
+ * around their own statements. */
+static int job_change(svc_store *bs, int64_t id, bool (*allowed)(int state),
+                      bool (*change)(sq_store *s, int64_t id, int64_t now, rs_err *err), rs_err *err)
 {
     sq_store *s = S(bs);
     int64_t now;
     int rc = -1, state = 0;
     pthread_mutex_lock(&s->mu);
-    if (!sq_tx_begin(s, &now, err))
-        goto out;
-    int l = sq_lock_job(s, id, &state, NULL, err);
-    bool ok = l >= 0, live = l > 0 && (state == SVC_QUEUED || state == SVC_RUNNING);
-    if (ok && live)
-        ok = run(s, "cancel", "UPDATE jobs SET state = 4, finished = ?2 WHERE id = ?1", ARGS(I(id), I(now)), NULL,
-                 err) >= 0 &&
-             sq_end_units(s, id, err) && sq_refresh(s, id, err);
-    rc = sq_tx_end(s, ok, l == 0 ? 0 : live ? 1 : 2, err);
-out:
+    if (sq_tx_begin(s, &now, err)) {
+        int l = sq_lock_job(s, id, &state, NULL, err);
+        bool applies = l > 0 && allowed(state), ok = l >= 0 && (!applies || change(s, id, now, err));
+        rc = sq_tx_end(s, ok, l == 0 ? 0 : applies ? 1 : 2, err);
+    }
     pthread_mutex_unlock(&s->mu);
     return rc;
+}
+
+static bool is_live(int state)
+{
+    return state == SVC_QUEUED || state == SVC_RUNNING;
+}
+
+static bool is_over(int state)
+{
+    return !is_live(state);
+}
+
+static bool is_failed(int state)
+{
+    return state == SVC_FAILED;
+}
+
+static bool cancel_job(sq_store *s, int64_t id, int64_t now, rs_err *err)
+{
+    return run(s, "cancel", "UPDATE jobs SET state = 4, finished = ?2 WHERE id = ?1", ARGS(I(id), I(now)), NULL, err) >=
+               0 &&
+           sq_end_units(s, id, err) && sq_refresh(s, id, err);
+}
+
+int sq_cancel(svc_store *bs, int64_t id, rs_err *err)
+{
+    return job_change(bs, id, is_live, cancel_job, err);
 }
 
 int sq_expiring(svc_store *bs, int64_t age_s, const char *host, int64_t *out, int max, rs_err *err)
@@ -145,23 +173,16 @@ int sq_expire(svc_store *bs, int64_t id, rs_err *err)
     return n < 0 ? -1 : n > 0;
 }
 
+static bool remove_job(sq_store *s, int64_t id, int64_t now, rs_err *err)
+{
+    (void)now;
+    return run(s, "remove the units", "DELETE FROM units WHERE job_id = ?1", ARGS(I(id)), NULL, err) >= 0 &&
+           run(s, "remove the job", "DELETE FROM jobs WHERE id = ?1", ARGS(I(id)), NULL, err) >= 0;
+}
+
 int sq_remove(svc_store *bs, int64_t id, rs_err *err)
 {
-    sq_store *s = S(bs);
-    int64_t now;
-    int rc = -1, state = 0;
-    pthread_mutex_lock(&s->mu);
-    if (!sq_tx_begin(s, &now, err))
-        goto out;
-    int l = sq_lock_job(s, id, &state, NULL, err);
-    bool ok = l >= 0, over = l > 0 && state != SVC_QUEUED && state != SVC_RUNNING;
-    if (ok && over)
-        ok = run(s, "remove the units", "DELETE FROM units WHERE job_id = ?1", ARGS(I(id)), NULL, err) >= 0 &&
-             run(s, "remove the job", "DELETE FROM jobs WHERE id = ?1", ARGS(I(id)), NULL, err) >= 0;
-    rc = sq_tx_end(s, ok, l == 0 ? 0 : over ? 1 : 2, err);
-out:
-    pthread_mutex_unlock(&s->mu);
-    return rc;
+    return job_change(bs, id, is_over, remove_job, err);
 }
 
 /* by_state[state] = count: row i is (state, count) */
@@ -179,30 +200,23 @@ bool sq_counts(svc_store *bs, int64_t by_state[SVC_NSTATES], rs_err *err)
                     INT32_MAX, err) >= 0;
 }
 
+static bool retry_job(sq_store *s, int64_t id, int64_t now, rs_err *err)
+{
+    (void)now;
+    return run(s, "re-queue the units",
+               "UPDATE units SET state = 0, attempts = 0, lost = 0, error = '', owner = '', claimed_until = 0,"
+               " frames_done = 0, fps = 0, started = 0, finished = 0, done_by = '', done_attempt = 0"
+               " WHERE job_id = ?1",
+               ARGS(I(id)), NULL, err) >= 0 &&
+           run(s, "re-queue the job",
+               "UPDATE jobs SET state = 0, error = '', desync_tick = -1, started = 0, finished = 0 WHERE id = ?1",
+               ARGS(I(id)), NULL, err) >= 0 &&
+           sq_refresh(s, id, err);
+}
+
 int sq_retry(svc_store *bs, int64_t id, rs_err *err)
 {
-    sq_store *s = S(bs);
-    int64_t now;
-    int rc = -1, state = 0;
-    pthread_mutex_lock(&s->mu);
-    if (!sq_tx_begin(s, &now, err))
-        goto out;
-    int l = sq_lock_job(s, id, &state, NULL, err);
-    bool ok = l >= 0, failed = l > 0 && state == SVC_FAILED;
-    if (ok && failed)
-        ok = run(s, "re-queue the units",
-                 "UPDATE units SET state = 0, attempts = 0, lost = 0, error = '', owner = '', claimed_until = 0,"
-                 " frames_done = 0, fps = 0, started = 0, finished = 0, done_by = '', done_attempt = 0"
-                 " WHERE job_id = ?1",
-                 ARGS(I(id)), NULL, err) >= 0 &&
-             run(s, "re-queue the job",
-                 "UPDATE jobs SET state = 0, error = '', desync_tick = -1, started = 0, finished = 0 WHERE id = ?1",
-                 ARGS(I(id)), NULL, err) >= 0 &&
-             sq_refresh(s, id, err);
-    rc = sq_tx_end(s, ok, l == 0 ? 0 : failed ? 1 : 2, err);
-out:
-    pthread_mutex_unlock(&s->mu);
-    return rc;
+    return job_change(bs, id, is_failed, retry_job, err);
 }
 
 static void pending_row(void *dst, const sq_res *r, int i)
