@@ -1,5 +1,5 @@
 #version 330 core
-// variants: - GLOW GLOW+LEVEL2 GLOW+FLARE GLOW+LEVEL2+FLARE
+// variants: - REACH=1 REACH=2 REACH=3 REACH=4 GLOW GLOW+LEVEL2 GLOW+FLARE GLOW+LEVEL2+FLARE
 // Separable Gaussian (9 taps, sigma 2 texels, as 5 bilinear fetches) along
 // u_dir (one texel of the source in uv units).  Used by the shadow mask,
 // the silhouette mip chain and bloom.  The output has the source's size.
@@ -8,6 +8,18 @@
 // sun's flare (FLARE), so the tone map taps one texture a pixel, not three.
 uniform sampler2D u_src;
 uniform vec2 u_dir;
+#ifdef REACH
+// The same blur as texels, for steps of at most one texel (r_blur_into):
+// the weight of the texels 0..REACH away along u_axis, off the edges as
+// the sampler is (clamped, or a zero border).  Each texel is read once where each paired
+// bilinear fetch reads four, which on llvmpipe is the cheaper way for
+// 8-bit targets (the silhouette's levels, the shadow mask); the taps are
+// unrolled, as a loop to a uniform count and an array indexed by it cost
+// more than they save there.
+uniform ivec2 u_axis; // (1, 0) or (0, 1)
+uniform float u_w[REACH + 1];
+uniform int u_zero_border;
+#endif
 uniform float u_lod;
 #ifdef GLOW
 uniform float u_bloom;
@@ -22,12 +34,33 @@ out vec4 o_color;
 void main()
 {
     vec2 uv = gl_FragCoord.xy / vec2(textureSize(u_src, int(u_lod)));
+#ifdef REACH
+    int l = int(u_lod);
+    ivec2 p = ivec2(gl_FragCoord.xy), hi = textureSize(u_src, l) - 1;
+    // a texel off the edge: the edge's (u_zero_border 0) or zero (1, as
+    // the silhouette's CLAMP_TO_BORDER with a zero border)
+    int along = u_axis.x != 0 ? p.x : p.y, last = u_axis.x != 0 ? hi.x : hi.y;
+#define SIDE(q, j) texelFetch(u_src, clamp(q, ivec2(0), hi), l) * (u_zero_border == 1 && (j < 0 || j > last) ? 0.0 : 1.0)
+#define TAP(i) (SIDE(p + i * u_axis, along + i) + SIDE(p - i * u_axis, along - i)) * u_w[i]
+    vec4 c = texelFetch(u_src, p, l) * u_w[0] + TAP(1);
+#if REACH > 1
+    c += TAP(2);
+#endif
+#if REACH > 2
+    c += TAP(3);
+#endif
+#if REACH > 3
+    c += TAP(4);
+#endif
+#else
     // weights of taps 0, +-1..4 (sigma 2), paired into linear fetches
+    // (r_blur_kernel in r_gl.c has the same numbers)
     const float w0 = 0.2042, w1 = 0.3040, w2 = 0.0931;
     const float o1 = 1.3846, o2 = 3.2308;
     vec4 c = textureLod(u_src, uv, u_lod) * w0;
     c += (textureLod(u_src, uv + u_dir * o1, u_lod) + textureLod(u_src, uv - u_dir * o1, u_lod)) * w1;
     c += (textureLod(u_src, uv + u_dir * o2, u_lod) + textureLod(u_src, uv - u_dir * o2, u_lod)) * w2;
+#endif
 #ifndef GLOW
     o_color = c;
 #else

@@ -21,6 +21,7 @@
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
+#include "../runtime/render/r_local.h"
 #include "../runtime/render/r_stage.h"
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_img.h"
@@ -844,6 +845,77 @@ static void t_fighters_read_on_every_stage(void)
     plat_destroy(p);
 }
 
+/* The silhouette's and the shadow mask's blur reads each texel once
+ * (r_blur_texels_into) where the others take bilinear pairs: the same
+ * kernel, so the same picture within the 8-bit filter weights' rounding,
+ * for every step up to a texel, both axes, a clamped edge and a zero
+ * border (the silhouette's sampler: a blur that clamps there darkens its
+ * edges, which is how the first version went wrong). */
+static void t_texel_blur_matches_pairs(void)
+{
+    for (float k = 0.125f; k <= 1.0f; k += 0.125f) {
+        float w[5], sum = 0;
+        int reach = r_blur_kernel(k, w);
+        bool beyond = false;
+        for (int i = 0; i < 5; i++) {
+            sum += i ? 2 * w[i] : w[i];
+            beyond |= i > reach && w[i] != 0;
+        }
+        T_ASSERTF(fabsf(sum - 0.9984f) < 1e-4f && reach >= 1 && reach <= 4 && !beyond,
+                  "k %.3f: weights add to %.5f, reach %d", k, sum, reach);
+    }
+    plat *p = t_context("egl");
+    r_game *r = t_game_new(false);
+    enum { BW = 40, BH = 24 };
+    static uint8_t src[BW * BH], a[BW * BH], b[BW * BH];
+    uint32_t seed = 7;
+    for (int i = 0; i < BW * BH; i++) {
+        seed = seed * 1664525u + 1013904223u;
+        src[i] = (uint8_t)(seed >> 24);
+    }
+    static const float zero[4] = {0};
+    GLuint out_a = r_tex2d(GL_R8, BW, BH, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+    GLuint out_b = r_tex2d(GL_R8, BW, BH, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+    GLuint fa = r_fbo_for(out_a, 0, 0), fb = r_fbo_for(out_b, 0, 0);
+    int worst = 0;
+    for (int border = 0; border < 2; border++) {
+        GLuint in = r_tex2d(GL_R8, BW, BH, GL_RED, GL_UNSIGNED_BYTE, src, GL_LINEAR,
+                            border ? GL_CLAMP_TO_BORDER : GL_CLAMP_TO_EDGE);
+        if (border) {
+            gl.BindTexture(GL_TEXTURE_2D, in);
+            gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, zero);
+        }
+        for (int axis = 0; axis < 2; axis++)
+            for (float k = 0.25f; k <= 1.0f; k += 0.25f) {
+                float dx = axis ? 0 : k, dy = axis ? k : 0;
+                gl.Disable(GL_SCISSOR_TEST);
+                r_blur_into(r, fa, in, 0, BW, BH, dx, dy);
+                r_blur_texels_into(r, fb, in, 0, BW, BH, dx, dy, border);
+                gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+                gl.BindFramebuffer(GL_FRAMEBUFFER, fa);
+                gl.ReadPixels(0, 0, BW, BH, GL_RED, GL_UNSIGNED_BYTE, a);
+                gl.BindFramebuffer(GL_FRAMEBUFFER, fb);
+                gl.ReadPixels(0, 0, BW, BH, GL_RED, GL_UNSIGNED_BYTE, b);
+                int most = 0;
+                for (int i = 0; i < BW * BH; i++)
+                    most = abs(a[i] - b[i]) > most ? abs(a[i] - b[i]) : most;
+                T_ASSERTF(most <= 2, "%s, %s, step %.2f: texels and pairs differ by %d levels",
+                          border ? "zero border" : "clamped", axis ? "down" : "across", k, most);
+                worst = most > worst ? most : worst;
+            }
+        gl.DeleteTextures(1, &in);
+    }
+    fprintf(stderr, "    texels against bilinear pairs: at most %d levels apart\n", worst);
+    T_EQ(gl.GetError(), GL_NO_ERROR);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteFramebuffers(1, &fa);
+    gl.DeleteFramebuffers(1, &fb);
+    gl.DeleteTextures(1, &out_a);
+    gl.DeleteTextures(1, &out_b);
+    r_game_destroy(r);
+    plat_destroy(p);
+}
+
 /* The renderer's error ids: each has its own text, and they are the
  * render module's (rs_err.h). */
 static void t_error_ids(void)
@@ -871,4 +943,5 @@ T_MAIN({"error_ids", t_error_ids}, {"golden_egl", t_golden_egl}, {"golden_osmesa
        {"shadows_darken_the_floor", t_shadows_darken_the_floor},
        {"shadow_follows_the_key_light", t_shadow_follows_the_key_light}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
        {"packed_float_hdr", t_packed_float_hdr}, {"lens_stays_on_the_head", t_lens_stays_on_the_head},
-       {"fighters_read_on_every_stage", t_fighters_read_on_every_stage})
+       {"fighters_read_on_every_stage", t_fighters_read_on_every_stage},
+       {"texel_blur_matches_pairs", t_texel_blur_matches_pairs})

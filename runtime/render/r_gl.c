@@ -137,9 +137,55 @@ void r_blur_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int 
     gl.Uniform1f(r_loc(p, "u_lod"), (float)lod);
 }
 
+/* blur.frag's kernel as texel weights, for a step of k texels (0 < k <= 1):
+ * each paired bilinear fetch at offset o k splits its weight between
+ * texels floor(o k) and the next, and the fetches on both sides of the
+ * centre add into it.  w[0..4]; returns how far it reaches (1..4). */
+int r_blur_kernel(float k, float w[5])
+{
+    static const float w0 = 0.2042f, wi[2] = {0.3040f, 0.0931f}, oi[2] = {1.3846f, 3.2308f};
+    int reach = 1;
+    memset(w, 0, 5 * sizeof *w);
+    w[0] = w0;
+    for (int i = 0; i < 2; i++) {
+        float o = oi[i] * k;
+        int j = (int)floorf(o);
+        float f = o - (float)j;
+        w[j] += wi[i] * (1 - f) * (j == 0 ? 2 : 1);
+        w[j + 1] += wi[i] * f;
+        if (f > 0 && j + 1 > reach)
+            reach = j + 1;
+        else if (j > reach)
+            reach = j;
+    }
+    return reach;
+}
+
 void r_blur_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy)
 {
     r_blur_setup(r->prog[P_BLUR], dst_fbo, src_tex, lod, w, h, dx, dy);
+    r_fullscreen(r);
+}
+
+/* The same blur reading each texel once (blur.frag's REACH variants), for
+ * steps of at most a texel along one axis on 8-bit targets, clamped at the
+ * edge or with a zero border (zero_border: as src_tex's sampler has it);
+ * other steps take r_blur_into's bilinear pairs. */
+void r_blur_texels_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy,
+                        bool zero_border)
+{
+    float k = dx != 0 ? dx : dy;
+    if ((dx == 0) == (dy == 0) || !(k > 0 && k <= 1)) {
+        r_blur_into(r, dst_fbo, src_tex, lod, w, h, dx, dy);
+        return;
+    }
+    float kw[5];
+    int reach = r_blur_kernel(k, kw);
+    GLuint p = r->prog[P_BLUR_TEXELS + reach - 1];
+    r_blur_setup(p, dst_fbo, src_tex, lod, w, h, dx, dy);
+    gl.Uniform2i(r_loc(p, "u_axis"), dx != 0, dy != 0);
+    gl.Uniform1fv(r_loc(p, "u_w"), reach + 1, kw);
+    gl.Uniform1i(r_loc(p, "u_zero_border"), zero_border);
     r_fullscreen(r);
 }
 

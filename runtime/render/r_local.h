@@ -43,7 +43,8 @@ typedef struct prog {
  * the city's buildings and P_STAGE_HOLE the craters' insides (0 on a look
  * without them). */
 enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK_END,
-       P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_DOWN, P_SUNVIS, P_FLARE, P_HUD, P_FXAA, P_FXAA_MARK,
+       P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_BLUR_TEXELS, /* + 3: reaching 1..4 texels */
+       P_DOWN = P_BLUR_TEXELS + 4, P_SUNVIS, P_FLARE, P_HUD, P_FXAA, P_FXAA_MARK,
        P_GLOW, /* + 4 variants: bloom's last blur with its second level x the flare (r_post.c) */
        P_TONE = P_GLOW + 4, /* + 1 variant: with the glow */
        P_COUNT = P_TONE + 2 };
@@ -126,6 +127,15 @@ GLuint r_cube_tex(int n, float *const face[6], int levels); /* RGB16F faces; mip
 /* r_blur_into's state with program p (blur.frag or a variant), not drawn:
  * the caller sets the variant's uniforms, then r_fullscreen */
 void r_blur_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy);
+/* blur.frag's kernel for a step of k texels (0 < k <= 1) as the weights
+ * of the texels 0..4 away (w[5]); returns how many it reaches (1..4) */
+int r_blur_kernel(float k, float w[5]);
+/* r_blur_into reading each texel once: for the 8-bit targets (silhouette
+ * levels, with their zero border, and the shadow mask), where on llvmpipe
+ * it is cheaper; the RGBA16F ones (bloom) and the wrapped ones (fog) keep
+ * the bilinear pairs */
+void r_blur_texels_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy,
+                        bool zero_border);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
 /* The bloom pyramid for a w x h render: *steps down from the HDR image
  * to the BLOOM_ROWS level (halvings, the last a resample), *w4 its width. */

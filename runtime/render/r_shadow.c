@@ -139,9 +139,9 @@ static void run_silhouette_mips(void *u)
         r_down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
         restrict_level(r->sil_tex, k);
         clear_then_scissor(r->sil_tmp_fbo[k], b);
-        r_blur_into(r, r->sil_tmp_fbo[k], r->sil_tex, 0, n, n, 1, 0);
+        r_blur_texels_into(r, r->sil_tmp_fbo[k], r->sil_tex, 0, n, n, 1, 0, true);
         restrict_level(r->sil_tmp, k);
-        r_blur_into(r, r->sil_fbo[k], r->sil_tmp, 0, n, n, 0, 1);
+        r_blur_texels_into(r, r->sil_fbo[k], r->sil_tmp, 0, n, n, 0, 1, true);
     }
     gl.Disable(GL_SCISSOR_TEST);
     gl.BindTexture(GL_TEXTURE_2D, r->sil_tex);
@@ -229,8 +229,8 @@ static void run_mask_filter(void *u)
     gl.Uniform1f(r_loc(p, "u_radius"), k);
     r_fullscreen(r);
     /* outside the box both buffers hold 1, so the blur reads the truth there */
-    r_blur_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->mask_w, r->mask_h, k, 0);
-    r_blur_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->mask_w, r->mask_h, 0, k);
+    r_blur_texels_into(r, r->mask_fbo[0], r->mask_tex[1], 0, r->mask_w, r->mask_h, k, 0, false);
+    r_blur_texels_into(r, r->mask_fbo[1], r->mask_tex[0], 0, r->mask_w, r->mask_h, 0, k, false);
     gl.Disable(GL_SCISSOR_TEST);
     r->mask_final = 1;
 }
