@@ -41,6 +41,13 @@ enum MHD_Result http_health(svc_daemon *d, struct MHD_Connection *c, req *q)
         mw = d->cfg.render_width < mw ? d->cfg.render_width : mw, mh = d->cfg.render_height < mh ? d->cfg.render_height : mh;
     svc_buf_printf(&b, ",\"default_size\":\"%dx%d\",\"max_size\":\"%dx%d\",\"default_format\":\"%s\",\"default_quality\":\"%s\"",
                    d->cfg.width, d->cfg.height, mw, mh, d->cfg.format, d->cfg.quality);
+    /* and the encoder's choices a job may make (settings codecs, presets,
+     * min_crf; "*": whatever the encoder takes) */
+    svc_buf_add(&b, ",\"codecs\":", 10);
+    svc_json_str(&b, d->cfg.codecs[0] ? d->cfg.codecs : "*");
+    svc_buf_add(&b, ",\"presets\":", 11);
+    svc_json_str(&b, d->cfg.presets[0] ? d->cfg.presets : "*");
+    svc_buf_printf(&b, ",\"min_crf\":%d", d->cfg.min_crf);
     if (ok)
         svc_buf_printf(&b, ",\"queued\":%" PRId64 ",\"running\":%" PRId64 "}\n", counts[SVC_QUEUED], counts[SVC_RUNNING]);
     else {

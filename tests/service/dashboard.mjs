@@ -3,13 +3,17 @@
 //
 //   node tests/service/dashboard.mjs --url http://127.0.0.1:PORT --replay FILE.rsr \
 //        --shot OUT.png [--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]
-//        [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]
+//        [--phone-shot PHONE.png] [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]
 //
 // Opens the page in headless Chromium, uploads the replay, waits for the job's
 // row to reach data-state="done" (failing fast on "failed"/"cancelled"), checks
 // the row's <progress> moved, clicks "watch", waits for the <video> to load its
 // metadata (videoWidth > 0, duration > 0), saves a full-page screenshot and
-// prints one result line.  Exit 0 on success, 1 on any failure (with the reason),
+// prints one result line.  The form's encoder fields (codec, CRF, preset,
+// sound) must reach the job.  At 1280x800, and at 390x844 (a phone; its
+// screenshot PHONE.png with --phone-shot), nothing may scroll sideways (the
+// page's and the table's scrollWidth <= clientWidth) and every action of the
+// job's row must lie inside the window.  Exit 0 on success, 1 on any failure (with the reason),
 // 2 on bad usage.
 //
 // Without --token the daemon must need no token: the page must never show the
@@ -32,11 +36,12 @@ import fs from 'node:fs';
 import path from 'node:path';
 
 const USAGE = 'usage: node tests/service/dashboard.mjs --url URL --replay FILE --shot OUT.png ' +
-  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH] [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]';
+  '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH] [--phone-shot PHONE.png] ' +
+  '[--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]';
 
 function parseArgs(argv) {
   const o = { timeout: 120, size: '320x180', format: 'webm', chromium: process.env.CHROMIUM || '/usr/bin/chromium' };
-  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot', 'quota-token']);
+  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot', 'quota-token', 'phone-shot']);
   for (let i = 0; i < argv.length; i++) {
     let a = argv[i], v;
     if (a === '-h' || a === '--help') { console.log(USAGE); process.exit(0); }
@@ -152,6 +157,28 @@ async function downloadHashes(page, id) {
   }
 }
 
+// nothing scrolls sideways, and every action of the row shown is inside the window
+async function layoutFits(page, rowSel, what) {
+  const m = await page.evaluate((sel) => {
+    const de = document.documentElement, wrap = document.querySelector('.table-wrap');
+    const tr = document.querySelector(sel);
+    const out = [];
+    for (const el of tr ? tr.querySelectorAll('td.actions > button, td.actions > a, td.actions summary') : []) {
+      if (el.hidden || el.closest('[hidden]')) continue;
+      const b = el.getBoundingClientRect();
+      if (b.width === 0) continue;
+      if (b.left < 0 || b.right > window.innerWidth + 0.5) out.push(`${el.textContent.trim()} at ${Math.round(b.left)}..${Math.round(b.right)}`);
+    }
+    return { page: [de.scrollWidth, de.clientWidth], table: wrap ? [wrap.scrollWidth, wrap.clientWidth] : null,
+      outside: out, width: window.innerWidth, row: !!tr };
+  }, rowSel);
+  if (!m.row) fail(`${what}: the job's row is gone`);
+  if (m.page[0] > m.page[1]) fail(`${what}: the page scrolls sideways (scrollWidth ${m.page[0]} > clientWidth ${m.page[1]})`);
+  if (m.table && m.table[0] > m.table[1]) fail(`${what}: the jobs table scrolls sideways (scrollWidth ${m.table[0]} > clientWidth ${m.table[1]})`);
+  if (m.outside.length) fail(`${what}: actions outside the ${m.width} px window: ${m.outside.join(', ')}`);
+  return m;
+}
+
 async function main() {
   const opt = parseArgs(process.argv.slice(2));
   if (!fs.existsSync(opt.replay)) fail(`replay ${opt.replay} not found`);
@@ -191,7 +218,8 @@ async function main() {
       fail(`cannot open ${opt.url}/: ${e.message.split('\n')[0]}`);
     }
     if (!resp || !resp.ok()) fail(`GET ${opt.url}/ answered ${resp ? resp.status() : 'nothing'}`);
-    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-quality', '#upload-button', '#upload-status', '#jobs', '#player',
+    for (const sel of ['#upload-file', '#upload-size', '#upload-format', '#upload-quality', '#upload-codec', '#upload-crf',
+      '#upload-preset', '#upload-audio', '#upload-button', '#upload-status', '#jobs', '#player',
       '#token-section', '#token-input', '#token-save', '#token-error', '#token-forget']) {
       if (await page.locator(sel).count() !== 1) fail(`page has no single ${sel}`);
     }
@@ -216,6 +244,18 @@ async function main() {
       if (!vals.includes(val)) fail(`${sel} has no option '${val}' (has ${vals.join(', ')})`);
       await page.selectOption(sel, val);
     }
+    // the encoder's fields: what the form sends must be what the job gets
+    const enc = opt.format === 'webm' ? { codec: 'vp9', crf: '40', preset: '8' } : { codec: 'h264', crf: '30', preset: 'superfast' };
+    await page.selectOption('#upload-codec', enc.codec);
+    await page.fill('#upload-crf', enc.crf);
+    await page.fill('#upload-preset', enc.preset);
+    const presets = await page.$$eval('#upload-presets option', (os) => os.map((o) => o.value));
+    if (!presets.includes(enc.preset)) fail(`the preset suggestions (${presets.join(', ')}) leave out ${enc.preset}`);
+    if (!(await page.isChecked('#upload-audio'))) fail('the sound box is not checked by default');
+    const formats = await page.$$eval('#upload-format option', (os) => os.map((o) => o.value));
+    if (!formats.includes('mkv')) fail(`the format menu offers ${formats.join(', ')}: no mkv`);
+    const high = await page.$eval('#upload-quality option[value="high"]', (o) => o.textContent);
+    if (!/3×3/.test(high)) fail(`the high quality option says '${high}', not 3×3`);
     if (opt.format === 'mp4') {
       const can = await page.evaluate(() => document.createElement('video').canPlayType('video/mp4; codecs="avc1.640028"'));
       if (!can) fail('this Chromium cannot play H.264 mp4; use --format webm');
@@ -242,6 +282,9 @@ async function main() {
     }
     const job = await (await page.request.get(`${opt.url}/jobs/${id}`, opt.token ? { headers: { Authorization: `Bearer ${opt.token}` } } : {})).json();
     if (job.quality !== 'draft') fail(`the job was queued with quality ${job.quality}, not the 'draft' the form asked for`);
+    if (job.codec !== enc.codec || !job.encode.includes(`crf=${enc.crf}`) || !job.encode.includes(`preset=${enc.preset}`)) {
+      fail(`the job was queued with codec ${job.codec}, encode '${job.encode}': not the form's ${JSON.stringify(enc)}`);
+    }
 
     // 4. wait for the row to be done, watching its progress bar
     const rowSel = `#jobs tr[data-job-id="${id}"]`;
@@ -325,7 +368,7 @@ async function main() {
     const row = await page.$eval(rowSel, (tr) => ({
       poster: [tr.querySelector('img.poster').naturalWidth, tr.querySelector('img.poster').naturalHeight].join('x'),
       posterSrc: tr.querySelector('img.poster').src,
-      match: tr.querySelector('td.match').textContent, output: tr.querySelector('td.output').textContent,
+      match: tr.querySelector('.match').textContent, output: tr.querySelector('td.output').textContent,
     }));
     if (row.poster !== opt.size) fail(`the poster is ${row.poster}, not the video's ${opt.size}`);
     if (opt.token && !row.posterSrc.startsWith('blob:')) fail(`with a token the poster came from ${row.posterSrc}`);
@@ -341,6 +384,15 @@ async function main() {
     await page.$eval('.table-wrap', (w) => { w.scrollLeft = 0; });
     fs.mkdirSync(path.dirname(path.resolve(opt.shot)), { recursive: true });
     await page.screenshot({ path: opt.shot, fullPage: true });
+    await layoutFits(page, rowSel, 'at 1280x800');
+    if (opt['phone-shot']) {
+      await page.setViewportSize({ width: 390, height: 844 });
+      await sleep(300);
+      await layoutFits(page, rowSel, 'at 390x844');
+      fs.mkdirSync(path.dirname(path.resolve(opt['phone-shot'])), { recursive: true });
+      await page.screenshot({ path: opt['phone-shot'], fullPage: true });
+      await page.setViewportSize({ width: 1280, height: 800 });
+    }
     checkPageErrors();
     if (!opt.token) {
       // 8. delete the finished job: a confirm, then the row and its files go
@@ -359,7 +411,8 @@ async function main() {
     console.log(`dashboard ok${opt.token ? ' with a token' : ''}: job ${id} done in ${secs} s ` +
       `(total ${((Date.now() - t0) / 1000).toFixed(1)} s), ` +
       `video ${meta.w}x${meta.h} ${opt.format} from ${meta.src.split(':')[0]}:, duration ${dur} s, ` +
-      `progress ${samples} samples ${increases} rises, shot ${opt.shot}${opt.token ? ` and ${opt['form-shot']}` : ''}`);
+      `progress ${samples} samples ${increases} rises, shot ${opt.shot}${opt['phone-shot'] ? ` and ${opt['phone-shot']}` : ''}` +
+      `${opt.token ? ` and ${opt['form-shot']}` : ''}`);
   } finally {
     await browser.close().catch(() => {});
   }

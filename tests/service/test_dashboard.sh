@@ -1,7 +1,9 @@
 #!/bin/sh
 # The dashboard in a real browser: headless Chromium (Debian's), driven by
 # playwright-core (tests/service/dashboard.mjs), uploads a replay, watches
-# the progress bar reach done and plays the video: once on a loopback daemon
+# the progress bar reach done and plays the video, with the form's encoder
+# options, and checks that nothing scrolls sideways at 1280x800 and 390x844
+# (the phone screenshot): once on a loopback daemon
 # that needs no token, once on one that does (the token form, a refused
 # token, the video from a blob: URL, reload, "forget token", a 429).  Screenshots
 # land in $RS_TEST_OUT/dashboard*.png.
@@ -25,10 +27,10 @@ t_upload_progress_and_watch() {
     need_browser || return 1
     "$RS_BIN" record --ai --quiet --seconds 5 --seed 12 --stage temple -o match.rsr || return 1
     svc_start d $SVC_FAST --render-size 320x180 --max-size 640x360 || return 1
-    shot=${RS_TEST_OUT:-.}/dashboard.png
+    shot=${RS_TEST_OUT:-.}/dashboard.png phone=${RS_TEST_OUT:-.}/dashboard-phone.png
     node "$here/service/dashboard.mjs" --url "$SVC_URL" --replay match.rsr --size 320x180 --format webm \
-        --shot "$shot" --chromium "$chromium" --timeout 120 || { tail -20 d.log; return 1; }
-    [ -s "$shot" ] || { echo "no screenshot"; return 1; }
+        --shot "$shot" --phone-shot "$phone" --chromium "$chromium" --timeout 120 || { tail -20 d.log; return 1; }
+    [ -s "$shot" ] && [ -s "$phone" ] || { echo "no screenshots"; return 1; }
     svc_stop
 }
 
