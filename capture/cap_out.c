@@ -13,6 +13,11 @@ bool cap_out_is_stream(const char *path)
     return rs_out_is_stream(path);
 }
 
+const char *cap_out_name(const char *path)
+{
+    return strcmp(path, "-") ? path : "standard output";
+}
+
 bool cap_out_open(cap_out *o, const char *path, rs_err *err)
 {
     memset(o, 0, sizeof *o);
@@ -43,8 +48,11 @@ bool cap_out_open(cap_out *o, const char *path, rs_err *err)
 bool cap_out_write(cap_out *o, const void *data, size_t n, rs_err *err)
 {
     errno = 0;
-    if (fwrite(data, 1, n, o->f) != n)
+    if (fwrite(data, 1, n, o->f) != n) {
+        if (errno == EPIPE)
+            return rs_fail(err, CAP_ERR_PIPE_CLOSED, "%s: the reader closed the pipe", cap_out_name(o->path));
         return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", o->path, strerror(errno ? errno : EIO));
+    }
     return true;
 }
 
@@ -68,6 +76,8 @@ bool cap_out_close(cap_out *o, bool ok, rs_err *err)
         if (!good) {
             if (!o->device)
                 unlink(o->tmp);
+            if (e == EPIPE)
+                return rs_fail(err, CAP_ERR_PIPE_CLOSED, "%s: the reader closed the pipe before the end", cap_out_name(o->path));
             return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", o->path, strerror(e ? e : EIO));
         }
         if (!o->device && rename(o->tmp, o->path) != 0) {

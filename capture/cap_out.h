@@ -16,6 +16,8 @@ typedef struct cap_out {
 } cap_out;
 
 bool cap_out_open(cap_out *o, const char *path, rs_err *err);
+/* path as messages name it: "-" is "standard output" */
+const char *cap_out_name(const char *path);
 /* "-", or an existing character device, pipe or socket: written in place, never renamed. */
 bool cap_out_is_stream(const char *path);
 bool cap_out_write(cap_out *o, const void *data, size_t n, rs_err *err);

@@ -39,7 +39,9 @@
     X(SEG_HASHES, "a segment's frame hash list is missing, malformed or differs from its manifest")  \
     /* encoder settings (cap_enc.h) */                                                               \
     X(ENC_SETTING, "an encoder setting that the container or the encoder does not take")              \
-    X(ENC_HW, "the hardware encoder asked for (--hw nvenc|vaapi) has no device or does not open")
+    X(ENC_HW, "the hardware encoder asked for (--hw nvenc|vaapi) has no device or does not open")    \
+    /* a stream output (-o -, a pipe) */                                                            \
+    X(PIPE_CLOSED, "the program reading the output pipe closed it before the end")
 
 typedef enum cap_error {
     CAP_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_CAP),

@@ -60,6 +60,8 @@ static const char *ext_of(const char *path)
 
 static int fail_av(rs_err *err, int id, const char *path, const char *what, int code)
 {
+    if (code == AVERROR(EPIPE))
+        return rs_fail(err, CAP_ERR_PIPE_CLOSED, "%s: the reader closed the pipe", cap_out_name(path));
     char msg[AV_ERROR_MAX_STRING_SIZE] = "";
     av_strerror(code, msg, sizeof msg);
     return rs_fail(err, id, "%s: %s: %s", path, what, msg);

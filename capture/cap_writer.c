@@ -54,6 +54,10 @@ static bool write_one(cap_writer *w, const uint8_t *frame, uint64_t index, rs_er
         return rs_fail(err, CAP_ERR_WRITE, "writing the frame hash list failed at frame %llu: %s",
                        (unsigned long long)(index + w->sink->index_base), strerror(errno));
     bool ok = w->sink->ops->write(w->sink, frame, index, err);
+    if (!ok && err && err->code == CAP_ERR_PIPE_CLOSED) { /* where the reader stopped */
+        size_t l = strlen(err->msg);
+        snprintf(err->msg + l, sizeof err->msg - l, " at frame %llu", (unsigned long long)(index + w->sink->index_base));
+    }
     w->st.write_ms += (rs_now() - t0) * 1e3;
     if (ok)
         w->st.frames++;

@@ -1,7 +1,9 @@
 #include "cli.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -73,6 +75,43 @@ bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out)
         return false;
     }
     *out = v;
+    return true;
+}
+
+/* "SS[.s]", "MM:SS[.s]" or "HH:MM:SS[.s]": seconds, or -1 when malformed */
+static double clock_seconds(const char *arg)
+{
+    double total = 0;
+    const char *p = arg;
+    for (int field = 0; field < 3; field++) {
+        char *end;
+        if (!isdigit((unsigned char)*p))
+            return -1;
+        errno = 0;
+        double v = strtod(p, &end);
+        if (errno || end == p)
+            return -1;
+        bool frac = memchr(p, '.', (size_t)(end - p)) != NULL;
+        if (field > 0 && (v >= 60 || end - p < 2)) /* MM:SS: two digits after a colon, under 60 */
+            return -1;
+        total = total * 60 + v;
+        if (*end == 0)
+            return total;
+        if (*end != ':' || frac || field == 2)
+            return -1;
+        p = end + 1;
+    }
+    return -1;
+}
+
+bool cli_time(const char *opt, const char *arg, long *ticks)
+{
+    double s = arg[0] && !strpbrk(arg, "eExXpP") ? clock_seconds(arg) : -1;
+    if (s < 0 || s > CLI_TIME_MAX_S) {
+        opt_error("%s '%s': expected seconds (12.5), MM:SS (1:05) or HH:MM:SS (0:01:05.5), up to a week", opt, arg);
+        return false;
+    }
+    *ticks = lround(s * 60);
     return true;
 }
 

@@ -6,8 +6,11 @@
 #include <stdint.h>
 #include <stdio.h>
 
-/* 3: join only, one or more segments are bad (they are to be rendered again) */
-enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2, RS_EXIT_SEGMENT = 3 };
+/* The exit statuses (README, "Exit status"): 0 done; 1 the job failed; 2
+ * bad usage (an option, a name that cannot be written, a range past the
+ * replay); 3 join only: one or more segments are bad (they are to be
+ * rendered again); 4 the program reading -o - closed the pipe early. */
+enum { RS_EXIT_OK = 0, RS_EXIT_FAIL = 1, RS_EXIT_USAGE = 2, RS_EXIT_SEGMENT = 3, RS_EXIT_PIPE = 4 };
 
 typedef struct cli_cmd {
     const char *name;
@@ -31,6 +34,11 @@ const struct r_preset *cli_quality(const char *cmd, const char *arg);
 const char *cli_quality_help(void);
 /* Parses a non-negative 64-bit number (decimal or 0x hex). */
 bool cli_u64(const char *opt, const char *arg, uint64_t *out);
+/* A time: seconds ("12.5"), "MM:SS" or "HH:MM:SS" (fractions on the last
+ * field), at most CLI_TIME_MAX_S, as ticks (1/60 s, rounded to the
+ * nearest); prints a usage error naming opt. */
+#define CLI_TIME_MAX_S (7 * 24 * 3600.0)
+bool cli_time(const char *opt, const char *arg, long *ticks);
 /* Parses an integer in [lo, hi]; prints a usage error naming opt. */
 bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out);
 /* "ringside CMD: message" on stderr. */

@@ -2,6 +2,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <inttypes.h>
+#include <limits.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <stdio.h>
@@ -39,7 +40,8 @@ static void help(void)
            "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
-           "                       [--ticks A:B|A:] [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
+           "                       [--ticks A:B|A: | --from T [--to T | --duration T]]\n"
+           "                       [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
            "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
            "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n"
            "                       [--audio on|off] [--audio-bitrate RATE] [--loudness LUFS] [--wav FILE]\n"
@@ -47,10 +49,13 @@ static void help(void)
            "Renders every tick of a replay headless and writes one video frame per tick\n"
            "(60 frames a second, exact).  The output type comes from the extension (any\n"
            "case) or --format: %s.\n"
-           "The output appears only when complete; a failed render leaves nothing.\n\n"
+           "The output appears only when complete; a failed render leaves nothing.\n"
+           "REPLAY '-' reads the replay from standard input.\n\n"
            "  -o OUT             output file ('/dev/null' and other devices are streamed), an\n"
            "                     image sequence pattern such as frames/f%%06d.png, or '-': a\n"
-           "                     stream on standard output (Y4M unless --format says nut or mkv)\n"
+           "                     stream on standard output (Y4M unless --format says nut or mkv);\n"
+           "                     a reader that closes it early ends the render with the frame\n"
+           "                     it stopped at and exit status 4\n"
            "  --format F         the container when the name does not say it: y4m, nut, mkv,\n"
            "                     mp4 (not to a pipe: its index goes last) or webm\n"
            "  -y, --overwrite    replace outputs that exist (video, images, --hashes, --poster,\n"
@@ -95,6 +100,10 @@ static void help(void)
            "                     writes there: the game runs from tick 0 and the effects that\n"
            "                     carry history (water, snow, mist, LSPSM) are warmed up first;\n"
            "                     image names and --hashes lines are numbered A..B-1\n"
+           "  --from T, --to T, --duration T\n"
+           "                     the same range in time: T is seconds (12.5), MM:SS (1:05) or\n"
+           "                     HH:MM:SS (0:01:05.5), rounded to the nearest tick (1/60 s);\n"
+           "                     --from alone renders to the end; not with --ticks\n"
            "  --segment KEY      write a segment that 'ringside join' can put together with the\n"
            "                     others (.mp4, .mkv or .webm): first frame a keyframe, closed GOP,\n"
            "                     timestamps from tick A; beside it OUT.seg, its manifest (KEY,\n"
@@ -137,13 +146,24 @@ static void help(void)
            "  --quiet            no progress line (--progress off) and no summary\n"
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
-           "tick that differs, and nothing is written.\n",
+           "tick that differs, and nothing is written.\n\n"
+           "examples:\n"
+           "  ringside render demos/dojo.rsr -o dojo.mp4\n"
+           "                     the default job: 640x360, standard quality, AAC sound\n"
+           "  ringside render m.rsr -o m.webm --size 1280x720 --quality high\n"
+           "                     720p VP9, 3x3 pixels drawn per output pixel\n"
+           "  ringside render m.rsr --from 1:00 --duration 10 -o clip.mkv\n"
+           "                     ten seconds from the first minute\n"
+           "  cat m.rsr | ringside render - -o - | ffplay -\n"
+           "                     a replay from a pipe, watched as it renders (Y4M)\n"
+           "  ringside render m.rsr -o frames/f%%06d.png --ticks 600:660\n"
+           "                     one second as PNG images f000600.png .. f000659.png\n",
            cap_sink_formats(), CLI_SIZE_MIN, R_RENDER_MAX, cli_quality_help(), CAP_MAX_SCALE, CAP_MAX_PBO, CAP_DEFAULT_PBO, CAP_DEFAULT_QUEUE, JOB_POSTER_AFTER_KO, JOB_AUDIO_LUFS_MIN,
            JOB_AUDIO_LUFS_MAX, JOB_AUDIO_LUFS_DEFAULT, JOB_SPLIT_MIN_FRAMES);
 }
 
 /* long-only options (no letter): the encoder's */
-enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW, OPT_JOBS };
+enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW, OPT_JOBS, OPT_FROM, OPT_TO, OPT_DURATION };
 
 /* What a segment of a parallel render (--jobs) is given of the user's
  * options: the ones that decide the pictures and the encoding.  The rest
@@ -218,7 +238,8 @@ static const struct option opts[] = {
     {"poster", required_argument, 0, 'O'},     {"quality", required_argument, 0, 'L'},
     {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
     {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
-    {"jobs", required_argument, 0, OPT_JOBS}, {0}};
+    {"jobs", required_argument, 0, OPT_JOBS}, {"from", required_argument, 0, OPT_FROM},
+    {"to", required_argument, 0, OPT_TO},     {"duration", required_argument, 0, OPT_DURATION}, {0}};
 
 /* What the command line asks for. */
 typedef struct render_opts {
@@ -232,6 +253,8 @@ typedef struct render_opts {
     r_game_opts go;
     int passes;               /* 1 summary, 2 per frame */
     long first, end;          /* --ticks; end -1: the whole replay */
+    bool ticks_given;
+    long from, to, duration;  /* --from, --to, --duration in ticks; -1: not given */
     long progress_fd;
     int jobs;                 /* 0: auto */
     cap_pixfmt fmt;           /* RGBA for an image pattern, else I420 */
@@ -361,7 +384,10 @@ static int render_option(render_opts *o, int c, const char *arg, char **argv)
     case JOB_AUDIO_OPT_AUDIO: case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS: case JOB_AUDIO_OPT_WAV:
         return job_audio_option(&o->audio, "render", c, arg) ? -1 : RS_EXIT_USAGE;
     case 'o': o->out = arg; return -1;
-    case 'K': return parse_ticks(o, arg) ? -1 : RS_EXIT_USAGE;
+    case 'K': o->ticks_given = true; return parse_ticks(o, arg) ? -1 : RS_EXIT_USAGE;
+    case OPT_FROM: return cli_time("--from", arg, &o->from) ? -1 : RS_EXIT_USAGE;
+    case OPT_TO: return cli_time("--to", arg, &o->to) ? -1 : RS_EXIT_USAGE;
+    case OPT_DURATION: return cli_time("--duration", arg, &o->duration) ? -1 : RS_EXIT_USAGE;
     case 'H': o->hashes = arg; return -1;
     case 'S':
         if (!cap_seg_key_ok(arg)) {
@@ -392,10 +418,35 @@ static int render_option(render_opts *o, int c, const char *arg, char **argv)
     }
 }
 
+/* --from / --to / --duration (seconds) into the tick range --ticks takes */
+static bool time_range(render_opts *o)
+{
+    if (o->from < 0 && o->to < 0 && o->duration < 0)
+        return true;
+    if (o->ticks_given) {
+        cli_error("render", "--ticks and --from/--to/--duration say the same thing: give one of them");
+        return false;
+    }
+    if (o->to >= 0 && o->duration >= 0) {
+        cli_error("render", "--to and --duration both say where to stop: give one of them");
+        return false;
+    }
+    o->first = o->from < 0 ? 0 : o->from;
+    o->end = o->to >= 0 ? o->to : o->duration >= 0 ? o->first + o->duration : -1;
+    if (o->end >= 0 && o->end <= o->first) {
+        cli_error("render", "--from/--to/--duration: the end (%.3f s) must be after the start (%.3f s)", o->end / 60.0,
+                  o->first / 60.0);
+        return false;
+    }
+    return true;
+}
+
 /* What can be refused from the options alone; -1 to go on, else the exit status. */
 static int check_options(render_opts *o)
 {
     rs_err err = {0};
+    if (!time_range(o))
+        return RS_EXIT_USAGE;
     if (!o->out) {
         cli_error("render", "-o OUT is required");
         return RS_EXIT_USAGE;
@@ -441,7 +492,7 @@ static int check_options(render_opts *o)
 static int parse_options(int argc, char **argv, render_opts *o)
 {
     *o = (render_opts){.progress = RS_PROGRESS_AUTO, .cd = {.w = 640, .h = 360}, .quality = &r_presets[R_PRESET_DEFAULT],
-                       .end = -1, .progress_fd = -1};
+                       .end = -1, .progress_fd = -1, .from = -1, .to = -1, .duration = -1};
     int c, status;
     optind = 1;
     opterr = 0;
@@ -507,15 +558,25 @@ static int prepare(render_run *run)
     rs_err *err = &run->err;
     if (!rp_read(o->replay, &run->rp, err))
         return RS_EXIT_FAIL;
+    const char *name = strcmp(o->replay, "-") ? o->replay : RP_STDIN_NAME;
+    double len_s = (double)run->rp.ticks / 60.0;
     if (o->first >= (long)run->rp.ticks) {
-        rs_fail(err, JOB_ERR_TICKS, "%s: --ticks %ld: starts past the replay's end (%" PRIu64 " ticks)", o->replay,
-                o->first, run->rp.ticks);
+        if (o->ticks_given)
+            rs_fail(err, JOB_ERR_TICKS, "%s: --ticks %ld: starts past the replay's end (%" PRIu64 " ticks)", name, o->first,
+                    run->rp.ticks);
+        else
+            rs_fail(err, JOB_ERR_TICKS, "%s: --from %.3f s: starts past the replay's end (%.3f s, %" PRIu64 " ticks)", name,
+                    o->first / 60.0, len_s, run->rp.ticks);
         return RS_EXIT_USAGE;
     }
     if (o->end > (long)run->rp.ticks) { /* as ffmpeg's -t past the end: clamped, with a word */
-        fprintf(stderr, "ringside render: --ticks %ld:%ld: the replay ends at tick %" PRIu64 ", so ticks %ld:%" PRIu64
-                        " are drawn\n",
-                o->first, o->end, run->rp.ticks, o->first, run->rp.ticks);
+        if (o->ticks_given)
+            fprintf(stderr, "ringside render: --ticks %ld:%ld: the replay ends at tick %" PRIu64 ", so ticks %ld:%" PRIu64
+                            " are drawn\n",
+                    o->first, o->end, run->rp.ticks, o->first, run->rp.ticks);
+        else
+            fprintf(stderr, "ringside render: the replay ends at %.3f s, so %.3f s to %.3f s are drawn (not to %.3f s)\n",
+                    len_s, o->first / 60.0, len_s, o->end / 60.0);
         o->end = (long)run->rp.ticks;
     }
     run->first = (uint64_t)o->first, run->end = o->end < 0 ? run->rp.ticks : (uint64_t)o->end;
@@ -542,6 +603,38 @@ static int prepare(render_run *run)
     /* --jobs: segments drawn at once by processes of their own, then joined
      * (job_split.h), where the output can be joined */
     return plan_split(run);
+}
+
+/* The replay read from standard input, written to a temporary file the
+ * segments' processes can read ($TMPDIR, else /tmp); path gets its name. */
+static bool stdin_copy(const rp_replay *rp, char *path, size_t n, rs_err *err)
+{
+    const char *dir = getenv("TMPDIR");
+    snprintf(path, n, "%s/ringside-stdin-XXXXXX", dir && *dir ? dir : "/tmp");
+    uint8_t *buf;
+    size_t len;
+    if (!rp_encode(rp, &buf, &len, err))
+        return false;
+    int fd = mkstemp(path);
+    bool ok = fd >= 0;
+    for (size_t at = 0; ok && at < len;) {
+        ssize_t w = write(fd, buf + at, len - at);
+        if (w < 0 && errno == EINTR)
+            continue;
+        ok = w > 0;
+        at += ok ? (size_t)w : 0;
+    }
+    if (fd >= 0 && close(fd) != 0)
+        ok = false;
+    free(buf);
+    if (!ok) {
+        rs_fail(err, JOB_ERR_PROCESS, "%s: cannot keep the replay from standard input for the segments: %s", path,
+                strerror(errno));
+        if (fd >= 0)
+            unlink(path);
+        path[0] = 0;
+    }
+    return ok;
 }
 
 /* The segments of a parallel render, each a process of its own, joined. */
@@ -578,12 +671,19 @@ static int render_split(render_run *run, int argc, char **argv)
     exe[ne] = 0;
     const cap_desc *cd = &o->cd;
     snprintf(what, sizeof what, "%dx%d (drawn at %dx%d, quality %s)", cd->w, cd->h, cd->src_w, cd->src_h, o->quality->name);
-    job_split_desc jd = {.exe = exe, .replay = o->replay, .out = o->out, .first = run->first, .end = run->end, .jobs = run->split,
+    /* a replay from standard input: the segments read a copy of it */
+    char copy[PATH_MAX] = "";
+    if (!strcmp(o->replay, "-") && !stdin_copy(&run->rp, copy, sizeof copy, &run->err))
+        return RS_EXIT_FAIL;
+    job_split_desc jd = {.exe = exe, .replay = copy[0] ? copy : o->replay, .out = o->out, .first = run->first, .end = run->end, .jobs = run->split,
                          .pass = pass, .rp = &run->rp, .sink = &run->sink, .audio = &o->audio, .hashes = o->hashes,
                          .poster = run->poster.due ? o->poster : NULL, .overwrite = o->overwrite,
                          .progress = o->quiet ? RS_PROGRESS_OFF : (rs_progress_mode)o->progress, .progress_fd = (int)o->progress_fd,
                          .quiet = o->quiet, .what = what, .said = run->sink.enc_note, .stop = &stop_requested};
-    return job_split_run(&jd, &run->err);
+    int status = job_split_run(&jd, &run->err);
+    if (copy[0])
+        unlink(copy);
+    return status;
 }
 
 /* The frames, one a tick, into the capture; false with run->err filled. */
@@ -709,15 +809,22 @@ int cmd_render(int argc, char **argv)
      * first frame.  (A background job of a script starts with SIGINT
      * ignored; the handler replaces that too.) */
     stop_requested = 0;
-    struct sigaction sa = {0}, old_int, old_term;
+    struct sigaction sa = {0}, old_int, old_term, old_pipe, ign = {0};
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, &old_int);
     sigaction(SIGTERM, &sa, &old_term);
+    /* a reader that closes -o - early is an error we report (the frame it
+     * stopped at, exit status 4), not a silent death by SIGPIPE */
+    ign.sa_handler = SIG_IGN;
+    sigaction(SIGPIPE, &ign, &old_pipe);
     status = prepare(&run);
     if (status < 0)
         status = run.split > 1 ? render_split(&run, argc, argv) : render_here(&run);
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
+    sigaction(SIGPIPE, &old_pipe, NULL);
+    if (status == RS_EXIT_FAIL && run.err.code == CAP_ERR_PIPE_CLOSED)
+        status = RS_EXIT_PIPE;
     if (status != RS_EXIT_OK && run.err.msg[0])
         cli_error("render", "%s", run.err.msg);
     job_out_abandon(&run.outs);

@@ -68,5 +68,51 @@ t_warmup_reported() {
     done
 }
 
-t_run every_demo_from_a_mid_tick other_size_and_capture long_range_at_640x360 warmup_reported
+# the same range in seconds: --from/--to/--duration (seconds, MM:SS,
+# HH:MM:SS) give the ticks --ticks gives, an end past the replay is clamped
+# with a note, and what cannot be a range is bad usage (exit 2)
+t_seconds_are_ticks() {
+    small="--size 64x36 --render-size 64x36 --quality draft --quiet -o /dev/null"
+    rp=$SRC/demos/temple.rsr
+    "$RS_BIN" render "$rp" $small --ticks 90:120 --hashes ticks.h || return 1
+    for range in "--from 1.5 --to 2" "--from 0:01.5 --duration 0.5" "--from 0:00:01.5 --to 0:02" "--from 1.508 --to 1.992"; do
+        "$RS_BIN" render "$rp" $small $range -y --hashes secs.h 2>err.txt || { cat err.txt; return 1; }
+        cmp -s ticks.h secs.h || { echo "$range: not the frames of --ticks 90:120"; head -2 secs.h; return 1; }
+    done
+    # 2537 ticks (42.283 s): from 42 s on, 45 s is past the end
+    "$RS_BIN" render "$rp" $small --from 42 --to 45 --hashes end.h 2>err.txt || { cat err.txt; return 1; }
+    [ "$(wc -l <end.h)" = 17 ] && grep -q "the replay ends at 42.283 s, so 42.000 s to 42.283 s are drawn" err.txt ||
+        { echo "past the end:"; cat err.txt; wc -l end.h; return 1; }
+    for bad in "--from 1:5" "--from -1" "--to 1e3" "--from 2 --to 1" "--to 1 --duration 1" "--ticks 0:10 --from 1" "--from 99"; do
+        "$RS_BIN" render "$rp" $small $bad 2>err.txt
+        st=$?
+        [ $st = 2 ] && [ "$(wc -l <err.txt)" = 1 ] && grep -q "^ringside render: " err.txt ||
+            { echo "$bad: exit $st (want 2), said:"; cat err.txt; return 1; }
+    done
+    grep -q "starts past the replay's end (42.283 s, 2537 ticks)" err.txt || { cat err.txt; return 1; }
+}
+
+# REPLAY '-': the replay from standard input, also for --jobs (the
+# segments read a temporary copy, removed after); -o - to a reader that
+# stops early: one line with the frame and exit status 4
+t_stdin_and_a_closed_pipe() {
+    small="--size 64x36 --render-size 64x36 --quality draft --quiet --ticks 0:40"
+    rp=$SRC/demos/temple.rsr
+    "$RS_BIN" render "$rp" $small -o /dev/null --hashes file.h || return 1
+    "$RS_BIN" render - $small -o /dev/null --hashes stdin.h <"$rp" 2>err.txt || { cat err.txt; return 1; }
+    cmp -s file.h stdin.h || { echo "the replay from standard input drew other frames"; return 1; }
+    mkdir -p tmp
+    TMPDIR=$PWD/tmp "$RS_BIN" render - $small -o split.mkv --jobs 2 <"$rp" 2>err.txt || { cat err.txt; return 1; }
+    [ -s split.mkv ] && [ -z "$(ls tmp)" ] || { echo "--jobs 2 from standard input: $(ls tmp)"; cat err.txt; return 1; }
+    head -c 100 "$rp" | "$RS_BIN" render - $small -o /dev/null 2>err.txt
+    st=$?
+    [ $st = 1 ] && grep -q "^ringside render: standard input: " err.txt || { echo "a cut replay: exit $st"; cat err.txt; return 1; }
+    # the y4m header and one 64x36 frame are 3,512 bytes: the reader stops in the second
+    { "$RS_BIN" render "$rp" $small --progress off -o - 2>err.txt; echo $? >st.txt; } | head -c 5000 >/dev/null
+    [ "$(cat st.txt)" = 4 ] && grep -qx "ringside render: standard output: the reader closed the pipe at frame [0-9]*" err.txt ||
+        { echo "a closed pipe: exit $(cat st.txt)"; cat err.txt; return 1; }
+}
+
+t_run every_demo_from_a_mid_tick other_size_and_capture long_range_at_640x360 warmup_reported seconds_are_ticks \
+    stdin_and_a_closed_pipe
 t_done

@@ -387,10 +387,54 @@ void rp_free(rp_replay *rp)
     rp->checkpoints = NULL;
 }
 
+/* standard input to its end, at most max bytes (more: RP_ERR_TOO_BIG) */
+static uint8_t *read_stdin(size_t max, size_t *len, rs_err *err)
+{
+    size_t cap = 64 * 1024, n = 0;
+    uint8_t *buf = malloc(cap);
+    while (buf) {
+        if (n == cap) {
+            uint8_t *more = cap > max ? NULL : realloc(buf, cap * 2);
+            if (!more) {
+                free(buf);
+                if (cap > max)
+                    rs_fail(err, RP_ERR_TOO_BIG, "%s: more than %zu bytes: not a replay", RP_STDIN_NAME, max);
+                else
+                    rs_fail(err, RP_ERR_OPEN, "%s: out of memory", RP_STDIN_NAME);
+                return NULL;
+            }
+            buf = more, cap *= 2;
+        }
+        ssize_t r = read(0, buf + n, cap - n);
+        if (r == 0) {
+            *len = n;
+            return buf;
+        }
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r < 0) {
+            rs_fail(err, RP_ERR_OPEN, "%s: cannot read: %s", RP_STDIN_NAME, strerror(errno));
+            free(buf);
+            return NULL;
+        }
+        n += (size_t)r;
+    }
+    rs_fail(err, RP_ERR_OPEN, "%s: out of memory", RP_STDIN_NAME);
+    return NULL;
+}
+
 bool rp_read(const char *path, rp_replay *rp, rs_err *err)
 {
     memset(rp, 0, sizeof *rp);
     size_t n;
+    if (!strcmp(path, "-")) {
+        uint8_t *in = read_stdin(RP_MAX_FILE, &n, err);
+        if (!in)
+            return false;
+        bool ok = rp_decode(in, n, RP_STDIN_NAME, rp, err);
+        free(in);
+        return ok;
+    }
     uint8_t *buf = (uint8_t *)rs_read_file(path, RP_MAX_FILE, &n, err);
     if (!buf)
         return recode(err, err && err->code == RS_FILE_ERR_TOO_BIG ? RP_ERR_TOO_BIG : RP_ERR_OPEN);

@@ -93,6 +93,8 @@ bool rp_decode(const uint8_t *buf, size_t len, const char *name, rp_replay *rp, 
  * spends 2 bytes a tick decoding.  False when buf is too short or not a
  * replay. */
 bool rp_peek_ticks(const uint8_t *buf, size_t len, uint64_t *ticks);
+/* path "-": standard input, named RP_STDIN_NAME in messages */
+#define RP_STDIN_NAME "standard input"
 bool rp_read(const char *path, rp_replay *rp, rs_err *err);
 bool rp_write(const char *path, const rp_replay *rp, rs_err *err);
 void rp_free(rp_replay *rp);
