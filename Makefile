@@ -232,7 +232,7 @@ man: $(MAN_STAMP) $(BUILD)/dist/ringside.bash $(BUILD)/dist/ringside.conf.exampl
 $(MAN_STAMP): $(BUILD)/ringside tools/man.sh $(STAMPS)/man
 	@rm -rf $(BUILD)/man
 	tools/man.sh $(BUILD)/ringside $(BUILD)/man
-	@for f in $(BUILD)/man/*.[15]; do w=$$(groff -man -Tutf8 -ww -z $$f 2>&1); \
+	@for f in $(BUILD)/man/*.[15]; do w=$$(groff -man -Tutf8 -ww -z $$f 2>&1; mandoc -Tlint -W warning $$f 2>&1); \
 	    [ -z "$$w" ] || { echo "$$f: $$w" >&2; exit 1; }; done
 	@touch $@
 $(BUILD)/dist/ringside.bash: $(BUILD)/ringside tools/completion.sh

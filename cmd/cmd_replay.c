@@ -40,7 +40,12 @@ static void help(void)
            "  --ticks A:B   only ticks A to B-1 (default: the whole replay)\n"
            "  --loudness L  integrated loudness target in LUFS, -70..0 (default -16; true\n"
            "                peak at most -1 dBTP), or off: the mixer's level as it is\n"
-           "  --float       32-bit float samples (default 16-bit PCM)\n");
+           "  --float       32-bit float samples (default 16-bit PCM)\n\n"
+           "examples:\n"
+           "  ringside replay verify demos/dojo.rsr\n"
+           "                re-simulate the match and check every state hash\n"
+           "  ringside replay sound demos/dojo.rsr -o dojo.wav\n"
+           "                the soundtrack a render puts in the video, at -16 LUFS\n");
 }
 
 static void duration(uint64_t ticks, char *buf, size_t n)

@@ -39,6 +39,13 @@ static void help(void)
     printf("\nAPI tokens: 'ringside serve token --help'.  A daemon listening beyond loopback\n"
            "needs at least one (it refuses to start without); on loopback, requests need one\n"
            "as soon as one exists.\n"
+           "\nexamples:\n"
+           "  ringside serve --data /var/lib/ringside\n"
+           "                   one daemon on 127.0.0.1:8080: the dashboard, the API, one worker\n"
+           "  ringside serve --config /etc/ringside.conf --print-config\n"
+           "                   every setting's value, after the file and the options\n"
+           "  ringside serve token add alice --data /var/lib/ringside\n"
+           "                   an API token for a client (printed once)\n"
            "\nexit status: 0 after a clean stop (signal), 1 on a start-up failure, 2 on bad usage\n");
 }
 

@@ -47,8 +47,28 @@ static void usage(FILE *f)
                "  RINGSIDE_EGL_DEVICE=N  the EGL device to use (default: the first that works)\n"
                "  RINGSIDE_OIIO_PLUGIN   OpenImageIO's plugin, loaded for image files (default:\n"
                "                         ringside-oiio.so beside the binary or in ../lib/ringside)\n"
-               "\nexit status: 0 success, 1 failure, 2 bad usage (join: 3, a bad segment)\n"
-               "docs: 'man ringside-COMMAND'; README.md and docs/ (installed in share/doc/ringside)\n",
+               "  RS_PROGRESS_INTERVAL   seconds between --progress plain lines (default 5)\n"
+               "  TMPDIR                 where render - keeps the replay for --jobs (default /tmp)\n"
+               "\nfiles:\n"
+               "  ~/.cache/ringside      the prefiltered lighting of each stage (RINGSIDE_CACHE)\n"
+               "  share/ringside         shaders/ and stages/ of an installed ringside\n"
+               "  share/doc/ringside     README.md, docs/ and ringside.conf.example\n"
+               "\nexamples:\n"
+               "  ringside render demos/dojo.rsr -o dojo.mp4\n"
+               "                         a replay to a video: 640x360, 60 fps, sound, the default quality\n"
+               "  ringside record --ai --seconds 30 -o m.rsr\n"
+               "                         a CPU-vs-CPU match to a replay file\n"
+               "  ringside replay verify m.rsr\n"
+               "                         re-simulate a replay and check its state hashes\n"
+               "  ringside serve --config /etc/ringside.conf\n"
+               "                         the replay-to-video daemon and its dashboard\n"
+               "\nexit status:\n"
+               "  0  success\n"
+               "  1  failure: the message names the file and the reason\n"
+               "  2  bad usage: an option, a value or an output name that cannot work\n"
+               "  3  join: one or more segments are bad (named, to be rendered again)\n"
+               "  4  render -o -: the program reading the stream closed it early\n"
+               "\ndocs: 'man ringside-COMMAND'; README.md and docs/ (installed in share/doc/ringside)\n",
             plat_built_backends());
 }
 

@@ -33,15 +33,21 @@ t_readme_lists_every_command() {
 }
 
 # the help a page was made from: ringside.1 <- --help, ringside-bench-capture.1 <- bench capture --help
-page_help() {
+own_help() {
     case $1 in
     ringside) "$RS_BIN" --help ;;
     *) "$RS_BIN" $(echo "${1#ringside-}" | tr - ' ') --help ;;
     esac
 }
+# the text a page is made from: its --help, then the top-level exit statuses
+# (unless it has its own) and the pages around it (tools/man.sh)
+page_help() { cat "$(dirname "$RS_BIN")/man/.text/$1.txt"; }
 
-# words of a --help, as the page says them (SYNOPSIS has no "usage:")
-help_words() { sed '1s/^usage: //' | tr -s ' \t' '\n\n' | grep -v '^$'; }
+# words of a --help, as the page says them (SYNOPSIS has no "usage:", a
+# section's name is its heading)
+help_words() {
+    sed -E '1s/^usage: //; s/^(examples|environment|files|exit status|see also)://' | tr -s ' \t' '\n\n' | grep -v '^$'
+}
 
 # words of a rendered page below NAME: indented lines only (headings, the
 # header and the footer start at column 0), the NAME section left out
@@ -51,7 +57,8 @@ page_words() {
 }
 
 t_man_pages_match_help() {
-    command -v man >/dev/null && command -v groff >/dev/null || t_skip_install "man/groff not installed (make man installs groff-base)"
+    command -v man >/dev/null && command -v groff >/dev/null && command -v mandoc >/dev/null ||
+        t_skip_install "man, groff or mandoc not installed (make man installs groff-base, man-db and mandoc)"
     make -s -C "$SRC" man BUILD="$(dirname "$RS_BIN")" >make.txt 2>&1 || { cat make.txt; return 1; }
     man=$(dirname "$RS_BIN")/man
     # a page for every command
@@ -63,7 +70,14 @@ t_man_pages_match_help() {
         page=$(basename "$f" .1)
         warn=$(groff -man -Tutf8 -ww -z "$f" 2>&1)
         [ -z "$warn" ] || { echo "$page: groff: $warn"; return 1; }
-        page_help "$page" | help_words >help.txt
+        warn=$(mandoc -Tlint -W warning "$f" 2>&1)
+        [ -z "$warn" ] || { echo "$page: mandoc -Tlint: $warn"; return 1; }
+        # the page's text is its own --help first, word for word, then what man.sh adds
+        own_help "$page" >own.txt
+        page_help "$page" >text.txt
+        [ "$(head -n "$(wc -l <own.txt)" text.txt)" = "$(cat own.txt)" ] || { echo "$page: not made from its --help"; return 1; }
+        grep -q '^exit status:' text.txt && grep -q '^see also:' text.txt || { echo "$page: no exit status or see also"; return 1; }
+        help_words <text.txt >help.txt
         page_words "$f" >page.txt
         cmp -s help.txt page.txt || { echo "$page.1 differs from its --help:"; diff help.txt page.txt | head -20; return 1; }
         n=$((n + 1))
@@ -75,8 +89,8 @@ t_man_pages_match_help() {
     "$RS_BIN" render --help | help_words >help.txt
     ! cmp -s help.txt page.txt || { echo "a line missing from the page went unseen"; return 1; }
     # ringside.conf(5): renders clean and has every setting
-    warn=$(groff -man -Tutf8 -ww -z "$man/ringside.conf.5" 2>&1)
-    [ -z "$warn" ] || { echo "ringside.conf.5: groff: $warn"; return 1; }
+    warn=$(groff -man -Tutf8 -ww -z "$man/ringside.conf.5" 2>&1; mandoc -Tlint -W warning "$man/ringside.conf.5" 2>&1)
+    [ -z "$warn" ] || { echo "ringside.conf.5: groff or mandoc: $warn"; return 1; }
     GROFF_NO_SGR=1 MANWIDTH=250 man -l "$man/ringside.conf.5" 2>/dev/null | col -bx >conf.txt
     for s in $("$RS_BIN" serve --print-config | sed 's/ = .*//'); do
         grep -Eq "^       $s( |$)" conf.txt || { echo "ringside.conf.5 lacks $s"; return 1; }

@@ -33,9 +33,9 @@ group_pkgs() {
     # Debian's Chromium for the dashboard test, driven by playwright-core,
     # which npm fetches and Node.js runs
     service) echo "postgresql chromium nodejs npm" ;;
-    # make man checks every page it writes with groff -ww; the docs test
-    # renders them with man -l
-    man) echo "groff-base man-db" ;;
+    # make man checks every page it writes with groff -ww and mandoc -Tlint;
+    # the docs test renders them with man -l
+    man) echo "groff-base man-db mandoc" ;;
     # tools/gen-voice.sh: the announcer's lines, rendered once by espeak-ng
     voice) echo "espeak-ng" ;;
     *) echo "deps.sh: unknown group '$1' (known: build test service man voice)" >&2; return 1 ;;
