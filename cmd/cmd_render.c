@@ -605,36 +605,37 @@ static int prepare(render_run *run)
     return plan_split(run);
 }
 
-/* The replay read from standard input, written to a temporary file the
- * segments' processes can read ($TMPDIR, else /tmp); path gets its name. */
+/* The replay read from standard input, written (rp_write: checked, read
+ * back) into a temporary folder the segments' processes can read ($TMPDIR,
+ * else /tmp); path gets the file's name, stdin_copy_free removes both. */
 static bool stdin_copy(const rp_replay *rp, char *path, size_t n, rs_err *err)
 {
     const char *dir = getenv("TMPDIR");
     snprintf(path, n, "%s/ringside-stdin-XXXXXX", dir && *dir ? dir : "/tmp");
-    uint8_t *buf;
-    size_t len;
-    if (!rp_encode(rp, &buf, &len, err))
-        return false;
-    int fd = mkstemp(path);
-    bool ok = fd >= 0;
-    for (size_t at = 0; ok && at < len;) {
-        ssize_t w = write(fd, buf + at, len - at);
-        if (w < 0 && errno == EINTR)
-            continue;
-        ok = w > 0;
-        at += ok ? (size_t)w : 0;
-    }
-    if (fd >= 0 && close(fd) != 0)
-        ok = false;
-    free(buf);
-    if (!ok) {
+    if (!mkdtemp(path)) {
         rs_fail(err, JOB_ERR_PROCESS, "%s: cannot keep the replay from standard input for the segments: %s", path,
                 strerror(errno));
-        if (fd >= 0)
-            unlink(path);
         path[0] = 0;
+        return false;
     }
-    return ok;
+    size_t l = strlen(path);
+    snprintf(path + l, n - l, "/replay.rsr");
+    if (rp_write(path, rp, err))
+        return true;
+    path[l] = 0;
+    rmdir(path);
+    path[0] = 0;
+    return false;
+}
+
+static void stdin_copy_free(char *path)
+{
+    if (!path[0])
+        return;
+    unlink(path);
+    char *slash = strrchr(path, '/');
+    *slash = 0;
+    rmdir(path);
 }
 
 /* The segments of a parallel render, each a process of its own, joined. */
@@ -681,8 +682,7 @@ static int render_split(render_run *run, int argc, char **argv)
                          .progress = o->quiet ? RS_PROGRESS_OFF : (rs_progress_mode)o->progress, .progress_fd = (int)o->progress_fd,
                          .quiet = o->quiet, .what = what, .said = run->sink.enc_note, .stop = &stop_requested};
     int status = job_split_run(&jd, &run->err);
-    if (copy[0])
-        unlink(copy);
+    stdin_copy_free(copy);
     return status;
 }
 
