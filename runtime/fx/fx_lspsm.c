@@ -70,6 +70,7 @@ struct fx_lspsm_state {
     float lo[R_CITY_MAX][3], hi[R_CITY_MAX][3];
     GLuint city_vao, city_vbo, city_ibo, proxy_vao, proxy_vbo, proxy_ibo;
     GLsizei city_count;
+    bool depth_laid; /* this frame's buildings' depth is in the depth buffer (scene_depth) */
     GLint proxy_first[R_CITY_MAX];
     GLsizei proxy_count[R_CITY_MAX];
     /* tests and --passes */
@@ -141,7 +142,14 @@ static void run_map(void *u)
     gl.ClearColor(0, 0, 0, 0);
     gl.ClearDepth(1.0);
     gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    gl.Disable(GL_CULL_FACE); /* closed boxes and capsules: both sides cast */
+    /* the buildings' proxies are closed boxes: their faces turned from the
+     * light lie behind the ones turned to it, so only those are drawn
+     * (lspsm_map 5.1 -> 3.3 ms a plaza frame single-threaded).  Where the
+     * warp clips a face turned to the light, the one behind no longer
+     * stands in for it: in 30 frames of plaza, 433 bytes of 31 MB changed
+     * on one shadow edge, and bench quality's dB did not move */
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
     gl.Enable(GL_POLYGON_OFFSET_FILL);
     gl.PolygonOffset(1.5f, 4.0f);
     /* a tall building beyond the frustum's near plane (100 m towards the
@@ -162,7 +170,8 @@ static void run_map(void *u)
                         (const void *)((size_t)ls->proxy_first[i] * sizeof(unsigned)));
         drawn++;
     }
-    /* movable casters: the fighters */
+    /* movable casters: the fighters, both sides */
+    gl.Disable(GL_CULL_FACE);
     gl.Uniform1f(r_loc(p, "u_flag"), 1.0f);
     r_draw_fighters(r, p);
     gl.Disable(GL_POLYGON_OFFSET_FILL);
@@ -189,6 +198,10 @@ static void run_buildings(void *u)
         gl.Disable(GL_CULL_FACE);
         return;
     }
+    /* over the depth scene_depth laid before the ring */
+    if (ls->depth_laid)
+        gl.DepthFunc(GL_LEQUAL);
+    ls->depth_laid = false;
     GLuint p = r_stage_program(r, R_MAT_BUILDING);
     /* the fighters' blurred silhouette stops short of the buildings: this
      * map casts them there (u_shadows 0 counts its fighter texels) */
@@ -196,6 +209,22 @@ static void run_buildings(void *u)
     gl.BindVertexArray(ls->city_vao);
     gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
     gl.Disable(GL_CULL_FACE);
+}
+
+/* Inside "scene", before the ring: the buildings' depth (r_fx.h) */
+static bool lspsm_scene_depth(r_game *r, GLuint depth_prog)
+{
+    struct fx_lspsm_state *ls = LSPSM(r);
+    (void)depth_prog; /* bound, with the camera's uniforms */
+    if (!ls)
+        return false;
+    ls->depth_laid = false;
+    if (!need_buildings(r))
+        return false;
+    gl.BindVertexArray(ls->city_vao);
+    gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
+    ls->depth_laid = true;
+    return true;
 }
 
 static void run_focus(void *u)
@@ -426,7 +455,7 @@ const r_fx_module fx_lspsm_module = {
     .npass = {(int)(sizeof map_passes / sizeof map_passes[0]), (int)(sizeof surface_passes / sizeof surface_passes[0]),
               (int)(sizeof focus_passes / sizeof focus_passes[0])},
     .res = {{RES_LSPSM, "lspsm map", false}}, .scene_reads = RES_LSPSM,
-    .units = 2, .bind = lspsm_bind, .scene_define = lspsm_define,
+    .units = 2, .bind = lspsm_bind, .scene_define = lspsm_define, .scene_depth = lspsm_scene_depth,
     .warmup = lspsm_warmup, .advance = lspsm_advance, .needs_frame = lspsm_needs_frame,
 };
 

@@ -111,6 +111,13 @@ bool r_fx_draw_ring(r_game *r)
     return false;
 }
 
+void r_fx_scene_depth(r_game *r, GLuint depth_prog)
+{
+    for (int i = 0; i < r_fx_nmodules; i++)
+        if (r_fx_modules[i]->scene_depth)
+            r_fx_modules[i]->scene_depth(r, depth_prog);
+}
+
 int r_fx_warmup(r_game *r, const r_fx_module *m)
 {
     return m->warmup ? m->warmup(r) : R_FX_STATELESS;

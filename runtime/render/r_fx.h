@@ -54,6 +54,14 @@
  * the fighters), so scene must not clear it; draw_ring draws the ring mesh
  * in the effect's own order (scene has bound the stage program and the
  * ring's VAO) and returns true, or returns false and scene draws it whole.
+ * scene_depth draws, before the ring, the depth of the opaque surfaces its
+ * R_FX_SURFACE pass will shade this frame (depth_prog: the depth-only program,
+ * the camera's uniforms set, colour writes off) and returns true when it
+ * drew: the ring's and the ground's pixels behind them then fail the depth
+ * test before they are shaded (a software rasteriser shades every fragment
+ * that passes the depth test), and the
+ * surface pass draws over its own depth with GL_LEQUAL (scene.vert's
+ * invariant gl_Position makes the two agree exactly).
  *
  * History.  Simulations step the frame's steps times (r_fx_frame: whole
  * game ticks since the frame drawn last, 0 when a tick is drawn again)
@@ -152,6 +160,7 @@ typedef struct r_fx_module {
     /* inside "scene" (NULL: nothing to do there) */
     bool (*scene_cleared)(r_game *r);
     bool (*draw_ring)(r_game *r);
+    bool (*scene_depth)(r_game *r, GLuint depth_prog);
     /* history */
     int (*warmup)(r_game *r);         /* on the loaded stage: R_FX_STATELESS, N ticks or R_FX_FROM_START */
     void (*advance)(r_game *r);       /* one game tick, the frame set up; draws nothing on screen */

@@ -115,6 +115,7 @@ int r_fx_units(void);                          /* texture units the modules' bin
 void r_fx_bind(r_game *r, GLuint p, int what); /* every module's bind, units from R_FX_UNIT_FIRST */
 bool r_fx_scene_cleared(r_game *r);            /* an effect cleared the HDR target this frame */
 bool r_fx_draw_ring(r_game *r);                /* an effect drew the ring its own way */
+void r_fx_scene_depth(r_game *r, GLuint depth_prog);  /* the effects' opaque surfaces' depth, before the ring */
 int r_fx_warmup(r_game *r, const r_fx_module *m); /* its warm-up on the loaded stage */
 int64_t r_fx_history(r_game *r);               /* the most of them (R_FX_FROM_START wins) */
 bool r_fx_needs_frame(r_game *r, uint64_t ahead); /* a module whose window holds the tick `ahead` ticks

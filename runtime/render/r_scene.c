@@ -86,8 +86,15 @@ static void run_scene(void *u)
     gl.Disable(GL_STENCIL_TEST);
     gl.StencilMask(0xFF);
 
-    /* the ring and the ground, with the projected silhouette */
+    /* the effects' opaque surfaces' depth first (r_fx.h, scene_depth), so
+     * the ground they hide is not shaded */
     gl.DepthFunc(GL_LESS);
+    gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    r_camera_uniforms(r, r->prog[P_DEPTH]);
+    r_fx_scene_depth(r, r->prog[P_DEPTH]);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+
+    /* the ring and the ground, with the projected silhouette */
     r_stage_program(r, r_ring_material(r));
     gl.BindVertexArray(r->ring_vao);
     /* an effect may draw the ring in its own order (the holes: r_fx.h) */
