@@ -6,14 +6,14 @@
  *   .webm            Opus (libopus), default 128 kb/s
  *
  * DESIGN
- * - The render mixes the whole track before the first frame (it is a pure
- *   function of the replay, and cheap next to drawing), so the sink borrows
- *   one buffer and needs no queue between threads: after video frame i it
+ * - The track is a pure function of the replay, so the sink reads it as
+ *   it goes (cap_audio_read_fn: the match mixed on demand, never held
+ *   whole) and needs no queue between threads: after video frame i it
  *   encodes the track up to sample frame (i + 1) * 800, on the writer
- *   thread, in the encoder's own frame size (1024 AAC, 960 Opus).  The
- *   samples that do not fill an encoder frame wait in the track itself
- *   (`sent` is the FIFO's read position); the last partial frame goes out
- *   short at close, and the encoder pads it.
+ *   thread, in the encoder's own frame size (1024 AAC, 960 Opus).  `sent`
+ *   counts the frames read; whole encoder frames only, so the samples
+ *   that do not fill one stay unread until the next video frame; the last
+ *   partial frame goes out short at close, and the encoder pads it.
  * - Priming: both encoders start with a delay (AAC 1024 samples, Opus
  *   312) and say so (initial_padding): their first packet's pts lies that
  *   far below zero.  MP4 trims it exactly with an edit list.  Matroska,
@@ -27,6 +27,7 @@
  * - The track's sample frame k is at k / 48000 s and video frame i at
  *   i / 60 s: one clock, no resampling, no drift. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
@@ -76,7 +77,7 @@ static const struct {
     {"opus", "libopus", "Opus", 16000, 510000, OPUS_DEFAULT},
 };
 
-bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrate, rs_err *err)
+bool cap_sink_audio(cap_sink *s, cap_audio_read_fn read, void *u, size_t frames, int64_t bitrate, rs_err *err)
 {
     const char *codec = cap_sink_audio_codec(s);
     if (!codec)
@@ -91,7 +92,8 @@ bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrat
         if (bitrate && (bitrate < acodecs[i].lo || bitrate > acodecs[i].hi))
             return rs_fail(err, CAP_ERR_ENC_SETTING, "%s: --audio-bitrate %lldk: %s takes %lldk..%lldk", s->path,
                            (long long)(bitrate / 1000), acodecs[i].shown, (long long)(acodecs[i].lo / 1000), (long long)(acodecs[i].hi / 1000));
-        s->audio = pcm;
+        s->audio = read;
+        s->audio_u = u;
         s->audio_frames = frames;
         s->audio_bitrate = bitrate ? bitrate : acodecs[i].def;
         snprintf(s->audio_codec, sizeof s->audio_codec, "%s", codec);
@@ -109,7 +111,7 @@ static int fail_av(rs_err *err, int id, const char *path, const char *what, int 
 
 bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *err)
 {
-    *a = (cap_aenc){.pcm = s->audio, .frames = s->audio_frames};
+    *a = (cap_aenc){.frames = s->audio_frames};
     const char *name = !strcmp(s->audio_codec, "opus") ? "libopus" : "aac";
     const AVCodec *codec = avcodec_find_encoder_by_name(name);
     if (!codec)
@@ -145,8 +147,16 @@ bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err 
         if (par->extradata_size >= 12 && !memcmp(par->extradata, "OpusHead", 8))
             par->extradata[10] = par->extradata[11] = 0; /* the header's pre-skip, likewise */
     }
-    a->sent = a->skip < a->frames ? a->skip : a->frames;
     a->chunk = c->frame_size > 0 ? (size_t)c->frame_size : 1024;
+    if (!(a->buf = malloc(a->chunk * 2 * sizeof *a->buf)))
+        return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", s->path);
+    /* the priming's stand-in: the track's first frames, read and dropped */
+    for (size_t n; a->sent < (a->skip < a->frames ? a->skip : a->frames); a->sent += n) {
+        n = (a->skip < a->frames ? a->skip : a->frames) - a->sent;
+        n = n < a->chunk ? n : a->chunk;
+        if (!s->audio(s->audio_u, a->buf, n, err))
+            return false;
+    }
     a->frame->format = c->sample_fmt;
     a->frame->nb_samples = (int)a->chunk;
     a->frame->sample_rate = c->sample_rate;
@@ -176,7 +186,9 @@ static bool send(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, size_t n,
     int r = av_frame_make_writable(a->frame);
     if (r < 0)
         return fail_av(err, CAP_ERR_NOMEM, s->path, "audio frame", r);
-    const float *src = a->pcm + 2 * a->sent;
+    const float *src = a->buf;
+    if (!s->audio(s->audio_u, a->buf, n, err))
+        return false;
     if (a->frame->format == AV_SAMPLE_FMT_FLTP) {
         float *l = (float *)a->frame->data[0], *rr = (float *)a->frame->data[1];
         for (size_t k = 0; k < n; k++)
@@ -216,6 +228,8 @@ bool cap_aenc_finish(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_er
 
 void cap_aenc_close(cap_aenc *a)
 {
+    free(a->buf);
+    a->buf = NULL;
     av_packet_free(&a->pkt);
     av_frame_free(&a->frame);
     avcodec_free_context(&a->ctx);
@@ -223,9 +237,9 @@ void cap_aenc_close(cap_aenc *a)
 
 #else
 
-bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrate, rs_err *err)
+bool cap_sink_audio(cap_sink *s, cap_audio_read_fn read, void *u, size_t frames, int64_t bitrate, rs_err *err)
 {
-    (void)pcm, (void)frames, (void)bitrate;
+    (void)read, (void)u, (void)frames, (void)bitrate;
     return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this build has no FFmpeg libraries, so no audio stream (--wav writes the track)",
                    s->path);
 }

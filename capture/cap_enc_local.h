@@ -32,9 +32,9 @@ typedef struct cap_aenc {
     AVStream *st;
     AVFrame *frame;
     AVPacket *pkt;
-    const float *pcm;   /* the track, stereo interleaved */
-    size_t frames;      /* its length in sample frames */
-    size_t sent;        /* frames handed to the encoder: the FIFO's read position */
+    float *buf;         /* one encoder frame of the track, as read (stereo interleaved) */
+    size_t frames;      /* the track's length in sample frames */
+    size_t sent;        /* frames read from the track (the priming's stand-in, then encoded) */
     size_t chunk;       /* the encoder's frame size */
     size_t skip;        /* frames of the track's start that stand in for the priming (AAC in MKV, NUT) */
 } cap_aenc;

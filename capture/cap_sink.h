@@ -73,6 +73,11 @@ typedef struct cap_meta {
 } cap_meta;
 extern const char *const cap_meta_keys[]; /* NULL-terminated */
 
+/* Reads the next `frames` sample frames of a soundtrack (48 kHz stereo
+ * float, interleaved) into dst, in order from its first; false with err
+ * filled when it cannot. */
+typedef bool (*cap_audio_read_fn)(void *u, float *dst, size_t frames, rs_err *err);
+
 typedef struct cap_sink cap_sink;
 
 typedef struct cap_sink_ops {
@@ -111,8 +116,9 @@ struct cap_sink {
     int n_meta;
     /* FFmpeg sinks: the soundtrack (cap_audio.c), set by cap_sink_audio
      * before open; audio NULL: no audio stream */
-    const float *audio;    /* 48 kHz stereo float, interleaved, borrowed */
-    size_t audio_frames;   /* sample frames: 800 a video frame */
+    cap_audio_read_fn audio; /* the track, read in order on the writer thread; NULL: none */
+    void *audio_u;           /* its argument, borrowed until close */
+    size_t audio_frames;     /* sample frames: 800 a video frame */
     int64_t audio_bitrate; /* bits/s, filled with the default when 0 */
     char audio_codec[8];   /* "aac" or "opus" */
 };
@@ -140,7 +146,7 @@ const char *cap_sink_audio_codec(const cap_sink *s);
  * bits/s (0: 192k AAC, 128k Opus) and interleaved with the video as it is
  * written.  CAP_ERR_ENC_SETTING when the container takes no audio or the
  * bitrate is outside the encoder's range (the message names both). */
-bool cap_sink_audio(cap_sink *s, const float *pcm, size_t frames, int64_t bitrate, rs_err *err);
+bool cap_sink_audio(cap_sink *s, cap_audio_read_fn read, void *u, size_t frames, int64_t bitrate, rs_err *err);
 
 /* Human-readable list of what this build can write. */
 const char *cap_sink_formats(void);

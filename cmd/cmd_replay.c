@@ -210,25 +210,39 @@ static int sound(const char *path, const char *out, uint64_t first, uint64_t end
         return RS_EXIT_FAIL;
     rs_err err = {0};
     au_replay_opts o = {.target_lufs = lufs};
-    au_track t;
     int status = RS_EXIT_FAIL;
-    if (!au_replay_track(&rp, path, first, end, &o, &t, &err)) {
-        cli_error("replay", "%s", err.msg);
-    } else if (!au_wav_write(out, t.pcm, t.frames, float32, &err)) {
+    /* streamed: the match mixed again as the WAV is written, never held whole */
+    au_replay_stream *st = au_replay_open(&rp, path, first, end, &o, &err);
+    au_wav *w = st ? au_wav_open_known(out, float32, au_replay_info(st)->frames, &err) : NULL;
+    enum { PIECE = AU_TICK_FRAMES * 60 };
+    float *buf = w ? malloc(PIECE * 2 * sizeof *buf) : NULL;
+    bool ok = buf != NULL;
+    if (w && !buf)
+        rs_fail(&err, AU_ERR_NOMEM, "%s: out of memory", out);
+    const au_track_info *t = st ? au_replay_info(st) : NULL;
+    for (size_t at = 0; ok && at < t->frames;) {
+        size_t n = t->frames - at < PIECE ? t->frames - at : PIECE;
+        ok = au_replay_read(st, buf, n, &err) && au_wav_append(w, buf, n, &err);
+        at += n;
+    }
+    if (w)
+        ok = au_wav_close(w, ok, ok ? &err : &(rs_err){0}) && ok;
+    if (!ok) {
         cli_error("replay", "%s", err.msg);
     } else {
         if (isnan(lufs))
             fprintf(stderr, "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames, not normalized\n", out,
-                    t.first, t.end, t.frames);
+                    t->first, t->end, t->frames);
         else
             fprintf(stderr,
                     "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames; match %.1f LUFS %.1f dBTP -> "
                     "%.1f LUFS %.1f dBTP (gain %+.1f dB)\n",
-                    out, t.first, t.end, t.frames, t.lufs_before, t.peak_before, t.lufs_after, t.peak_after,
-                    t.gain_db);
+                    out, t->first, t->end, t->frames, t->lufs_before, t->peak_before, t->lufs_after, t->peak_after,
+                    t->gain_db);
         status = RS_EXIT_OK;
     }
-    au_track_free(&t);
+    free(buf);
+    au_replay_close(st);
     rp_free(&rp);
     return status;
 }

@@ -394,12 +394,120 @@ static void t_loudness_normalize_holds_peak(void)
     free(x);
 }
 
+
+/* The limiter streams: the normalized track read through au_norm_stream in
+ * pieces of 1, 97, 800 and 48001 frames is, byte for byte, what
+ * au_loud_normalize leaves in one buffer, on a signal the limiter works on
+ * all along and hardest in its last 60 frames (where its windows run past
+ * the end).  A ring or a delay off by one frame anywhere shows here. */
+typedef struct piece_src {
+    const float *x;
+    size_t at;
+} piece_src;
+static bool piece_read(void *u, float *dst, size_t frames, rs_err *err)
+{
+    (void)err;
+    piece_src *p = u;
+    memcpy(dst, p->x + 2 * p->at, frames * 2 * sizeof *dst);
+    p->at += frames;
+    return true;
+}
+static bool piece_rewind(void *u, rs_err *err)
+{
+    (void)err;
+    ((piece_src *)u)->at = 0;
+    return true;
+}
+
+static void t_loudness_stream_any_pieces(void)
+{
+    size_t n = 3 * AU_RATE + 37;
+    float *x = malloc(n * 2 * sizeof *x), *whole = malloc(n * 2 * sizeof *x), *got = malloc(n * 2 * sizeof *x);
+    for (size_t i = 0; i < n; i++) {
+        double v = 0.03 * sin(2 * 3.14159265 * 440 * i / AU_RATE) + (i % 7000 < 30 ? 0.8 : 0) + (i > n - 60 ? 0.9 : 0);
+        x[2 * i] = (float)v, x[2 * i + 1] = (float)(-0.7 * v);
+    }
+    memcpy(whole, x, n * 2 * sizeof *x);
+    rs_err err = {0};
+    au_loudness b, a;
+    T_ASSERTF(au_loud_normalize(whole, n, -16, -1, &b, &a, &err), "%s", err.msg);
+    /* pinned: the bytes the limiter gave when it worked on a whole buffer
+     * (its implementation up to 437b877), FNV-1a 64 */
+    uint64_t h = 1469598103934665603ull;
+    for (size_t i = 0; i < n * 2 * sizeof(float); i++)
+        h = (h ^ ((const uint8_t *)whole)[i]) * 1099511628211ull;
+    T_ASSERTF(h == 0x800496ab15829649ull, "the normalized bytes hash to %016llx, not 800496ab15829649 as before",
+              (unsigned long long)h);
+    piece_src ps = {x, 0};
+    au_source src = {piece_read, piece_rewind, &ps, n};
+    au_norm plan;
+    T_ASSERTF(au_norm_plan(&src, -16, -1, &plan, &err), "%s", err.msg);
+    T_ASSERT(plan.on && plan.after.integrated == a.integrated && plan.after.true_peak == a.true_peak);
+    T_ASSERTF(plan.gain > 1.5f, "gain %.3f: the limiter must have work to do", plan.gain);
+    au_norm_stream *st = au_norm_stream_new(&src, &plan, &err);
+    T_ASSERT(st != NULL);
+    static const size_t pieces[] = {1, 97, 800, 48001};
+    for (size_t k = 0; k < sizeof pieces / sizeof pieces[0]; k++) {
+        T_ASSERT(au_norm_stream_rewind(st, &err));
+        for (size_t at = 0; at < n;) {
+            size_t m = n - at < pieces[k] ? n - at : pieces[k];
+            T_ASSERTF(au_norm_stream_read(st, got + 2 * at, m, &err), "%s", err.msg);
+            at += m;
+        }
+        size_t d = 0, first = n;
+        for (size_t i = 0; i < 2 * n; i++)
+            if (memcmp(&got[i], &whole[i], sizeof(float))) {
+                d++;
+                first = i / 2 < first ? i / 2 : first;
+            }
+        T_ASSERTF(d == 0, "pieces of %zu: %zu samples differ from the buffer's, the first at frame %zu of %zu", pieces[k], d,
+                  first, n);
+    }
+    /* limited: the result is under the ceiling and not the input scaled */
+    T_ASSERTF(a.true_peak <= -1.0, "%.2f dBTP", a.true_peak);
+    T_ASSERT(!au_norm_stream_read(st, got, 1, &err) && err.code == AU_ERR_ARG); /* past the end */
+    au_norm_stream_free(st);
+    free(x), free(whole), free(got);
+}
+
 /* ---- a replay's soundtrack ---- */
 
 static void load(rp_replay *rp)
 {
     rs_err err = {0};
     T_ASSERTF(rp_read(DEMO, rp, &err), "%s", err.msg);
+}
+
+/* The stream gives the same samples as the buffer, in any pieces, again
+ * after a rewind, for a range and the whole match */
+static void t_track_streamed_equals_buffer(void)
+{
+    rp_replay rp;
+    load(&rp);
+    rs_err err = {0};
+    au_track t;
+    T_ASSERTF(au_replay_track(&rp, DEMO, 500, 900, NULL, &t, &err), "%s", err.msg);
+    au_replay_stream *s = au_replay_open(&rp, DEMO, 500, 900, NULL, &err);
+    T_ASSERTF(s != NULL, "%s", err.msg);
+    T_EQ(au_replay_info(s)->frames, t.frames);
+    T_ASSERT(au_replay_info(s)->lufs_after == t.lufs_after && au_replay_info(s)->gain_db == t.gain_db);
+    float *got = malloc(t.frames * 2 * sizeof *got);
+    static const size_t pieces[] = {1024, 799, 100000};
+    for (size_t k = 0; k < 3; k++) {
+        T_ASSERT(k == 0 || au_replay_rewind(s, &err));
+        for (size_t at = 0; at < t.frames;) {
+            size_t m = t.frames - at < pieces[k] ? t.frames - at : pieces[k];
+            T_ASSERTF(au_replay_read(s, got + 2 * at, m, &err), "%s", err.msg);
+            at += m;
+        }
+        T_ASSERTF(!memcmp(got, t.pcm, t.frames * 2 * sizeof *got), "pieces of %zu differ", pieces[k]);
+    }
+    T_ASSERT(!au_replay_read(s, got, 1, &err) && err.code == AU_ERR_ARG);
+    au_replay_close(s);
+    T_ASSERT(!au_replay_open(&rp, DEMO, 10, 10, NULL, &err) && err.code == AU_ERR_ARG);
+    free(got);
+    au_track_free(&t);
+    rp_free(&rp);
 }
 
 static void t_track_identical_and_sliced(void)
@@ -490,6 +598,8 @@ T_MAIN({"wav_round_trip", t_wav_round_trip}, {"wav_reads_other_formats", t_wav_r
        {"mixer_pan_gain_offset", t_mixer_pan_gain_offset},
        {"mixer_voice_limit_and_limiter", t_mixer_voice_limit_and_limiter}, {"mixer_music_phase", t_mixer_music_phase},
        {"cues_pan_and_diffs", t_cues_pan_and_diffs}, {"loudness_normalize_holds_peak", t_loudness_normalize_holds_peak},
+       {"loudness_stream_any_pieces", t_loudness_stream_any_pieces},
+       {"track_streamed_equals_buffer", t_track_streamed_equals_buffer},
        {"track_identical_and_sliced", t_track_identical_and_sliced},
        {"track_hit_onset_on_its_tick", t_track_hit_onset_on_its_tick},
        {"track_desync_names_tick", t_track_desync_names_tick})

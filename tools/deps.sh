@@ -28,7 +28,8 @@ group_pkgs() {
     # the simulation a second time (its state hashes must equal gcc's);
     # systemd's systemd-analyze verifies the unit file make install writes;
     # python3 parses SVG, WAV and HTTP in the checks (not in a minimal image)
-    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox glslang-tools clang systemd python3" ;;
+    # time: /usr/bin/time, the peak resident memory the flat-memory tests read
+    test) echo "xvfb xauth xdotool ffmpeg xz-utils sox glslang-tools clang systemd python3 time" ;;
     # make test-service: a real PostgreSQL server for the two-daemon test,
     # Debian's Chromium for the dashboard test, driven by playwright-core,
     # which npm fetches and Node.js runs

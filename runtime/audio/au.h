@@ -135,12 +135,39 @@ typedef struct au_track {
     double peak_before, peak_after;   /* true peak, dBTP, whole match */
 } au_track;
 
+/* What a replay's track is: its range and, when normalized, the whole
+ * match's loudness before and after (NAN when not normalized). */
+typedef struct au_track_info {
+    size_t frames;
+    uint64_t first, end;
+    double gain_db;
+    double lufs_before, lufs_after;
+    double peak_before, peak_after;
+} au_track_info;
+
+/* The soundtrack of ticks first..end-1, read in order, in pieces of any
+ * size, without ever holding the match's track: au_replay_open measures
+ * the whole match (mixing it again for each pass, au_norm_plan), then each
+ * read mixes on as far as it needs.  The same samples as au_replay_track
+ * (below), in memory that does not grow with the match's length.  rp must
+ * outlive the stream.  rewind starts the range again (another consumer:
+ * a WAV beside the video). */
+typedef struct au_replay_stream au_replay_stream;
+au_replay_stream *au_replay_open(const rp_replay *rp, const char *name, uint64_t first, uint64_t end,
+                                 const au_replay_opts *o, rs_err *err);
+const au_track_info *au_replay_info(const au_replay_stream *s);
+bool au_replay_read(au_replay_stream *s, float *dst, size_t frames, rs_err *err);
+bool au_replay_rewind(au_replay_stream *s, rs_err *err);
+void au_replay_close(au_replay_stream *s);
+
 /* The soundtrack of ticks first..end-1 (end 0: the replay's end): the game
  * simulated from tick 0, every tick's cues mixed, the whole match measured
  * and brought to target_lufs with its true peak held at peak_dbtp, then
  * ticks first..end-1 cut out.  So the audio of any range is exactly that
  * range of the whole match's track, and segments joined or a render of the
- * whole give the same samples.  name is for messages. */
+ * whole give the same samples.  name is for messages.  In one buffer
+ * (the range's length): tests, benches and short ranges; au_replay_open
+ * streams it. */
 bool au_replay_track(const rp_replay *rp, const char *name, uint64_t first, uint64_t end,
                      const au_replay_opts *o, au_track *t, rs_err *err);
 void au_track_free(au_track *t);
@@ -159,6 +186,43 @@ bool au_loud_measure(const float *pcm, size_t frames, au_loudness *out, rs_err *
 bool au_loud_normalize(float *pcm, size_t frames, double target_lufs, double peak_dbtp, au_loudness *before,
                        au_loudness *after, rs_err *err);
 
+/* Streaming: a meter fed in pieces (au_loud_measure is one piece). */
+typedef struct au_meter au_meter;
+au_meter *au_meter_new(rs_err *err);
+bool au_meter_add(au_meter *m, const float *pcm, size_t frames, rs_err *err);
+bool au_meter_result(au_meter *m, au_loudness *out, rs_err *err);
+void au_meter_free(au_meter *m);
+
+/* A track that can be read again from its start, in order, in pieces of
+ * any size: a buffer, or a replay mixed again (au_replay.c).  frames is
+ * its length. */
+typedef struct au_source {
+    bool (*read)(void *u, float *dst, size_t frames, rs_err *err);
+    bool (*rewind)(void *u, rs_err *err);
+    void *u;
+    size_t frames;
+} au_source;
+
+/* What au_loud_normalize does to a track, found by reading it (once to
+ * measure, once per pass of the gain and limiter), in constant memory. */
+typedef struct au_norm {
+    bool on;                     /* false: the track stays as it is (silence) */
+    float gain;                  /* linear, on every sample */
+    double ceiling;              /* the limiter's, linear */
+    double gain_db;              /* target - the track's integrated loudness */
+    au_loudness before, after;   /* the track's, and the result's */
+} au_norm;
+bool au_norm_plan(const au_source *src, double target_lufs, double peak_dbtp, au_norm *plan, rs_err *err);
+
+/* The normalized track, read in order: the same samples au_loud_normalize
+ * leaves in a buffer.  Reads its source ahead by a few hundred frames;
+ * rewind starts it again. */
+typedef struct au_norm_stream au_norm_stream;
+au_norm_stream *au_norm_stream_new(const au_source *src, const au_norm *plan, rs_err *err);
+bool au_norm_stream_read(au_norm_stream *s, float *dst, size_t frames, rs_err *err);
+bool au_norm_stream_rewind(au_norm_stream *s, rs_err *err);
+void au_norm_stream_free(au_norm_stream *s);
+
 /* ---- WAV files (au_wav.c) ---- */
 
 /* Writes stereo float frames as 16-bit PCM (float32: 32-bit float) at
@@ -171,6 +235,9 @@ bool au_wav_read(const char *path, float **pcm, size_t *frames, int *channels, i
 /* Streaming WAV writer for live output (au_out.c's wav backend). */
 typedef struct au_wav au_wav;
 au_wav *au_wav_open(const char *path, bool float32, rs_err *err);
+/* The same for a track of a known length: the header is right from the
+ * start, so "-" and pipes take it too (in place); close checks the count. */
+au_wav *au_wav_open_known(const char *path, bool float32, size_t frames, rs_err *err);
 bool au_wav_append(au_wav *w, const float *pcm, size_t frames, rs_err *err);
 bool au_wav_close(au_wav *w, bool ok, rs_err *err); /* ok: finish the header and rename */
 

@@ -1,8 +1,14 @@
 /* Loudness: EBU R128 measurement (libebur128: integrated, range, true
  * peak) and normalization: a gain to the target, then a true-peak limiter.
  *
- * DESIGN: the limiter works on a finished buffer, so it looks ahead for
- * free and adds no delay.  Per frame it estimates the true (inter-sample)
+ * DESIGN: everything here streams, so a track of any length is normalized
+ * in a few kilobytes.  The plan (au_norm_plan) reads its source once to
+ * measure it and once per pass of the loop below, each time from the
+ * start (a replay's source mixes the match again: cheaper than keeping
+ * it); the apply (au_norm_stream) reads it once more, through the same
+ * gain and limiter, and gives the result out in order.  The limiter looks
+ * ahead by holding back LOOK + a block + TAPS frames (AU_LIMITER_DELAY).
+ * Per frame it estimates the true (inter-sample)
  * peak with a 4x polyphase windowed-sinc interpolator, as BS.1770's
  * true-peak meter does; the gain each frame needs is r[n] = ceiling /
  * peak.  The applied gain is
@@ -28,34 +34,75 @@
 #define LOOK 96        /* L: look-ahead and attack, frames (2 ms) */
 #define RELEASE 4800   /* frames for the gain to recover from 0 to 1 (100 ms) */
 #define MARGIN_DB 0.2
+#define BLOCK 64      /* frames whose gain is skipped together when quiet */
+/* frames the limiter holds back: a window, a block and the interpolator's reach */
+#define AU_LIMITER_DELAY (LOOK + BLOCK + TAPS + 2)
 
-bool au_loud_measure(const float *pcm, size_t frames, au_loudness *out, rs_err *err)
+/* ---- the meter: libebur128, fed in pieces ---- */
+
+struct au_meter {
+    ebur128_state *st;
+};
+
+au_meter *au_meter_new(rs_err *err)
 {
-    ebur128_state *st = ebur128_init(AU_CHANNELS, AU_RATE, EBUR128_MODE_I | EBUR128_MODE_LRA | EBUR128_MODE_TRUE_PEAK);
-    if (!st)
-        return rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 could not start (out of memory)");
-    bool ok = true;
-    for (size_t at = 0; at < frames && ok;) { /* in pieces: its frame count is a size_t, its buffers are not */
+    au_meter *m = calloc(1, sizeof *m);
+    if (m)
+        m->st = ebur128_init(AU_CHANNELS, AU_RATE, EBUR128_MODE_I | EBUR128_MODE_LRA | EBUR128_MODE_TRUE_PEAK);
+    if (!m || !m->st) {
+        free(m);
+        rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 could not start (out of memory)");
+        return NULL;
+    }
+    return m;
+}
+
+bool au_meter_add(au_meter *m, const float *pcm, size_t frames, rs_err *err)
+{
+    for (size_t at = 0; at < frames;) { /* its frame count is a size_t, its buffers are not */
         size_t n = frames - at < (size_t)AU_RATE * 10 ? frames - at : (size_t)AU_RATE * 10;
-        ok = ebur128_add_frames_float(st, pcm + 2 * at, n) == EBUR128_SUCCESS;
+        if (ebur128_add_frames_float(m->st, pcm + 2 * at, n) != EBUR128_SUCCESS)
+            return rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 failed to measure %zu frames", frames);
         at += n;
     }
+    return true;
+}
+
+bool au_meter_result(au_meter *m, au_loudness *out, rs_err *err)
+{
     double I = -HUGE_VAL, lra = 0, tp = 0;
+    bool ok = true;
     for (unsigned c = 0; c < AU_CHANNELS && ok; c++) {
         double p;
-        ok = ebur128_true_peak(st, c, &p) == EBUR128_SUCCESS;
+        ok = ebur128_true_peak(m->st, c, &p) == EBUR128_SUCCESS;
         tp = ok && p > tp ? p : tp;
     }
-    ok = ok && ebur128_loudness_global(st, &I) == EBUR128_SUCCESS;
-    ok = ok && ebur128_loudness_range(st, &lra) == EBUR128_SUCCESS;
-    ebur128_destroy(&st);
+    ok = ok && ebur128_loudness_global(m->st, &I) == EBUR128_SUCCESS;
+    ok = ok && ebur128_loudness_range(m->st, &lra) == EBUR128_SUCCESS;
     if (!ok)
-        return rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 failed to measure %zu frames", frames);
+        return rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 failed to measure the track");
     out->integrated = isfinite(I) ? I : -HUGE_VAL;
     out->range = isfinite(lra) ? lra : 0;
     out->true_peak = tp > 0 ? 20 * log10(tp) : -HUGE_VAL;
     return true;
 }
+
+void au_meter_free(au_meter *m)
+{
+    if (m)
+        ebur128_destroy(&m->st);
+    free(m);
+}
+
+bool au_loud_measure(const float *pcm, size_t frames, au_loudness *out, rs_err *err)
+{
+    au_meter *m = au_meter_new(err);
+    bool ok = m && au_meter_add(m, pcm, frames, err) && au_meter_result(m, out, err);
+    au_meter_free(m);
+    return ok;
+}
+
+/* ---- the limiter, streaming ---- */
 
 /* The interpolator: a windowed sinc at the original Nyquist, 4x. */
 static void make_fir(double h[OS * TAPS])
@@ -69,142 +116,242 @@ static void make_fir(double h[OS * TAPS])
     }
 }
 
-/* r[n]: the gain frame n may have, 1 where it is under the ceiling. */
-static void needed_gain(const float *pcm, size_t frames, double ceiling, float *r)
-{
+#define RING 1024     /* the limiter's window on the track: > its delay + PIECE */
+#define PIECE 256     /* frames taken in at a time */
+#define AT(x) ((x) & (RING - 1))
+
+typedef struct au_limiter au_limiter;
+struct au_limiter {
     double h[OS * TAPS];
-    make_fir(h);
-    const size_t B = 64;
-    for (size_t b0 = 0; b0 < frames; b0 += B) {
-        size_t b1 = b0 + B < frames ? b0 + B : frames;
-        /* skip blocks that are far below the ceiling, their neighbours too:
-         * an inter-sample peak is never 6 dB over the samples around it */
-        size_t lo = b0 > TAPS ? b0 - TAPS : 0, hi = b1 + TAPS < frames ? b1 + TAPS : frames;
-        float near = 0;
-        for (size_t i = 2 * lo; i < 2 * hi; i++)
-            near = fabsf(pcm[i]) > near ? fabsf(pcm[i]) : near;
-        for (size_t n = b0; n < b1; n++)
-            r[n] = 1;
-        if (near < 0.5 * ceiling)
-            continue;
-        for (size_t n = b0; n < b1; n++) {
-            /* the interpolated points between frames n-1 and n+1 */
-            double peak = 0;
-            for (int c = 0; c < 2; c++) {
-                for (int p = 0; p < OS; p++) {
-                    double y = 0;
-                    for (int k = 0; k < TAPS; k++) {
-                        long j = (long)n - TAPS / 2 + 1 + k;
-                        if (j >= 0 && (size_t)j < frames)
-                            y += h[OS * (TAPS - 1 - k) + p] * pcm[2 * j + c];
-                    }
-                    peak = fabs(y) > peak ? fabs(y) : peak;
-                }
-                double s = fabs(pcm[2 * n + c]);
-                peak = s > peak ? s : peak;
-            }
-            r[n] = peak > ceiling ? (float)(ceiling / peak) : 1;
-        }
-    }
-    /* an interpolated point lies between frames: both neighbours must
-     * honour it */
-    float prev = 1;
-    for (size_t n = 0; n < frames; n++) {
-        float cur = r[n], next = n + 1 < frames ? r[n + 1] : 1, m = cur < prev ? cur : prev;
-        r[n] = m < next ? m : next;
-        prev = cur;
-    }
-}
-
-/* The gain curve of the DESIGN note, applied in place; false when no
- * frame needed limiting. */
-static bool limit(float *pcm, size_t frames, double ceiling, bool *nomem)
-{
-    float *r = malloc(frames * sizeof *r), *pre = malloc(frames * sizeof *pre), *suf = malloc(frames * sizeof *suf);
-    bool any = false;
-    if (!r || !pre || !suf) {
-        *nomem = true;
-        goto done;
-    }
-    needed_gain(pcm, frames, ceiling, r);
-    for (size_t n = 0; n < frames && !any; n++)
-        any = r[n] < 1;
-    if (!any)
-        goto done;
-    /* m[k] = min(r[k..k+L-1]) by blocks of L (van Herk / Gil-Werman): the
-     * minimum from k to its block's end, and from the next block's start
-     * to k+L-1 */
-    for (size_t b = 0; b < frames; b += LOOK) {
-        size_t e = b + LOOK < frames ? b + LOOK : frames;
-        pre[b] = r[b];
-        for (size_t k = b + 1; k < e; k++)
-            pre[k] = r[k] < pre[k - 1] ? r[k] : pre[k - 1];
-        suf[e - 1] = r[e - 1];
-        for (size_t k = e - 1; k-- > b;)
-            suf[k] = r[k] < suf[k + 1] ? r[k] : suf[k + 1];
-    }
-    double mprev = 1, sum = LOOK;
+    double ceiling;
+    size_t total; /* the track's length: its end changes the last frames' gain */
+    size_t in;    /* frames taken in */
+    size_t rdone; /* r[] (the gain each frame may have) known below this */
+    size_t adone; /* r[] with the neighbours' step known below this */
+    size_t out;   /* frames given out */
+    float pcm[RING * 2], rraw[RING], radj[RING];
+    size_t dq[RING], dqh, dqt; /* a window's minimum: indices of increasing radj */
+    double mprev, sum;
     float ring[LOOK];
+    bool any;
+};
+
+static au_limiter *au_limiter_new(size_t total, double ceiling)
+{
+    au_limiter *l = calloc(1, sizeof *l);
+    if (!l)
+        return NULL;
+    make_fir(l->h);
+    l->ceiling = ceiling;
+    l->total = total;
+    l->mprev = 1;
+    l->sum = LOOK;
     for (size_t i = 0; i < LOOK; i++)
-        ring[i] = 1; /* m' before the start: no limiting */
-    for (size_t k = 0; k < frames; k++) {
-        size_t last = k + LOOK - 1;
-        double m = suf[k];
-        if (last < frames && last / LOOK != k / LOOK)
-            m = pre[last] < m ? pre[last] : m;
-        double rise = mprev + 1.0 / RELEASE;
-        m = m < rise ? m : rise;
-        mprev = m;
-        float mf = (float)m;
-        sum += mf - ring[k % LOOK];
-        ring[k % LOOK] = mf;
-        if (k % 4096 == 4095) { /* the running sum drifts by roundings: recount */
-            sum = 0;
-            for (size_t i = 0; i < LOOK; i++)
-                sum += ring[i];
-        }
-        float g = (float)(sum / LOOK);
-        g = g > r[k] ? r[k] : g; /* equal or less in exact arithmetic; a rounding must not cross it */
-        pcm[2 * k] *= g;
-        pcm[2 * k + 1] *= g;
-    }
-done:
-    free(r);
-    free(pre);
-    free(suf);
-    return any;
+        l->ring[i] = 1; /* m' before the start: no limiting */
+    return l;
 }
 
-bool au_loud_normalize(float *pcm, size_t frames, double target_lufs, double peak_dbtp, au_loudness *before,
-                       au_loudness *after, rs_err *err)
+static void au_limiter_free(au_limiter *l)
 {
+    free(l);
+}
+
+static bool au_limiter_any(const au_limiter *l)
+{
+    return l->any;
+}
+
+/* r[n] for the block b0..b1-1: the gain frame n may have, 1 where it is
+ * under the ceiling.  Blocks far below the ceiling are skipped, with their
+ * neighbours: an inter-sample peak is never 6 dB over the samples around it */
+static void block_gain(au_limiter *l, size_t b0, size_t b1)
+{
+    size_t lo = b0 > TAPS ? b0 - TAPS : 0, hi = b1 + TAPS < l->total ? b1 + TAPS : l->total;
+    float near = 0;
+    for (size_t i = lo; i < hi; i++)
+        for (int c = 0; c < 2; c++)
+            near = fabsf(l->pcm[2 * AT(i) + c]) > near ? fabsf(l->pcm[2 * AT(i) + c]) : near;
+    for (size_t n = b0; n < b1; n++)
+        l->rraw[AT(n)] = 1;
+    if (near < 0.5 * l->ceiling)
+        return;
+    for (size_t n = b0; n < b1; n++) {
+        /* the interpolated points between frames n-1 and n+1 */
+        double peak = 0;
+        for (int c = 0; c < 2; c++) {
+            for (int p = 0; p < OS; p++) {
+                double y = 0;
+                for (int k = 0; k < TAPS; k++) {
+                    long j = (long)n - TAPS / 2 + 1 + k;
+                    if (j >= 0 && (size_t)j < l->total)
+                        y += l->h[OS * (TAPS - 1 - k) + p] * l->pcm[2 * AT((size_t)j) + c];
+                }
+                peak = fabs(y) > peak ? fabs(y) : peak;
+            }
+            double s = fabs(l->pcm[2 * AT(n) + c]);
+            peak = s > peak ? s : peak;
+        }
+        l->rraw[AT(n)] = peak > l->ceiling ? (float)(l->ceiling / peak) : 1;
+    }
+}
+
+/* Frame k out, its window's minimum m given: the release, the attack's mean */
+static void give(au_limiter *l, size_t k, double m, float *out)
+{
+    double rise = l->mprev + 1.0 / RELEASE;
+    m = m < rise ? m : rise;
+    l->mprev = m;
+    float mf = (float)m;
+    l->sum += mf - l->ring[k % LOOK];
+    l->ring[k % LOOK] = mf;
+    if (k % 4096 == 4095) { /* the running sum drifts by roundings: recount */
+        l->sum = 0;
+        for (size_t i = 0; i < LOOK; i++)
+            l->sum += l->ring[i];
+    }
+    float g = (float)(l->sum / LOOK), r = l->radj[AT(k)];
+    g = g > r ? r : g; /* equal or less in exact arithmetic; a rounding must not cross it */
+    out[2 * (k - l->out)] = l->pcm[2 * AT(k)] * g;
+    out[2 * (k - l->out) + 1] = l->pcm[2 * AT(k) + 1] * g;
+}
+
+/* Everything the frames taken in allow; returns the frames written */
+static size_t run(au_limiter *l, float *out)
+{
+    size_t first = l->out, k = first;
+    while (l->rdone < l->total) {
+        size_t b0 = l->rdone, b1 = b0 + BLOCK < l->total ? b0 + BLOCK : l->total;
+        if (l->in < (b1 + TAPS < l->total ? b1 + TAPS : l->total))
+            break;
+        block_gain(l, b0, b1);
+        l->rdone = b1;
+    }
+    /* an interpolated point lies between frames: both neighbours honour it */
+    while (l->adone < l->rdone && (l->adone + 1 < l->rdone || l->rdone == l->total)) {
+        size_t n = l->adone;
+        float cur = l->rraw[AT(n)], prev = n > 0 ? l->rraw[AT(n - 1)] : 1, next = n + 1 < l->total ? l->rraw[AT(n + 1)] : 1;
+        float m = cur < prev ? cur : prev;
+        float a = m < next ? m : next;
+        l->radj[AT(n)] = a;
+        l->any |= a < 1;
+        while (l->dqt > l->dqh && l->radj[AT(l->dq[AT(l->dqt - 1)])] >= a)
+            l->dqt--;
+        l->dq[AT(l->dqt++)] = n;
+        l->adone = n + 1;
+        /* m[k] = min(r[k .. k+LOOK-1]): k's window is complete */
+        if (n + 1 >= LOOK) {
+            size_t kk = n + 1 - LOOK;
+            while (l->dq[AT(l->dqh)] < kk)
+                l->dqh++;
+            give(l, kk, l->radj[AT(l->dq[AT(l->dqh)])], out);
+            k = kk + 1;
+        }
+        if (n + 1 == l->total) {
+            /* the last frames: their windows run past the end, and (as the
+             * block minimum this replaced had it) stop at the end of the
+             * LOOK-aligned block that holds k */
+            for (size_t t = l->total > LOOK - 1 ? l->total - LOOK + 1 : 0; t < l->total; t++) {
+                size_t b = t - t % LOOK, e = b + LOOK < l->total ? b + LOOK : l->total;
+                float mm = l->radj[AT(t)];
+                for (size_t i = t + 1; i < e; i++)
+                    mm = l->radj[AT(i)] < mm ? l->radj[AT(i)] : mm;
+                give(l, t, mm, out);
+                k = t + 1;
+            }
+        }
+    }
+    size_t n = k - first;
+    l->out = k;
+    return n;
+}
+
+static size_t au_limiter_push(au_limiter *l, const float *in, size_t n, float *out)
+{
+    size_t written = 0;
+    for (size_t at = 0; at < n;) {
+        size_t take = n - at < PIECE ? n - at : PIECE;
+        if (take > l->total - l->in)
+            take = l->total - l->in; /* past the length it was made for: dropped */
+        if (!take)
+            break;
+        for (size_t i = 0; i < take; i++) {
+            l->pcm[2 * AT(l->in + i)] = in[2 * (at + i)];
+            l->pcm[2 * AT(l->in + i) + 1] = in[2 * (at + i) + 1];
+        }
+        l->in += take;
+        at += take;
+        written += run(l, out + 2 * written);
+    }
+    return written;
+}
+
+/* ---- normalization: the plan, then the stream ---- */
+
+/* One read of the source from its start through gain g and, when limit,
+ * the limiter at ceiling c into the meter. */
+static bool measure_pass(const au_source *src, float g, bool limit, double c, au_loudness *a, bool *limited, rs_err *err)
+{
+    enum { CH = 4800 };
+    float *buf = malloc((CH + AU_LIMITER_DELAY) * 2 * sizeof *buf * 2);
+    au_meter *m = au_meter_new(err);
+    au_limiter *l = limit ? au_limiter_new(src->frames, c) : NULL;
+    bool ok = false;
+    if (!buf || !m || (limit && !l)) {
+        if (m)
+            rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory");
+        goto done;
+    }
+    float *lim = buf + (CH + AU_LIMITER_DELAY) * 2;
+    if (!src->rewind(src->u, err))
+        goto done;
+    for (size_t at = 0; at < src->frames;) {
+        size_t n = src->frames - at < CH ? src->frames - at : CH;
+        if (!src->read(src->u, buf, n, err))
+            goto done;
+        at += n;
+        if (g != 1)
+            for (size_t i = 0; i < 2 * n; i++)
+                buf[i] *= g;
+        const float *x = buf;
+        size_t nx = n;
+        if (l) {
+            nx = au_limiter_push(l, buf, n, lim);
+            x = lim;
+        }
+        if (!au_meter_add(m, x, nx, err))
+            goto done;
+    }
+    ok = au_meter_result(m, a, err);
+    if (limited)
+        *limited = l && au_limiter_any(l);
+done:
+    free(buf);
+    au_meter_free(m);
+    au_limiter_free(l);
+    return ok;
+}
+
+bool au_norm_plan(const au_source *src, double target_lufs, double peak_dbtp, au_norm *plan, rs_err *err)
+{
+    memset(plan, 0, sizeof *plan);
     if (!isfinite(target_lufs) || target_lufs < -70 || target_lufs > 0 || !isfinite(peak_dbtp) || peak_dbtp > 0 ||
         peak_dbtp < -30)
         return rs_fail(err, AU_ERR_ARG, "loudness: target %.1f LUFS, ceiling %.1f dBTP (expected -70..0 and -30..0)",
                        target_lufs, peak_dbtp);
     au_loudness b, a;
-    if (!au_loud_measure(pcm, frames, &b, err))
+    if (!measure_pass(src, 1, false, 0, &b, NULL, err))
         return false;
-    if (before)
-        *before = b;
+    plan->before = b;
     a = b;
     if (isfinite(b.integrated)) {
-        float *orig = malloc(frames * 2 * sizeof *orig);
-        if (!orig)
-            return rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory for %zu frames", frames);
-        memcpy(orig, pcm, frames * 2 * sizeof *orig);
         double gain_db = target_lufs - b.integrated, ceiling_db = peak_dbtp - MARGIN_DB;
         for (int pass = 0; pass < 6; pass++) {
             float g = (float)pow(10.0, gain_db / 20.0);
-            for (size_t i = 0; i < 2 * frames; i++)
-                pcm[i] = orig[i] * g;
-            bool nomem = false;
-            bool limited = limit(pcm, frames, pow(10.0, ceiling_db / 20.0), &nomem);
-            if (nomem || !au_loud_measure(pcm, frames, &a, err)) {
-                free(orig);
-                return nomem ? rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory for the limiter (%zu frames)", frames)
-                             : false;
-            }
+            double c = pow(10.0, ceiling_db / 20.0);
+            bool limited;
+            if (!measure_pass(src, g, true, c, &a, &limited, err))
+                return false;
+            plan->on = true, plan->gain = g, plan->ceiling = c;
             /* the limiter took loudness away: make it up (a few times at
              * most: on programme that is all peaks it cannot be) */
             bool peak_ok = a.true_peak <= peak_dbtp;
@@ -216,9 +363,139 @@ bool au_loud_normalize(float *pcm, size_t frames, double target_lufs, double pea
             if (!loud_ok)
                 gain_db += target_lufs - a.integrated;
         }
-        free(orig);
+        plan->gain_db = target_lufs - b.integrated;
     }
-    if (after)
-        *after = a;
+    plan->after = a;
     return true;
+}
+
+struct au_norm_stream {
+    const au_source *src;
+    au_norm plan;
+    au_limiter *l;
+    size_t taken;        /* source frames read */
+    float *in, *held;    /* a piece of the source; the limiter's output not yet given */
+    size_t nheld, at;    /* held frames, the next one to give */
+};
+
+#define SPIECE 1024
+
+au_norm_stream *au_norm_stream_new(const au_source *src, const au_norm *plan, rs_err *err)
+{
+    au_norm_stream *s = calloc(1, sizeof *s);
+    if (s) {
+        s->in = malloc(SPIECE * 2 * sizeof *s->in);
+        s->held = malloc((SPIECE + AU_LIMITER_DELAY) * 2 * sizeof *s->held);
+    }
+    if (!s || !s->in || !s->held) {
+        au_norm_stream_free(s);
+        rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory");
+        return NULL;
+    }
+    s->src = src;
+    s->plan = *plan;
+    if (!au_norm_stream_rewind(s, err)) {
+        au_norm_stream_free(s);
+        return NULL;
+    }
+    return s;
+}
+
+bool au_norm_stream_rewind(au_norm_stream *s, rs_err *err)
+{
+    au_limiter_free(s->l);
+    s->l = NULL;
+    s->taken = s->nheld = s->at = 0;
+    if (s->plan.on && !(s->l = au_limiter_new(s->src->frames, s->plan.ceiling)))
+        return rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory");
+    return s->src->rewind(s->src->u, err);
+}
+
+bool au_norm_stream_read(au_norm_stream *s, float *dst, size_t frames, rs_err *err)
+{
+    while (frames) {
+        if (s->at == s->nheld) {
+            size_t n = s->src->frames - s->taken < SPIECE ? s->src->frames - s->taken : SPIECE;
+            if (!n)
+                return rs_fail(err, AU_ERR_ARG, "loudness: read past the end of the track (%zu frames)", s->src->frames);
+            if (!s->src->read(s->src->u, s->in, n, err))
+                return false;
+            s->taken += n;
+            s->at = 0;
+            if (s->plan.on) {
+                for (size_t i = 0; i < 2 * n; i++)
+                    s->in[i] *= s->plan.gain;
+                s->nheld = au_limiter_push(s->l, s->in, n, s->held);
+            } else {
+                memcpy(s->held, s->in, n * 2 * sizeof *s->in);
+                s->nheld = n;
+            }
+            continue;
+        }
+        size_t n = s->nheld - s->at < frames ? s->nheld - s->at : frames;
+        memcpy(dst, s->held + 2 * s->at, n * 2 * sizeof *dst);
+        s->at += n, dst += 2 * n, frames -= n;
+    }
+    return true;
+}
+
+void au_norm_stream_free(au_norm_stream *s)
+{
+    if (!s)
+        return;
+    au_limiter_free(s->l);
+    free(s->in);
+    free(s->held);
+    free(s);
+}
+
+/* ---- a buffer normalized in place, through the same stream ---- */
+
+typedef struct buf_src {
+    const float *pcm;
+    size_t at;
+} buf_src;
+
+static bool buf_read(void *u, float *dst, size_t frames, rs_err *err)
+{
+    (void)err;
+    buf_src *b = u;
+    memmove(dst, b->pcm + 2 * b->at, frames * 2 * sizeof *dst); /* in place: the output lags the input */
+    b->at += frames;
+    return true;
+}
+
+static bool buf_rewind(void *u, rs_err *err)
+{
+    (void)err;
+    ((buf_src *)u)->at = 0;
+    return true;
+}
+
+bool au_loud_normalize(float *pcm, size_t frames, double target_lufs, double peak_dbtp, au_loudness *before,
+                       au_loudness *after, rs_err *err)
+{
+    buf_src b = {pcm, 0};
+    au_source src = {buf_read, buf_rewind, &b, frames};
+    au_norm plan;
+    if (!au_norm_plan(&src, target_lufs, peak_dbtp, &plan, err))
+        return false;
+    if (before)
+        *before = plan.before;
+    if (after)
+        *after = plan.after;
+    if (!plan.on)
+        return true;
+    au_norm_stream *s = au_norm_stream_new(&src, &plan, err);
+    if (!s)
+        return false;
+    /* the stream reads ahead of what it gives, so writing behind it is safe */
+    bool ok = true;
+    for (size_t at = 0; at < frames && ok;) {
+        size_t n = frames - at < SPIECE ? frames - at : SPIECE;
+        ok = au_norm_stream_read(s, pcm + 2 * at, n, err);
+        at += n;
+    }
+    au_norm_stream_free(s);
+    return ok;
 }

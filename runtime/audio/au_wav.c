@@ -5,7 +5,8 @@
  * Writing goes to "<path>.part", renamed into place when complete
  * (rs_file.h), so a failed or interrupted run never leaves a WAV that
  * looks finished.  "-" and other streams (rs_out_is_stream) are written in
- * place by au_wav_write, whose sizes are known up front.
+ * place by au_wav_write and au_wav_open_known, whose sizes are known up
+ * front.
  *
  * DESIGN: 16-bit output is plain rounding with clipping, no dither: dither
  * would need noise, and the soundtrack must be a pure function of the
@@ -160,34 +161,57 @@ bool au_wav_write(const char *path, const float *pcm, size_t frames, bool float3
 struct au_wav {
     FILE *f;
     bool float32;
-    uint64_t frames;
+    bool stream;     /* "-" or a pipe: written in place, its size known up front */
+    uint64_t frames, known;
     char path[PATH_MAX];
     char part[PATH_MAX + 8];
 };
 
-au_wav *au_wav_open(const char *path, bool float32, rs_err *err)
+/* known: the frames that will be appended (the header says so from the
+ * start, so "-" and pipes can take it), or 0 with a file: written at close */
+static au_wav *wav_open(const char *path, bool float32, size_t known, rs_err *err)
 {
     au_wav *w = calloc(1, sizeof *w);
     if (!w) {
         rs_fail(err, AU_ERR_NOMEM, "%s: out of memory", path);
         return NULL;
     }
+    uint32_t bytes = 0;
+    if (known && too_long(path, known, float32, &bytes, err)) {
+        free(w);
+        return NULL;
+    }
     w->float32 = float32;
+    w->known = known;
+    w->stream = known && rs_out_is_stream(path);
     snprintf(w->path, sizeof w->path, "%s", path);
     rs_part_path(path, w->part, sizeof w->part);
-    w->f = fopen(w->part, "wb");
+    w->f = !w->stream ? fopen(w->part, "wb") : strcmp(path, "-") ? fopen(path, "wb") : stdout;
     uint8_t h[64];
-    size_t hn = header(h, float32, 0);
+    size_t hn = header(h, float32, bytes);
     if (!w->f || fwrite(h, 1, hn, w->f) != hn) {
-        rs_fail(err, AU_ERR_WAV_OPEN, "%s: cannot create (as %s): %s", w->path, w->part, strerror(errno));
-        if (w->f) {
+        if (w->stream)
+            rs_fail(err, AU_ERR_WAV_OPEN, "%s: cannot write: %s", w->path, strerror(errno));
+        else
+            rs_fail(err, AU_ERR_WAV_OPEN, "%s: cannot create (as %s): %s", w->path, w->part, strerror(errno));
+        if (w->f && w->f != stdout)
             fclose(w->f);
+        if (w->f && !w->stream)
             unlink(w->part);
-        }
         free(w);
         return NULL;
     }
     return w;
+}
+
+au_wav *au_wav_open(const char *path, bool float32, rs_err *err)
+{
+    return wav_open(path, float32, 0, err);
+}
+
+au_wav *au_wav_open_known(const char *path, bool float32, size_t frames, rs_err *err)
+{
+    return wav_open(path, float32, frames ? frames : 0, err);
 }
 
 bool au_wav_append(au_wav *w, const float *pcm, size_t frames, rs_err *err)
@@ -201,7 +225,7 @@ bool au_wav_append(au_wav *w, const float *pcm, size_t frames, rs_err *err)
         size_t n = frames < 4096 ? frames : 4096;
         encode(buf, pcm, n, w->float32);
         if (fwrite(buf, 1, n * block, w->f) != n * block)
-            return rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->part, strerror(errno));
+            return rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->stream ? w->path : w->part, strerror(errno));
         w->frames += n;
         pcm += n * AU_CHANNELS;
         frames -= n;
@@ -213,7 +237,14 @@ bool au_wav_close(au_wav *w, bool ok, rs_err *err)
 {
     if (!w)
         return ok;
-    if (ok) {
+    if (ok && w->known && w->frames != w->known)
+        ok = rs_fail(err, AU_ERR_WAV_OPEN, "%s: %llu frames written where its header says %llu", w->path,
+                     (unsigned long long)w->frames, (unsigned long long)w->known);
+    if (ok && w->stream) {
+        ok = fflush(w->f) == 0;
+        if (!ok)
+            rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->path, strerror(errno));
+    } else if (ok) {
         uint8_t h[64];
         size_t hn = header(h, w->float32, (uint32_t)(w->frames * AU_CHANNELS * (w->float32 ? 4 : 2)));
         ok = fflush(w->f) == 0 && fseek(w->f, 0, SEEK_SET) == 0 && fwrite(h, 1, hn, w->f) == hn &&
@@ -221,9 +252,11 @@ bool au_wav_close(au_wav *w, bool ok, rs_err *err)
         if (!ok)
             rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->part, strerror(errno));
     }
-    if (fclose(w->f) != 0 && ok)
-        ok = rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->part, strerror(errno));
-    if (ok) {
+    if (w->f != stdout && fclose(w->f) != 0 && ok)
+        ok = rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->stream ? w->path : w->part, strerror(errno));
+    if (w->stream) {
+        /* a stream is the reader's: nothing to rename or remove */
+    } else if (ok) {
         ok = rs_commit_file(w->path, err);
         if (!ok && err)
             err->code = AU_ERR_WAV_OPEN;
