@@ -4,9 +4,9 @@
  *
  * Writing goes to "<path>.part", renamed into place when complete
  * (rs_file.h), so a failed or interrupted run never leaves a WAV that
- * looks finished.  "-" and other streams (rs_out_is_stream) are written in
- * place by au_wav_write and au_wav_open_known, whose sizes are known up
- * front.
+ * looks finished; errors name the file as given.  "-" and other streams
+ * (rs_out_is_stream) are written in place by au_wav_write and
+ * au_wav_open_known, whose sizes are known up front.
  *
  * DESIGN: 16-bit output is plain rounding with clipping, no dither: dither
  * would need noise, and the soundtrack must be a pure function of the
@@ -225,7 +225,7 @@ bool au_wav_append(au_wav *w, const float *pcm, size_t frames, rs_err *err)
         size_t n = frames < 4096 ? frames : 4096;
         encode(buf, pcm, n, w->float32);
         if (fwrite(buf, 1, n * block, w->f) != n * block)
-            return rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->stream ? w->path : w->part, strerror(errno));
+            return rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->path, strerror(errno));
         w->frames += n;
         pcm += n * AU_CHANNELS;
         frames -= n;
@@ -250,10 +250,10 @@ bool au_wav_close(au_wav *w, bool ok, rs_err *err)
         ok = fflush(w->f) == 0 && fseek(w->f, 0, SEEK_SET) == 0 && fwrite(h, 1, hn, w->f) == hn &&
              fflush(w->f) == 0 && fsync(fileno(w->f)) == 0;
         if (!ok)
-            rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->part, strerror(errno));
+            rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->path, strerror(errno));
     }
     if (w->f != stdout && fclose(w->f) != 0 && ok)
-        ok = rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->stream ? w->path : w->part, strerror(errno));
+        ok = rs_fail(err, AU_ERR_WAV_OPEN, "%s: write failed: %s", w->path, strerror(errno));
     if (w->stream) {
         /* a stream is the reader's: nothing to rename or remove */
     } else if (ok) {
