@@ -151,11 +151,12 @@ bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err 
     if (!(a->buf = malloc(a->chunk * 2 * sizeof *a->buf)))
         return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", s->path);
     /* the priming's stand-in: the track's first frames, read and dropped */
-    for (size_t n; a->sent < (a->skip < a->frames ? a->skip : a->frames); a->sent += n) {
-        n = (a->skip < a->frames ? a->skip : a->frames) - a->sent;
-        n = n < a->chunk ? n : a->chunk;
+    size_t skip = a->skip < a->frames ? a->skip : a->frames;
+    while (a->sent < skip) {
+        size_t n = skip - a->sent < a->chunk ? skip - a->sent : a->chunk;
         if (!s->audio(s->audio_u, a->buf, n, err))
             return false;
+        a->sent += n;
     }
     a->frame->format = c->sample_fmt;
     a->frame->nb_samples = (int)a->chunk;

@@ -287,88 +287,6 @@ static size_t au_limiter_push(au_limiter *l, const float *in, size_t n, float *o
 
 /* ---- normalization: the plan, then the stream ---- */
 
-/* One read of the source from its start through gain g and, when limit,
- * the limiter at ceiling c into the meter. */
-static bool measure_pass(const au_source *src, float g, bool limit, double c, au_loudness *a, bool *limited, rs_err *err)
-{
-    enum { CH = 4800 };
-    float *buf = malloc((CH + AU_LIMITER_DELAY) * 2 * sizeof *buf * 2);
-    au_meter *m = au_meter_new(err);
-    au_limiter *l = limit ? au_limiter_new(src->frames, c) : NULL;
-    bool ok = false;
-    if (!buf || !m || (limit && !l)) {
-        if (m)
-            rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory");
-        goto done;
-    }
-    float *lim = buf + (CH + AU_LIMITER_DELAY) * 2;
-    if (!src->rewind(src->u, err))
-        goto done;
-    for (size_t at = 0; at < src->frames;) {
-        size_t n = src->frames - at < CH ? src->frames - at : CH;
-        if (!src->read(src->u, buf, n, err))
-            goto done;
-        at += n;
-        if (g != 1)
-            for (size_t i = 0; i < 2 * n; i++)
-                buf[i] *= g;
-        const float *x = buf;
-        size_t nx = n;
-        if (l) {
-            nx = au_limiter_push(l, buf, n, lim);
-            x = lim;
-        }
-        if (!au_meter_add(m, x, nx, err))
-            goto done;
-    }
-    ok = au_meter_result(m, a, err);
-    if (limited)
-        *limited = l && au_limiter_any(l);
-done:
-    free(buf);
-    au_meter_free(m);
-    au_limiter_free(l);
-    return ok;
-}
-
-bool au_norm_plan(const au_source *src, double target_lufs, double peak_dbtp, au_norm *plan, rs_err *err)
-{
-    memset(plan, 0, sizeof *plan);
-    if (!isfinite(target_lufs) || target_lufs < -70 || target_lufs > 0 || !isfinite(peak_dbtp) || peak_dbtp > 0 ||
-        peak_dbtp < -30)
-        return rs_fail(err, AU_ERR_ARG, "loudness: target %.1f LUFS, ceiling %.1f dBTP (expected -70..0 and -30..0)",
-                       target_lufs, peak_dbtp);
-    au_loudness b, a;
-    if (!measure_pass(src, 1, false, 0, &b, NULL, err))
-        return false;
-    plan->before = b;
-    a = b;
-    if (isfinite(b.integrated)) {
-        double gain_db = target_lufs - b.integrated, ceiling_db = peak_dbtp - MARGIN_DB;
-        for (int pass = 0; pass < 6; pass++) {
-            float g = (float)pow(10.0, gain_db / 20.0);
-            double c = pow(10.0, ceiling_db / 20.0);
-            bool limited;
-            if (!measure_pass(src, g, true, c, &a, &limited, err))
-                return false;
-            plan->on = true, plan->gain = g, plan->ceiling = c;
-            /* the limiter took loudness away: make it up (a few times at
-             * most: on programme that is all peaks it cannot be) */
-            bool peak_ok = a.true_peak <= peak_dbtp;
-            bool loud_ok = !limited || fabs(a.integrated - target_lufs) <= 0.2 || pass >= 3;
-            if (peak_ok && loud_ok)
-                break;
-            if (!peak_ok)
-                ceiling_db -= a.true_peak - peak_dbtp + 0.05;
-            if (!loud_ok)
-                gain_db += target_lufs - a.integrated;
-        }
-        plan->gain_db = target_lufs - b.integrated;
-    }
-    plan->after = a;
-    return true;
-}
-
 struct au_norm_stream {
     const au_source *src;
     au_norm plan;
@@ -447,6 +365,69 @@ void au_norm_stream_free(au_norm_stream *s)
     free(s->in);
     free(s->held);
     free(s);
+}
+
+/* One read of the source from its start through the plan's gain and
+ * limiter (the stream that gives the result) into the meter; limited: the
+ * limiter had anything to do. */
+static bool measure_pass(const au_source *src, const au_norm *p, au_loudness *a, bool *limited, rs_err *err)
+{
+    float *buf = malloc(SPIECE * 2 * sizeof *buf);
+    au_norm_stream *s = buf ? au_norm_stream_new(src, p, err) : NULL;
+    au_meter *m = s ? au_meter_new(err) : NULL;
+    if (!buf)
+        rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory");
+    bool ok = m != NULL;
+    for (size_t at = 0; ok && at < src->frames;) {
+        size_t n = src->frames - at < SPIECE ? src->frames - at : SPIECE;
+        ok = au_norm_stream_read(s, buf, n, err) && au_meter_add(m, buf, n, err);
+        at += n;
+    }
+    ok = ok && au_meter_result(m, a, err);
+    if (ok && limited)
+        *limited = s->l && au_limiter_any(s->l);
+    au_meter_free(m);
+    au_norm_stream_free(s);
+    free(buf);
+    return ok;
+}
+
+bool au_norm_plan(const au_source *src, double target_lufs, double peak_dbtp, au_norm *plan, rs_err *err)
+{
+    memset(plan, 0, sizeof *plan);
+    if (!isfinite(target_lufs) || target_lufs < -70 || target_lufs > 0 || !isfinite(peak_dbtp) || peak_dbtp > 0 ||
+        peak_dbtp < -30)
+        return rs_fail(err, AU_ERR_ARG, "loudness: target %.1f LUFS, ceiling %.1f dBTP (expected -70..0 and -30..0)",
+                       target_lufs, peak_dbtp);
+    au_loudness b, a;
+    if (!measure_pass(src, &(au_norm){.on = false}, &b, NULL, err))
+        return false;
+    plan->before = b;
+    a = b;
+    if (isfinite(b.integrated)) {
+        double gain_db = target_lufs - b.integrated, ceiling_db = peak_dbtp - MARGIN_DB;
+        for (int pass = 0; pass < 6; pass++) {
+            float g = (float)pow(10.0, gain_db / 20.0);
+            double c = pow(10.0, ceiling_db / 20.0);
+            bool limited;
+            if (!measure_pass(src, &(au_norm){.on = true, .gain = g, .ceiling = c}, &a, &limited, err))
+                return false;
+            plan->on = true, plan->gain = g, plan->ceiling = c;
+            /* the limiter took loudness away: make it up (a few times at
+             * most: on programme that is all peaks it cannot be) */
+            bool peak_ok = a.true_peak <= peak_dbtp;
+            bool loud_ok = !limited || fabs(a.integrated - target_lufs) <= 0.2 || pass >= 3;
+            if (peak_ok && loud_ok)
+                break;
+            if (!peak_ok)
+                ceiling_db -= a.true_peak - peak_dbtp + 0.05;
+            if (!loud_ok)
+                gain_db += target_lufs - a.integrated;
+        }
+        plan->gain_db = target_lufs - b.integrated;
+    }
+    plan->after = a;
+    return true;
 }
 
 /* ---- a buffer normalized in place, through the same stream ---- */

@@ -211,7 +211,7 @@ au_wav *au_wav_open(const char *path, bool float32, rs_err *err)
 
 au_wav *au_wav_open_known(const char *path, bool float32, size_t frames, rs_err *err)
 {
-    return wav_open(path, float32, frames ? frames : 0, err);
+    return wav_open(path, float32, frames, err);
 }
 
 bool au_wav_append(au_wav *w, const float *pcm, size_t frames, rs_err *err)
