@@ -468,10 +468,25 @@ static void bad_segments(svc_daemon *d, worker *w)
     count(d, &d->jobs_retried);
 }
 
+/* The child's progress so far, and the frames it drew since the last read
+ * into the daemon's count (a join copies frames, it draws none): on every
+ * tend and once more when it exits, so the last frames, reported just
+ * before the exit, count too */
+static void take_progress(svc_daemon *d, worker *w)
+{
+    int64_t before = w->done;
+    read_child(d, w);
+    if (w->done > before && w->job.unit.kind != SVC_UNIT_JOIN) {
+        pthread_mutex_lock(&d->mu);
+        d->frames_rendered += (uint64_t)(w->done - before);
+        pthread_mutex_unlock(&d->mu);
+    }
+}
+
 /* A child ended: decide what its unit (and so its job) becomes. */
 static void on_exit_status(svc_daemon *d, worker *w, int status)
 {
-    read_child(d, w);
+    take_progress(d, w);
     svc_job *j = &w->job;
     int kind = j->unit.kind;
     rs_err err = {0};
@@ -565,13 +580,7 @@ out:
 /* Heartbeat, fps, watchdog for one busy worker. */
 static void tend(svc_daemon *d, worker *w, double now)
 {
-    int64_t before = w->done;
-    read_child(d, w);
-    if (w->done > before && w->job.unit.kind != SVC_UNIT_JOIN) { /* a join copies frames, it draws none */
-        pthread_mutex_lock(&d->mu);
-        d->frames_rendered += (uint64_t)(w->done - before);
-        pthread_mutex_unlock(&d->mu);
-    }
+    take_progress(d, w);
     if (now - w->fps_t0 >= 1.0) {
         /* smoothed over a few seconds, so the ETA does not jump about */
         double f = (double)(w->done - w->fps_d0) / (now - w->fps_t0);
