@@ -99,7 +99,7 @@ check-layers:
 	@tools/check-layers.sh
 	@tools/check-length.sh
 
-.PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
+.PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run fuzz-run-wire man
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -161,9 +161,17 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 	@mkdir -p $(dir $@)
 	$(CC) $(filter-out -O% -MMD -MP,$(CFLAGS)) $(subst simhash-,-,$(notdir $@)) $(LDFLAGS) -o $@ $(SIM_SRC) -lm
 
-# libFuzzer on the replay reader (clang; not part of make test)
+# libFuzzer on the replay reader and the raw request check (clang; not part of make test)
 FUZZ_SECONDS ?= 600
-fuzz: build/fuzz/fuzz_replay
+fuzz: build/fuzz/fuzz_replay build/fuzz/fuzz_wire
+build/fuzz/fuzz_wire: tests/fuzz_wire.c service/svc_wire.c service/svc_wire.h
+	@mkdir -p build/fuzz
+	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
+	    -o $@ tests/fuzz_wire.c service/svc_wire.c
+fuzz-run-wire: build/fuzz/fuzz_wire
+	@mkdir -p build/fuzz/corpus-wire
+	cp tests/fuzz/wire/* build/fuzz/corpus-wire/
+	build/fuzz/fuzz_wire -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -print_final_stats=1 build/fuzz/corpus-wire
 build/fuzz/fuzz_replay: tests/fuzz_replay.c $(SIM_SRC)
 	@mkdir -p build/fuzz
 	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer,address,undefined \

@@ -19,6 +19,7 @@
 #include "../service/svc_json.h"
 #include "../service/svc_local.h"
 #include "../service/svc_upload.h"
+#include "../service/svc_wire.h"
 #if defined(RS_HAVE_MHD)
 #include "../service/svc_http_local.h"
 #endif
@@ -1264,6 +1265,163 @@ static void t_config_error_ids(void)
     T_ASSERT(!svc_config_load(&c, path, &e) && e.code == SVC_CONFIG_ERR_SYNTAX);
 }
 
+/* --- the raw bytes of requests (svc_wire) --- */
+
+typedef struct wire_case {
+    const char *bytes;
+    size_t n; /* 0: strlen */
+    int status;
+    const char *why; /* a part of the reason (NULL: not checked) */
+} wire_case;
+
+#define GOOD_HEAD "Host: a\r\n\r\n"
+static const wire_case wire_cases[] = {
+    {"GET / HTTP/1.1\r\n" GOOD_HEAD, 0, 0, NULL},
+    {"GET /jobs/1?x=%00 HTTP/1.0\r\n" GOOD_HEAD, 0, 0, NULL}, /* escapes are the gate's */
+    {"OPTIONS * HTTP/1.1\r\n" GOOD_HEAD, 0, 0, NULL},
+    {"\r\nGET / HTTP/1.1\r\n" GOOD_HEAD, 0, 0, NULL}, /* an empty line before is ignored */
+    {"GET /\xc3\xa9 HTTP/1.1\r\nX-A: \t caf\xc3\xa9\t\r\n" GOOD_HEAD, 0, 0, NULL},
+    {"POST /jobs HTTP/1.1\r\nContent-Length: 3\r\n\r\n\0\r\nGET / HTTP/1.1\r\n" GOOD_HEAD, 42, 0, NULL},
+    {"POST /jobs HTTP/1.1\r\nTransfer-Encoding: Chunked \r\n\r\n3;x=1\r\n\0\0\0\r\n0\r\nT: 1\r\n\r\n", 0, 0, NULL},
+    /* the issue's four, and their neighbours */
+    {"GET /jobs/1\0/video HTTP/1.1\r\n" GOOD_HEAD, 35, 400, "raw control byte 0x00 in the request target"},
+    {"GET /jobs/ 1 HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "a space inside the target"},
+    {"POST /jobs HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\nabc", 0, 413, "max_upload"},
+    {"POST /jobs HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n00000000000000001\r\n", 0, 400, "16 hex digits"},
+    {"POST /jobs HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\nzz\r\n", 0, 400, "not hexadecimal"},
+    {"POST /jobs HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n3\r\nabcd\r\n", 0, 400, "longer than its size"},
+    {"GET /a\x7f HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "0x7f"},
+    {"GET /a\r HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "no HTTP version"},
+    {"GET /a\tb HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "0x09 in the request target"},
+    {"GET http://a/ HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "origin form"},
+    {"GET a HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "origin form"},
+    {"GET *x HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "origin form"},
+    {"GET  / HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "METHOD TARGET"},
+    {"GET / HTTP/1.1 \r\n" GOOD_HEAD, 0, 400, "METHOD TARGET"},
+    {"GET / HTTP/2.0\r\n" GOOD_HEAD, 0, 505, "HTTP/2.0 is not supported"},
+    {"GET / HTTP/1.2\r\n" GOOD_HEAD, 0, 505, "HTTP/1.2"},
+    {"GET / HTTP/0.9\r\n" GOOD_HEAD, 0, 505, NULL},
+    {"GET / http/1.1\r\n" GOOD_HEAD, 0, 400, "METHOD TARGET"},
+    {"GET / HTTP/1.1\n" GOOD_HEAD, 0, 400, "LF without CR"},
+    {"GET / HTTP/1.1\r\nHost: a\n\r\n", 0, 400, "LF without CR"},
+    {"GET / HTTP/1.1\r\nHost: a\r\n\n", 0, 400, "LF without CR"},
+    {"GET / HTTP/1.1\r\nX-A: a\rb\r\n" GOOD_HEAD, 0, 400, "CR that does not end a line"},
+    {"GET / HTTP/1.1\r\nX-A: a\0b\r\n" GOOD_HEAD, 29, 400, "0x00 in a header value"},
+    {"GET / HTTP/1.1\r\nX-A: a\001b\r\n" GOOD_HEAD, 0, 400, "0x01 in a header value"},
+    {"GET / HTTP/1.1\r\nX-\001: a\r\n" GOOD_HEAD, 0, 400, "0x01 in a header"},
+    {"GET / HTTP/1.1\r\nX-A: a\r\n b\r\n" GOOD_HEAD, 0, 400, "folding"},
+    {"GET / HTTP/1.1\r\nX-A : a\r\n" GOOD_HEAD, 0, 400, "its colon"},
+    {"GET / HTTP/1.1\r\n: a\r\n" GOOD_HEAD, 0, 400, "empty name"},
+    {"GE\x01T / HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "0x01"},
+    {"G(T / HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "not a token"},
+    {"/ HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "begin with a method"},
+    {"GET / HTTP/1.1\r\nContent-Length: 1x\r\n\r\n", 0, 400, "not a number"},
+    {"GET / HTTP/1.1\r\nContent-Length: 1, 1\r\n\r\n", 0, 400, "not a number"},
+    {"GET / HTTP/1.1\r\nContent-Length: 12345678901234567890123\r\n\r\n", 0, 400, "not a number"},
+    {"GET / HTTP/1.1\r\nContent-Length: 1\r\nContent-Length: 1\r\n\r\n", 0, 400, "two Content-Length"},
+    {"POST / HTTP/1.1\r\nContent-Length: 1\r\nTransfer-Encoding: chunked\r\n\r\n", 0, 400, "both"},
+    {"POST / HTTP/1.1\r\nTransfer-Encoding: gzip\r\n\r\n", 0, 501, "'gzip': only chunked"},
+    {"POST / HTTP/1.1\r\nTransfer-Encoding: gzip, chunked\r\n\r\n", 0, 501, NULL},
+    {"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\nTransfer-Encoding: chunked\r\n\r\n", 0, 501, NULL},
+    {"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n1\r\na\r\n0\r\nX: \001\r\n\r\n", 0, 400, "0x01"},
+    /* a smuggled second request, its control byte found too */
+    {"POST / HTTP/1.1\r\nContent-Length: 2\r\n\r\nabGET /\001 HTTP/1.1\r\n" GOOD_HEAD, 0, 400, "0x01"},
+};
+
+static int wire_run(const wire_case *c, uint64_t max, size_t piece, svc_wire *w)
+{
+    size_t n = c->n ? c->n : strlen(c->bytes);
+    svc_wire_init(w, max);
+    int st = 0;
+    for (size_t i = 0; i < n && !st; i += piece)
+        st = svc_wire_feed(w, c->bytes + i, n - i < piece ? n - i : piece);
+    return st;
+}
+
+static void t_wire_cases(void)
+{
+    for (size_t i = 0; i < sizeof wire_cases / sizeof *wire_cases; i++) {
+        const wire_case *c = &wire_cases[i];
+        svc_wire w, one;
+        int st = wire_run(c, 1 << 20, (size_t)-1, &w);
+        T_ASSERTF(st == c->status, "case %zu (%.40s): %d (%s), want %d", i, c->bytes, st, w.why, c->status);
+        T_ASSERTF(!c->why || strstr(w.why, c->why), "case %zu: '%s' does not say '%s'", i, w.why, c->why);
+        /* the same verdict, word for word, whatever the pieces */
+        for (size_t piece = 1; piece <= 7; piece++) {
+            int s1 = wire_run(c, 1 << 20, piece, &one);
+            T_ASSERTF(s1 == st && !strcmp(one.why, w.why), "case %zu in pieces of %zu: %d '%s', whole %d '%s'", i,
+                      piece, s1, one.why, st, w.why);
+        }
+    }
+    /* a verdict stays */
+    svc_wire w;
+    svc_wire_init(&w, 0);
+    T_EQ(svc_wire_feed(&w, "GET /\001", 6), 400);
+    T_EQ(svc_wire_feed(&w, " HTTP/1.1\r\n\r\n", 13), 400);
+    T_ASSERT(!strcmp(svc_wire_phrase(505), "HTTP Version Not Supported"));
+}
+
+/* Requests are counted as they end, chunked bodies against max_body. */
+static void t_wire_framing(void)
+{
+    svc_wire w;
+    svc_wire_init(&w, 10);
+    const char *two = "GET / HTTP/1.1\r\nHost: a\r\n\r\nPOST /jobs HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n"
+                      "4\r\nabcd\r\n6\r\nabcdef\r\n0\r\n\r\n";
+    T_EQ(svc_wire_feed(&w, two, strlen(two)), 0);
+    T_EQ((int)w.requests, 2);
+    /* 11 bytes in chunks, one past max_body: refused at the size, before its data */
+    const char *over = "POST /jobs HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n4\r\nabcd\r\n7\r\n";
+    T_EQ(svc_wire_feed(&w, over, strlen(over)), 413);
+    T_EQ((int)w.requests, 2); /* the third request is the refused one */
+    /* Content-Length bodies are the handler's to limit: not counted here */
+    svc_wire_init(&w, 10);
+    const char *cl = "POST /jobs HTTP/1.1\r\nContent-Length: 20\r\n\r\n01234567890123456789";
+    T_EQ(svc_wire_feed(&w, cl, strlen(cl)), 0);
+    T_EQ((int)w.requests, 1);
+    /* no limit: a chunk of 2^64 - 1 bytes is framing like any other */
+    svc_wire_init(&w, 0);
+    const char *big = "POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\nabc";
+    T_EQ(svc_wire_feed(&w, big, strlen(big)), 0);
+}
+
+/* Random bytes and random edits of good requests: a verdict of the four
+ * statuses or none, never a crash (ASan and UBSan watch), the same verdict
+ * in any pieces. */
+static void t_wire_random(void)
+{
+    static const char *const good[] = {
+        "GET /jobs?limit=5 HTTP/1.1\r\nHost: a\r\nAuthorization: Bearer x\r\n\r\n",
+        "POST /jobs HTTP/1.1\r\nHost: a\r\nTransfer-Encoding: chunked\r\n\r\n5\r\nabcde\r\n0\r\n\r\n",
+        "POST /jobs HTTP/1.1\r\nHost: a\r\nContent-Length: 4\r\n\r\nabcd",
+    };
+    char buf[256];
+    int seen[4] = {0};
+    for (int it = 0; it < 20000; it++) {
+        const char *g = good[rnd() % 3];
+        size_t n = strlen(g);
+        memcpy(buf, g, n);
+        if (it % 4 == 0) {
+            n = 1 + rnd() % 64;
+            for (size_t i = 0; i < n; i++)
+                buf[i] = (char)rnd();
+        } else
+            for (int e = 1 + (int)(rnd() % 3); e > 0; e--)
+                buf[rnd() % n] = (char)"\0\r\n \t:;/*%0fF\x7f\x80"[rnd() % 16];
+        wire_case c = {buf, n, 0, NULL};
+        svc_wire w, p;
+        int st = wire_run(&c, 1 << 16, (size_t)-1, &w);
+        T_ASSERTF(st == 0 || st == 400 || st == 413 || st == 501 || st == 505, "status %d", st);
+        T_ASSERTF(!st == !w.why[0], "status %d with reason '%s'", st, w.why);
+        seen[st == 0 ? 0 : st == 400 ? 1 : st == 505 ? 2 : 3]++;
+        int sp = wire_run(&c, 1 << 16, 1 + rnd() % 9, &p);
+        T_ASSERTF(sp == st && !strcmp(p.why, w.why), "iteration %d: %d '%s' in pieces, %d '%s' whole", it, sp, p.why,
+                  st, w.why);
+    }
+    /* the edits reach both sides of the grammar */
+    T_ASSERTF(seen[0] > 100 && seen[1] > 100, "good %d, 400 %d", seen[0], seen[1]);
+}
+
 T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t_tokens_and_bearer},
        {"config_defaults", t_config_defaults}, {"config_data_default", t_config_data_default}, {"config_set", t_config_set}, {"config_lengths", t_config_lengths},
        {"config_listen_bare_ipv6", t_config_listen_bare_ipv6}, {"config_load_good", t_config_load_good},
@@ -1277,4 +1435,5 @@ T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t
        {"upload_verified", t_upload_verified},
        {"http_status_table", t_http_status_table}, {"encode_options", t_encode_options},
        {"route_table", t_route_table}, {"upload_params", t_upload_params},
-       {"config_error_ids", t_config_error_ids})
+       {"config_error_ids", t_config_error_ids}, {"wire_cases", t_wire_cases}, {"wire_framing", t_wire_framing},
+       {"wire_random", t_wire_random})
