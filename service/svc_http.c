@@ -110,7 +110,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     (void)version;
     svc_daemon *d = cls;
     req *q = *con_cls; /* made by http_gate_uri */
-    if (!q)
+    if (!q || http_guard_refused(c)) /* the guard answered its raw bytes (svc_wire) */
         return MHD_NO;
     if (!q->started)
         return begin(d, c, q, url, method);
@@ -128,6 +128,7 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls, en
     (void)toe;
     svc_daemon *d = cls;
     http_guard_phase(d->net, c, NET_HEADERS); /* a keep-alive connection's next request */
+    http_guard_completed(c);
     req *q = *con_cls;
     if (!q)
         return;

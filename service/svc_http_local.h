@@ -1,7 +1,9 @@
 /* svc_http_local.h: what the files of the HTTP layer share.  Private to
  * them (the rest of service/ sees svc_http_start/stop in svc_local.h).
  *
- * A request passes fixed phases, in this order (svc_http.c runs them):
+ * Before libmicrohttpd parses a byte, the guard checks it (svc_http_recv.c
+ * hands it over, svc_wire.c is the grammar) and answers a refusal itself.
+ * A request then passes fixed phases, in this order (svc_http.c runs them):
  *   1. gate      svc_http_gate.c   the request's form: control characters,
  *                                  header syntax, Host, transfer coding,
  *                                  Origin (CORS), the query parameters its
@@ -23,6 +25,7 @@
 #include "svc_json.h"
 #include "svc_local.h"
 #include "svc_upload.h"
+#include "svc_wire.h"
 
 typedef struct req req;
 typedef enum MHD_Result (*svc_handler)(svc_daemon *d, struct MHD_Connection *c, req *q);
@@ -106,7 +109,7 @@ enum MHD_Result http_send_file(struct MHD_Connection *c, int fd, uint64_t len, c
 /* --- the connection guard (svc_http_guard.c) --- */
 
 enum { NET_HEADERS, NET_BODY, NET_ANSWER }; /* a connection's phase */
-enum { CUT_HEADER_TIMEOUT, CUT_BODY_RATE, CUT_MAX_UPLOAD, NET_NCUTS };
+enum { CUT_HEADER_TIMEOUT, CUT_BODY_RATE, CUT_MAX_UPLOAD, CUT_MALFORMED, NET_NCUTS };
 
 typedef struct net_conn {
     struct net_conn *prev, *next;
@@ -118,7 +121,16 @@ typedef struct net_conn {
     bool cut;       /* shut down by the reaper */
     char cors[256]; /* the Origin to answer with CORS headers ("" none) */
     bool vary;      /* answers depend on Origin (cors_origins is set) */
+    struct svc_net *net;
+    /* the raw bytes (svc_http_recv.c), checked by the MHD thread that reads them */
+    svc_wire w;
+    uint32_t done;  /* requests libmicrohttpd has finished on it (on_completed) */
+    bool answering; /* a response is queued for the request in progress */
+    bool pending;   /* w refused a request libmicrohttpd has not reached yet */
+    bool refused;   /* answered by the guard: libmicrohttpd's reads fail, requests get MHD_NO */
 } net_conn;
+
+typedef struct net_linger net_linger;
 
 struct svc_net {
     svc_daemon *d;
@@ -132,6 +144,13 @@ struct svc_net {
     pthread_t reaper;
     bool reaper_started;
     char hosts[1024];   /* accepted Host names, comma-separated, lower case (the gate's) */
+    /* refused connections read to their end before they close (lingering) */
+    int linger_ep;      /* epoll of their descriptors (-1: none) */
+    net_linger *lingers;
+    long lingering;
+    uint64_t linger_full; /* closed at once: LINGER_MAX were lingering */
+    pthread_t linger_thread;
+    bool linger_started;
 };
 
 svc_net *http_guard_new(svc_daemon *d);
@@ -152,6 +171,11 @@ bool http_guard_reserve(svc_net *n, req *q, long bytes);
 void http_guard_release(svc_net *n, req *q);
 /* An upload past max_upload: a 413 written to the socket, the connection closed. */
 enum MHD_Result http_guard_cut_oversize(svc_daemon *d, struct MHD_Connection *c, req *q);
+/* A response is queued on c (http_queue); a request on c is finished (on_completed). */
+void http_guard_answering(struct MHD_Connection *c);
+void http_guard_completed(struct MHD_Connection *c);
+/* Whether the guard has answered and refused c: every call on it is MHD_NO. */
+bool http_guard_refused(struct MHD_Connection *c);
 void http_guard_metrics(svc_net *n, svc_buf *b);
 /* max_connections within the open-file limit (raised toward the hard one). */
 unsigned http_guard_connection_limit(const svc_config *cfg);

@@ -91,7 +91,10 @@ enum MHD_Result http_queue(struct MHD_Connection *c, unsigned status, struct MHD
     }
     if (nc && nc->vary)
         MHD_add_response_header(r, "Vary", "Origin");
-    return MHD_queue_response(c, status, r);
+    enum MHD_Result ret = MHD_queue_response(c, status, r);
+    if (ret == MHD_YES)
+        http_guard_answering(c);
+    return ret;
 }
 
 /* A body answer, never cached; h one more header (NULL: none). */

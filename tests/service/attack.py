@@ -13,6 +13,11 @@ figures in docs/service.md, "On a network").  Loopback only.
       an endless chunked POST /jobs; prints "sent BYTES status CODE"
   attack.py raw PORT [--timeout S] < REQUEST
       sends the bytes of stdin as they are; prints the status line's code
+  attack.py linger PORT [--token T] [--after BYTES]
+      an endless chunked POST /jobs that goes on sending BYTES after the
+      answer begins to arrive (as a client's bytes in flight do), then
+      reads it; prints "status CODE end clean|reset sent BYTES": clean when
+      every byte was taken and the answer ended with the connection's end
   attack.py rps PORT [--clients C] [--seconds T]
       keep-alive GET /healthz loops; prints "rps R"
 """
@@ -143,6 +148,42 @@ def cmd_raw(a):
         print(0)
 
 
+def cmd_linger(a):
+    import select
+    s = connect(a.port, None)
+    auth = ('Authorization: Bearer %s\r\n' % a.token).encode() if a.token else b''
+    s.sendall(b'POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\n' + auth +
+              b'Transfer-Encoding: chunked\r\nContent-Type: application/octet-stream\r\n\r\n')
+    chunk = b'4000\r\n' + b'\0' * 0x4000 + b'\r\n'
+    sent, answered, end, reset = 0, None, time.time() + 10, False
+    s.settimeout(1)
+    while time.time() < end:
+        if answered is None and select.select([s], [], [], 0)[0]:
+            answered = sent
+        if answered is not None and sent - answered >= a.after:
+            break
+        try:
+            s.sendall(chunk)
+            sent += len(chunk)
+        except OSError:
+            reset = True
+            break
+    data = b''
+    try:
+        s.shutdown(socket.SHUT_WR)
+        s.settimeout(5)
+        while True:
+            b = s.recv(65536)
+            if not b:
+                break
+            data += b
+    except OSError:
+        reset = True
+    parts = data.split(b' ', 2)
+    code = int(parts[1]) if len(parts) > 1 and parts[1].isdigit() else 0
+    print('status %d end %s sent %d' % (code, 'reset' if reset else 'clean', sent))
+
+
 def cmd_rps(a):
     counts = [0] * a.clients
     end = time.time() + a.seconds
@@ -201,12 +242,17 @@ def main():
     r = sub.add_parser('raw')
     r.add_argument('port', type=int)
     r.add_argument('--timeout', type=float, default=5)
+    g = sub.add_parser('linger')
+    g.add_argument('port', type=int)
+    g.add_argument('--token')
+    g.add_argument('--after', type=int, default=1 << 20)
     q = sub.add_parser('rps')
     q.add_argument('port', type=int)
     q.add_argument('--clients', type=int, default=4)
     q.add_argument('--seconds', type=float, default=5)
     a = p.parse_args()
-    {'hold': cmd_hold, 'latency': cmd_latency, 'chunked': cmd_chunked, 'raw': cmd_raw, 'rps': cmd_rps}[a.cmd](a)
+    {'hold': cmd_hold, 'latency': cmd_latency, 'chunked': cmd_chunked, 'raw': cmd_raw, 'linger': cmd_linger,
+     'rps': cmd_rps}[a.cmd](a)
 
 
 if __name__ == '__main__':

@@ -76,13 +76,17 @@ t_header_timeout_cuts_slow_and_idle() {
     [ "$(code_of "$SVC_URL/healthz")" = 200 ] || return 1
 }
 
+# A client that never stops sending, answer or not: refused at max_upload,
+# then read by the lingering close for at most 64 MiB (LINGER_BYTES,
+# svc_http_guard.c) and 10 s, then cut: with both ends' socket buffers
+# (tens of MiB on loopback), well under 128 MiB sent.
 t_endless_chunked_upload_cut_at_max_upload() {
     svc_start d --max-upload 64K || return 1
     r=$($ATTACK chunked "$(port_of)" --seconds 5)
     echo "$r"
     set -- $r
     [ "$4" = 413 ] || { echo "no 413 for an endless chunked upload"; return 1; }
-    [ "$2" -lt $((16 << 20)) ] || { echo "$2 bytes sent before the cut"; return 1; }
+    [ "$2" -lt $((128 << 20)) ] || { echo "$2 bytes sent before the cut"; return 1; }
     [ "$(metric 'ringside_http_connections_cut_total{reason="max_upload"}')" = 1 ] || return 1
     [ "$(code_of "$SVC_URL/healthz")" = 200 ] || return 1
 }
@@ -119,31 +123,125 @@ t_upload_memory_full_is_503() {
     [ "$code" = 400 ] || { echo "after the release: $code $(cat resp.txt)"; return 1; }
 }
 
+# Every malformed request carries a valid Host and token, so each reaches
+# the check it names (before, the Host check answered 421 first and hid
+# what the parser did); the raw bytes are checked before libmicrohttpd
+# parses them (service/svc_wire.c), the rest by the gate.
 t_malformed_requests() {
     "$RS_BIN" record --ai --quiet --seconds 1 --seed 3 -o good.rsr || return 1
+    mkdir -p d
+    tok=$("$RS_BIN" serve token add ops --operator --data d 2>add.err) || { cat add.err; return 1; }
     svc_start d || return 1
     port=$(port_of)
+    ok="Host: 127.0.0.1\r\nAuthorization: Bearer $tok\r\n"
     raw() { printf "$1" | $ATTACK raw "$port" --timeout 5; }
     want() { # CODE WHAT GOT
         [ "$3" = "$1" ] || { echo "$2: HTTP $3, want $1 $(cat resp.txt 2>/dev/null)"; return 1; }
     }
-    want 501 "Transfer-Encoding: gzip" "$(raw 'POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nTransfer-Encoding: gzip\r\n\r\nabc')" || return 1
-    want 400 "%00 in the path" "$(code_of "$SVC_URL/jobs/1%00")" || return 1
-    want 400 "%00 in the query" "$(code_of --data-binary @good.rsr "$SVC_URL/jobs?format=mp4%00")" || return 1
-    want 400 "%1f in the query" "$(code_of "$SVC_URL/jobs?limit=1%1f")" || return 1
-    want 400 "HTTP/1.1 without Host" "$(raw 'GET /healthz HTTP/1.1\r\n\r\n')" || return 1
-    want 400 "a space before a colon" "$(raw 'GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\nX-A : b\r\n\r\n')" || return 1
-    want 400 "?sise=1" "$(code_of --data-binary @good.rsr "$SVC_URL/jobs?sise=1")" || return 1
+    # the token is right: a well-formed request with it is answered
+    want 200 "GET /jobs with the token" "$(raw "GET /jobs HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 401 "GET /jobs without it" "$(raw 'GET /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n')" || return 1
+    # a job to be asked for: a NUL cut path would find it
+    code=$(curl -s -o resp.txt -w '%{http_code}' -H "Authorization: Bearer $tok" --data-binary @good.rsr \
+        "$SVC_URL/jobs?size=160x90")
+    want 201 "the upload" "$code" || return 1
+    # raw bytes: control characters, the request line's form, the version
+    want 400 "a raw NUL in the target" "$(raw "GET /jobs/1\0/video HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 400 "a raw NUL ending the target" "$(raw "GET /jobs/1\0 HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 400 "a space in the target" "$(raw "GET /jobs/ 1 HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 400 "a tab in the target" "$(raw "GET /jobs/\t1 HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 400 "DEL in the target" "$(raw "GET /jobs\177 HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 400 "an absolute-form target" "$(raw "GET http://127.0.0.1/jobs HTTP/1.1\r\n$ok\r\n")" || return 1
+    want 505 "HTTP/2.0" "$(raw "GET /jobs HTTP/2.0\r\n$ok\r\n")" || return 1
+    want 505 "HTTP/1.2" "$(raw "GET /jobs HTTP/1.2\r\n$ok\r\n")" || return 1
+    want 400 "a bare LF" "$(raw "GET /jobs HTTP/1.1\n$ok\r\n")" || return 1
+    want 400 "a NUL in a header value" "$(raw "GET /jobs HTTP/1.1\r\n${ok}X-A: a\0b\r\n\r\n")" || return 1
+    want 400 "a control byte in a header value" "$(raw "GET /jobs HTTP/1.1\r\n${ok}X-A: a\001b\r\n\r\n")" || return 1
+    want 400 "a bare CR in a header value" "$(raw "GET /jobs HTTP/1.1\r\n${ok}X-A: a\rb\r\n\r\n")" || return 1
+    want 400 "obsolete line folding" "$(raw "GET /jobs HTTP/1.1\r\n${ok}X-A: a\r\n b\r\n\r\n")" || return 1
+    want 400 "a space before a colon" "$(raw "GET /jobs HTTP/1.1\r\n${ok}X-A : b\r\n\r\n")" || return 1
+    want 400 "Content-Length and chunked" \
+        "$(raw "POST /jobs HTTP/1.1\r\n${ok}Content-Length: 3\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n")" || return 1
+    want 501 "Transfer-Encoding: gzip" "$(raw "POST /jobs HTTP/1.1\r\n${ok}Transfer-Encoding: gzip\r\n\r\nabc")" || return 1
+    # the answer says why, and the log names the client and the reason
+    printf "GET /jobs/1\0/video HTTP/1.1\r\n$ok\r\n" | $ATTACK raw "$port" --timeout 5 >/dev/null
+    grep -q 'refused (400): a raw control byte 0x00 in the request target' d.log || { tail -5 d.log; return 1; }
+    # chunk sizes: answered at once, not when the connection's deadline ends it
+    t0=$(date +%s%N)
+    want 413 "a chunk of 2^64 - 1 bytes" \
+        "$(raw "POST /jobs HTTP/1.1\r\n${ok}Transfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\nabc")" || return 1
+    ms=$((($(date +%s%N) - t0) / 1000000))
+    [ "$ms" -lt 3000 ] || { echo "the 413 took $ms ms"; return 1; }
+    want 400 "a chunk size of 17 digits" \
+        "$(raw "POST /jobs HTTP/1.1\r\n${ok}Transfer-Encoding: chunked\r\n\r\n00000000000000001\r\nabc")" || return 1
+    want 400 "a chunk size in letters" "$(raw "POST /jobs HTTP/1.1\r\n${ok}Transfer-Encoding: chunked\r\n\r\nzz\r\n")" || return 1
+    # a smuggled request after a body, and one pipelined after a good one:
+    # the good one is answered, the bad one refused
+    want 400 "a request hidden in a body" \
+        "$(raw "POST /jobs HTTP/1.1\r\n${ok}Content-Length: 2\r\n\r\nabGET /\001 HTTP/1.1\r\n$ok\r\n")" || return 1
+    printf "GET /healthz HTTP/1.1\r\n$ok\r\nGET /jobs/1\0 HTTP/1.1\r\n$ok\r\n" |
+        python3 -c 'import re, socket, sys
+s = socket.create_connection(("127.0.0.1", int(sys.argv[1])))
+s.sendall(sys.stdin.buffer.read())
+s.settimeout(5)
+d = b""
+while True:
+    b = s.recv(65536)
+    if not b:
+        break
+    d += b
+print(" ".join(c.decode() for c in re.findall(rb"HTTP/1\.1 (\d{3}) ", d)))' "$port" >pipe.txt
+    [ "$(cat pipe.txt)" = "200 400" ] || { echo "pipelined: $(cat pipe.txt), want 200 400"; return 1; }
+    # the gate's own checks, on what libmicrohttpd decoded
+    want 400 "%00 in the path" "$(code_of -H "Authorization: Bearer $tok" "$SVC_URL/jobs/1%00")" || return 1
+    want 400 "%00 in the query" \
+        "$(code_of -H "Authorization: Bearer $tok" --data-binary @good.rsr "$SVC_URL/jobs?format=mp4%00")" || return 1
+    want 400 "%1f in the query" "$(code_of -H "Authorization: Bearer $tok" "$SVC_URL/jobs?limit=1%1f")" || return 1
+    want 400 "HTTP/1.1 without Host" "$(raw "GET /jobs HTTP/1.1\r\nAuthorization: Bearer $tok\r\n\r\n")" || return 1
+    want 400 "?sise=1" "$(code_of -H "Authorization: Bearer $tok" --data-binary @good.rsr "$SVC_URL/jobs?sise=1")" || return 1
     grep -q "unknown query parameter sise" resp.txt || { cat resp.txt; return 1; }
     want 400 "/healthz?x=1" "$(code_of "$SVC_URL/healthz?x=1")" || return 1
-    # a chunk size of 2^64-1 ends with the header deadline's cousin, the body rate
-    r=$(raw 'POST /jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nTransfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\nabc')
-    [ "$r" != "" ] || return 1
+    n=$(curl -s -H "Authorization: Bearer $tok" "$SVC_URL/metrics" |
+        awk '$1 == "ringside_http_connections_cut_total{reason=\"malformed\"}" { print $2 }')
+    [ "$n" -ge 18 ] || { echo "malformed cuts: $n, want >= 18"; return 1; }
     # what is well formed still works
-    want 200 "GET /jobs?limit=5" "$(code_of "$SVC_URL/jobs?limit=5")" || return 1
+    want 200 "GET /jobs?limit=5" "$(code_of -H "Authorization: Bearer $tok" "$SVC_URL/jobs?limit=5")" || return 1
     want 201 "POST /jobs?size=160x90&format=webm&name=x" \
-        "$(code_of --data-binary @good.rsr "$SVC_URL/jobs?size=160x90&format=webm&name=x.rsr")" || return 1
+        "$(code_of -H "Authorization: Bearer $tok" --data-binary @good.rsr "$SVC_URL/jobs?size=160x90&format=webm&name=x.rsr")" || return 1
+    want 201 "a chunked upload" "$(code_of -H "Authorization: Bearer $tok" -H 'Transfer-Encoding: chunked' \
+        --data-binary @good.rsr "$SVC_URL/jobs?size=160x90")" || return 1
     want 200 "healthz" "$(code_of "$SVC_URL/healthz")" || return 1
+}
+
+# A refused upload's client still has bytes in flight when the answer
+# comes: the daemon reads them (a lingering close) so the client reads the
+# answer, where closing at once sent a reset that could overtake it.
+t_refused_upload_lingers() {
+    mkdir -p d
+    tok=$("$RS_BIN" serve token add ops --operator --data d 2>add.err) || { cat add.err; return 1; }
+    svc_start d --max-upload 64K || return 1
+    for i in 1 2 3; do
+        r=$($ATTACK linger "$(port_of)" --token "$tok")
+        echo "$r"
+        case "$r" in "status 413 end clean "*) ;; *) return 1 ;; esac
+    done
+    # 40 curl clients at once, each past max_upload: every one reads the 413
+    head -c $((4 << 20)) /dev/zero >big.bin
+    i=0 pids=""
+    while [ $i -lt 40 ]; do
+        curl -s -o /dev/null -w '%{http_code} %{exitcode}\n' -H "Authorization: Bearer $tok" \
+            -H 'Transfer-Encoding: chunked' -H 'Expect:' --data-binary @big.bin "$SVC_URL/jobs" >"storm.$i" &
+        pids="$pids $!" i=$((i + 1))
+    done
+    wait $pids
+    sort storm.* | uniq -c
+    [ "$(cat storm.* | grep -c '^413 0$')" = 40 ] || return 1
+    m() { curl -s -H "Authorization: Bearer $tok" "$SVC_URL/metrics" | awk -v m="$1" '$1 == m { print $2 }'; }
+    [ "$(m 'ringside_http_connections_cut_total{reason="max_upload"}')" = 43 ] || return 1
+    i=0
+    while [ "$(m ringside_http_connections_lingering)" != 0 ]; do
+        sleep 0.2; i=$((i + 1)); [ $i -lt 75 ] || { echo "connections still lingering"; return 1; }
+    done
 }
 
 t_host_and_origin() {
@@ -215,5 +313,5 @@ t_cors_when_configured() {
 
 t_run ${T_ONLY:-slowloris_from_one_address idle_from_a_hundred_addresses header_timeout_cuts_slow_and_idle \
     endless_chunked_upload_cut_at_max_upload stalled_upload_cut_by_min_body_rate upload_memory_full_is_503 \
-    malformed_requests host_and_origin cors_when_configured}
+    malformed_requests refused_upload_lingers host_and_origin cors_when_configured}
 t_done
