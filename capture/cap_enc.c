@@ -629,7 +629,7 @@ bool cap_enc_trial_run(const cap_enc *enc, int w, int h, const uint8_t *i420, in
     snprintf(t->encoder, sizeof t->encoder, "%s", name);
     snprintf(t->preset, sizeof t->preset, "%s", enc->preset[0] ? enc->preset : row->preset_default);
     t->crf = enc->crf ? enc->crf : row->crf_default;
-    av_log_set_level(AV_LOG_ERROR);
+    cap_av_log_level();
     cap_encoder x = {0};
     AVCodecContext *d = NULL;
     AVPacket *pkt = av_packet_alloc();

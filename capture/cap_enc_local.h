@@ -47,4 +47,8 @@ bool cap_aenc_feed(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, size_t 
 bool cap_aenc_finish(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *err);
 void cap_aenc_close(cap_aenc *a);
 
+/* FFmpeg's own log at the process's level (rs_log.h): errors, or its
+ * statistics too with -v, nothing with --loglevel quiet. */
+void cap_av_log_level(void);
+
 #endif

@@ -63,7 +63,7 @@ cap_join *cap_join_open(const cap_join_desc *d, rs_err *err)
         return NULL;
     }
     j->d = *d;
-    av_log_set_level(AV_LOG_ERROR);
+    cap_av_log_level();
     snprintf(j->part, sizeof j->part, "%s.part", d->out);
     int r = avformat_alloc_output_context2(&j->fmt, NULL, !strcmp(fmt, "mkv") ? "matroska" : fmt, j->part);
     if (r < 0) {

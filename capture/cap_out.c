@@ -40,7 +40,7 @@ bool cap_out_open(cap_out *o, const char *path, rs_err *err)
         o->f = fopen(o->tmp, "wb");
     }
     if (!o->f)
-        return rs_fail(err, CAP_ERR_CREATE, "%s: cannot create (as %s): %s", o->path, o->tmp, strerror(errno));
+        return rs_fail(err, CAP_ERR_CREATE, "%s: cannot create (as %s): %s", cap_out_name(o->path), o->tmp, strerror(errno));
     setvbuf(o->f, NULL, _IOFBF, 1 << 20);
     return true;
 }
@@ -51,7 +51,7 @@ bool cap_out_write(cap_out *o, const void *data, size_t n, rs_err *err)
     if (fwrite(data, 1, n, o->f) != n) {
         if (errno == EPIPE)
             return rs_fail(err, CAP_ERR_PIPE_CLOSED, "%s: the reader closed the pipe", cap_out_name(o->path));
-        return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", o->path, strerror(errno ? errno : EIO));
+        return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", cap_out_name(o->path), strerror(errno ? errno : EIO));
     }
     return true;
 }
@@ -78,7 +78,7 @@ bool cap_out_close(cap_out *o, bool ok, rs_err *err)
                 unlink(o->tmp);
             if (e == EPIPE)
                 return rs_fail(err, CAP_ERR_PIPE_CLOSED, "%s: the reader closed the pipe before the end", cap_out_name(o->path));
-            return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", o->path, strerror(e ? e : EIO));
+            return rs_fail(err, CAP_ERR_WRITE, "%s: write failed: %s", cap_out_name(o->path), strerror(e ? e : EIO));
         }
         if (!o->device && rename(o->tmp, o->path) != 0) {
             e = errno;

@@ -36,6 +36,7 @@
 #include "cap_enc_local.h"
 #include "cap_out.h"
 #include "cap_sink.h"
+#include "../runtime/util/rs_log.h"
 
 typedef struct ff_impl {
     AVFormatContext *fmt;
@@ -67,9 +68,15 @@ static int fail_av(rs_err *err, int id, const char *path, const char *what, int 
     return rs_fail(err, id, "%s: %s: %s", path, what, msg);
 }
 
+void cap_av_log_level(void)
+{
+    /* encoder statistics are noise on our stderr, unless -v asks for them */
+    av_log_set_level(rs_log_on(RS_LOG_DEBUG) ? AV_LOG_INFO : rs_log_on(RS_LOG_ERROR) ? AV_LOG_ERROR : AV_LOG_QUIET);
+}
+
 bool cap_ffmpeg_check(const char *path, const char *ext, rs_err *err)
 {
-    av_log_set_level(AV_LOG_ERROR); /* encoder statistics are noise on our stderr */
+    cap_av_log_level();
     /* the encoder is cap_sink_encoder's to find: the codec asked for may not be the container's default */
     if (!av_guess_format(container(ext), NULL, NULL))
         return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this FFmpeg has no %s muxer", path, container(ext));

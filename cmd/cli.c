@@ -15,6 +15,7 @@
 #include "../runtime/render/r_quality.h"
 #include "../runtime/render/r_stage.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/util/rs_out.h"
 #include "../runtime/util/rs_progress.h"
 
@@ -24,6 +25,8 @@ const char *cli_command;
 static void opt_error(const char *fmt, ...) RS_PRINTF(1, 2);
 static void opt_error(const char *fmt, ...)
 {
+    if (!rs_log_on(RS_LOG_ERROR))
+        return;
     va_list ap;
     fprintf(stderr, cli_command ? "ringside %s: " : "ringside: ", cli_command);
     va_start(ap, fmt);
@@ -32,20 +35,88 @@ static void opt_error(const char *fmt, ...)
     fputc('\n', stderr);
 }
 
+static void say(int level, const char *cmd, const char *what, const char *fmt, va_list ap)
+{
+    if (!rs_log_on(level))
+        return;
+    fprintf(stderr, "ringside %s: %s", cmd, what);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+}
+
 void cli_error(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
-    fprintf(stderr, "ringside %s: ", cmd);
     va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
+    say(RS_LOG_ERROR, cmd, "", fmt, ap);
     va_end(ap);
-    fputc('\n', stderr);
+}
+
+void cli_warn(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    say(RS_LOG_WARNING, cmd, "warning: ", fmt, ap);
+    va_end(ap);
+}
+
+void cli_info(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    say(RS_LOG_INFO, cmd, "", fmt, ap);
+    va_end(ap);
+}
+
+void cli_debug(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    say(RS_LOG_DEBUG, cmd, "", fmt, ap);
+    va_end(ap);
 }
 
 int cli_usage_error(const char *cmd)
 {
-    fprintf(stderr, "ringside %s: see 'ringside %s --help'\n", cmd, cmd);
+    if (rs_log_on(RS_LOG_ERROR))
+        fprintf(stderr, "ringside %s: see 'ringside %s --help'\n", cmd, cmd);
     return RS_EXIT_USAGE;
+}
+
+bool cli_log_options(int *argc, char **argv)
+{
+    int out = 1;
+    bool ok = true, ended = false;
+    for (int i = 1; i < *argc; i++) {
+        const char *a = argv[i];
+        int level = -1;
+        if (ended || a[0] != '-') {
+            ended |= !strcmp(a, "--");
+            argv[out++] = argv[i];
+            continue;
+        }
+        if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+            level = RS_LOG_WARNING;
+        else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
+            level = RS_LOG_DEBUG;
+        else if (!strcmp(a, "--loglevel") || !strncmp(a, "--loglevel=", 11)) {
+            const char *v = a[10] == '=' ? a + 11 : i + 1 < *argc ? argv[++i] : NULL;
+            if (!v || !rs_log_parse(v, &level)) {
+                fprintf(stderr, "ringside: --loglevel '%s': expected quiet, error, warning, info or debug\n",
+                        v ? v : "");
+                ok = false;
+                continue;
+            }
+        } else {
+            argv[out++] = argv[i];
+            continue;
+        }
+        rs_log_level = level;
+        rs_log_explicit = true;
+    }
+    argv[out] = NULL;
+    *argc = out;
+    return ok;
 }
 
 int cli_bad_option(const char *cmd, char *const *argv)
@@ -189,6 +260,8 @@ bool cli_stage(const char *arg, int *stage)
             return true;
         }
     }
+    if (!rs_log_on(RS_LOG_ERROR))
+        return false;
     fprintf(stderr, cli_command ? "ringside %s: " : "ringside: ", cli_command);
     fprintf(stderr, "--stage '%s': unknown stage (expected", arg);
     for (int i = 0; i < G_STAGES; i++)

@@ -41,8 +41,24 @@ bool cli_u64(const char *opt, const char *arg, uint64_t *out);
 bool cli_time(const char *opt, const char *arg, long *ticks);
 /* Parses an integer in [lo, hi]; prints a usage error naming opt. */
 bool cli_int(const char *opt, const char *arg, long lo, long hi, long *out);
-/* "ringside CMD: message" on stderr. */
+/* "ringside CMD: message" on stderr, at the error level (rs_log.h). */
 void cli_error(const char *cmd, const char *fmt, ...);
+/* "ringside CMD: warning: message", at the warning level. */
+void cli_warn(const char *cmd, const char *fmt, ...);
+/* "ringside CMD: message", at the info level: what a command did. */
+void cli_info(const char *cmd, const char *fmt, ...);
+/* "ringside CMD: message", at the debug level (-v). */
+void cli_debug(const char *cmd, const char *fmt, ...);
+/* The options every command takes, wherever they stand before "--":
+ * --loglevel LEVEL, --loglevel=LEVEL, -q (warning), --quiet, -v (debug),
+ * --verbose.  Removes them from argv (argc updated) and sets rs_log_level;
+ * false after a usage error (an unknown level). */
+bool cli_log_options(int *argc, char **argv);
+/* The line every command's --help ends its options with. */
+#define CLI_LOG_HELP \
+    "  -q, -v, --loglevel LEVEL\n" \
+    "                     how much goes to stderr: quiet, error, warning (-q), info\n" \
+    "                     (the default) or debug (-v)\n"
 /* The command running now ("render"), set by main before it runs one: the
  * option parsers above name it in their messages. */
 extern const char *cli_command;

@@ -32,6 +32,7 @@
 
 #include "../player/mv_player.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "snd_out.h"
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
@@ -49,7 +50,7 @@ static void help(void)
 {
     printf("usage: ringside attract [MOVIE ...] [--demo REPLAY ...] [--idle SECONDS] [--fullscreen]\n"
            "                        [--size WxH] [--upload MODE] [--headless --script FILE --ticks N]\n"
-           "                        [--screenshot FILE] [--quiet] [--attract-sound on|off] [--mute]\n"
+           "                        [--screenshot FILE] [-q|-v] [--attract-sound on|off] [--mute]\n"
            "                        [--volume V] [--audio-out FILE.wav] [--audio-device NAME] [-y]\n\n"
            "The cabinet's attract loop: plays the movies and demo replays in the order given,\n"
            "over and over, until a player presses any button; then a match against the CPU.\n"
@@ -67,7 +68,7 @@ static void help(void)
            "                  by '+': up down left right punch kick guard start\n"
            "  --ticks N       stop after N ticks\n"
            "  --screenshot F  save the last frame (.png or .ppm)\n"
-           "  --quiet         no log lines\n"
+           CLI_LOG_HELP
            "  --attract-sound on|off\n"
            "                  the operator's attract-sound setting: off silences the loop (movies'\n"
            "                  soundtracks, demos' game sound and music); a match always has sound\n"
@@ -555,8 +556,7 @@ int cmd_attract(int argc, char **argv)
         {"fullscreen", no_argument, 0, 'f'},   {"size", required_argument, 0, 'z'},
         {"upload", required_argument, 0, 'u'}, {"headless", no_argument, 0, 'H'},
         {"script", required_argument, 0, 's'}, {"ticks", required_argument, 0, 'n'},
-        {"screenshot", required_argument, 0, 'o'}, {"quiet", no_argument, 0, 'q'},
-        {"help", no_argument, 0, 'h'},         {"attract-sound", required_argument, 0, 'S'},
+        {"screenshot", required_argument, 0, 'o'}, {"help", no_argument, 0, 'h'},         {"attract-sound", required_argument, 0, 'S'},
         {"mute", no_argument, 0, 'M'},         {"volume", required_argument, 0, 'V'},
         {"audio-out", required_argument, 0, 'A'}, {"audio-device", required_argument, 0, 'D'},
         {"overwrite", no_argument, 0, 'y'},    {0}};
@@ -568,6 +568,7 @@ int cmd_attract(int argc, char **argv)
         return RS_EXIT_FAIL;
     }
     a->items = items;
+    a->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     a->cur = -1;
     a->prepared = -1;
     a->w = 1280;
@@ -582,7 +583,7 @@ int cmd_attract(int argc, char **argv)
     optind = 1;
     opterr = 0;
     /* "-" first: movies and --demo keep their command-line order */
-    while ((c = getopt_long(argc, argv, "-qhy", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "-hy", opts, NULL)) != -1) {
         switch (c) {
         case 1: items[a->nitems++] = (item){ITEM_MOVIE, optarg, false}; break;
         case 'd': items[a->nitems++] = (item){ITEM_DEMO, optarg, false}; break;
@@ -607,7 +608,6 @@ int cmd_attract(int argc, char **argv)
             a->limit = n;
             break;
         case 'o': shot = optarg; break;
-        case 'q': a->quiet = true; break;
         case 'S':
             if (strcmp(optarg, "on") && strcmp(optarg, "off")) {
                 cli_error("attract", "--attract-sound '%s': expected on or off", optarg);

@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/game/g_ai.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/replay/rp.h"
@@ -23,7 +24,7 @@
 static void help(void)
 {
     printf("usage: ringside bench platform [--size WxH] [--frames N] [--runs N] [--csv FILE] [-y|-n]\n"
-           "       ringside bench sim [--hours H] [--csv FILE] [-y|-n] [--progress tty|plain|off] [--quiet]\n"
+           "       ringside bench sim [--hours H] [--csv FILE] [-y|-n] [--progress tty|plain|off] [-q|-v]\n"
            "       ringside bench capture [--frames N] [--sink mp4|y4m|null] ... (see bench capture --help)\n"
            "       ringside bench accuracy [--frames N] ... (see bench accuracy --help)\n"
            "       ringside bench upload [--frames N] [--modes LIST] ... (see bench upload --help)\n"
@@ -46,7 +47,7 @@ static void help(void)
            "  -y, -n        replace an existing --csv FILE, or refuse it, naming it (the default)\n"
            "  --progress M  sim: tty, plain (a line every 5 s and the last) or off; default\n"
            "                tty on a terminal, else plain\n"
-           "  --quiet       sim: no progress line (--progress off)\n");
+           CLI_LOG_HELP);
 }
 
 static void on_progress(uint64_t done, uint64_t total, void *user)
@@ -130,7 +131,6 @@ static int bench_sim(int argc, char **argv)
 {
     static const struct option opts[] = {{"hours", required_argument, 0, 'H'},
                                          {"csv", required_argument, 0, 'c'},
-                                         {"quiet", no_argument, 0, 'q'},
                                          {"help", no_argument, 0, 'h'},
                                          {"overwrite", no_argument, 0, 'y'},
                                          {"no-overwrite", no_argument, 0, 'n'},
@@ -138,19 +138,18 @@ static int bench_sim(int argc, char **argv)
                                          {0}};
     long hours = 24;
     const char *csv = NULL;
-    bool quiet = false, overwrite = false;
+    bool quiet = !rs_log_on(RS_LOG_INFO), overwrite = false;
     int progress = RS_PROGRESS_AUTO;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "hyn", opts, NULL)) != -1) {
         switch (c) {
         case 'H':
             if (!cli_int("--hours", optarg, 1, 168, &hours))
                 return RS_EXIT_USAGE;
             break;
         case 'c': csv = optarg; break;
-        case 'q': quiet = true; break;
         case 'y': overwrite = true; break;
         case 'n': overwrite = false; break;
         case 'g': if (!cli_progress_mode("bench", optarg, &progress)) return RS_EXIT_USAGE; break;

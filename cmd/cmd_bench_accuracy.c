@@ -189,7 +189,7 @@ static void help(void)
 {
     printf("usage: ringside bench accuracy [--only capture|ibl|tone|water|fog|lspsm] [--frames N] [--size WxH]\n"
            "                               [--render-size WxH] [--ibl-sizes LIST] [--ibl-reference N]\n"
-           "                               [--stage NAME] [--csv FILE] [-y|-n]\n\n"
+           "                               [--stage NAME] [--csv FILE] [-y|-n] [-q|-v]\n\n"
            "Run time against error, six tables:\n"
            "  capture  downscales N frames of demos/dojo.rsr with every GPU filter (box, bilinear,\n"
            "           nearest, lanczos3) and the CPU box of sequential capture, and compares each\n"
@@ -217,7 +217,8 @@ static void help(void)
            "                      tone and LSPSM tables go to FILE's name with -ibl, -tone and\n"
            "                      -lspsm added).  A FILE given here must be in a folder that\n"
            "                      exists, and none of its tables may exist unless -y\n"
-           "  -y, -n              replace those tables, or refuse them, naming one (the default)\n");
+           "  -y, -n              replace those tables, or refuse them, naming one (the default)\n"
+           CLI_LOG_HELP);
 }
 
 /* out/x.csv + "-ibl" -> out/x-ibl.csv */

@@ -21,14 +21,15 @@
 
 static void help(void)
 {
-    printf("usage: ringside bench audio [--replay FILE] [--csv FILE] [-y|-n]\n\n"
+    printf("usage: ringside bench audio [--replay FILE] [--csv FILE] [-y|-n] [-q|-v]\n\n"
            "Times the sound on the CPU: building the bank, the mixer per tick (800\n"
            "frames) on the replay's own cues and on a busy load with every voice playing,\n"
            "and making the replay's whole soundtrack (simulate, mix, measure, normalize:\n"
            "what render and replay sound do), with its real-time factor.\n\n"
            "  --replay FILE  the replay (default demos/dojo.rsr)\n"
            "  --csv FILE     also write the table as CSV\n"
-           "  -y, -n         replace an existing --csv FILE, or refuse it (the default)\n");
+           "  -y, -n         replace an existing --csv FILE, or refuse it (the default)\n"
+           CLI_LOG_HELP);
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -14,6 +14,7 @@
 #include "../capture/cap.h"
 #include "bench_chart.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/render/r_quality.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
@@ -165,7 +166,7 @@ static bool do_run(bench *b, run *r, rs_err *err)
 static void help(void)
 {
     printf("usage: ringside bench capture [--frames N] [--runs N] [--size WxH] [--quality Q] [--render-size WxH]\n"
-           "                              [--sink mp4|y4m|null] [--csv FILE] [--chart FILE.png] [-y|-n] [--quiet]\n\n"
+           "                              [--sink mp4|y4m|null] [--csv FILE] [--chart FILE.png] [-y|-n] [-q|-v]\n\n"
            "Renders %s same frames of demos/dojo.rsr (from tick 600) through every capture\n"
            "configuration and prints fps and milliseconds per frame for each stage:\n"
            "render-only, writer-only (frames from memory to the sink), sequential (CPU\n"
@@ -184,7 +185,7 @@ static void help(void)
            "  -y, -n             replace a --csv or --chart FILE given here, or refuse it (the\n"
            "                     default); the defaults under out/ are replaced each run.\n"
            "                     --csv - writes to standard output\n"
-           "  --quiet            no progress line\n",
+           CLI_LOG_HELP,
            "the");
 }
 
@@ -202,17 +203,18 @@ static int parse_options(int argc, char **argv, bench *b, capture_opts *o)
     static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
                                          {"render-size", required_argument, 0, 'r'}, {"sink", required_argument, 0, 'k'},
                                          {"csv", required_argument, 0, 'c'},    {"chart", required_argument, 0, 'C'},
-                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {"help", no_argument, 0, 'h'},
                                          {"runs", required_argument, 0, 'R'},   {"quality", required_argument, 0, 'L'},
                                          {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
     *o = (capture_opts){.nrep = 3, .quality = &r_presets[R_PRESET_DEFAULT], .sink = "mp4", .csv = "out/bench-capture.csv",
                         .chart = "out/bench-capture.png"};
+    o->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     long v;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "hyn", opts, NULL)) != -1) {
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 10, 100000, &v)) return RS_EXIT_USAGE; b->frames = (int)v; break;
         case 's': if (!cli_size("--size", optarg, 8192, &b->w, &b->h)) return RS_EXIT_USAGE; break;
@@ -230,7 +232,6 @@ static int parse_options(int argc, char **argv, bench *b, capture_opts *o)
         case 'y': o->overwrite = true; break;
         case 'n': o->overwrite = false; break;
         case 'R': if (!cli_int("--runs", optarg, 1, MAX_RUNS, &o->nrep)) return RS_EXIT_USAGE; break;
-        case 'q': o->quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }

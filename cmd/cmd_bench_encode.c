@@ -23,6 +23,7 @@
 
 #include "../capture/cap.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "job_render.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_game.h"
@@ -51,7 +52,7 @@ static const trial_set sets[] = {
 static void help(void)
 {
     printf("usage: ringside bench encode [--frames N] [--size WxH] [--render-size WxH]\n"
-           "                             [--codecs LIST] [--quick] [--csv FILE] [--quiet]\n\n"
+           "                             [--codecs LIST] [--quick] [--csv FILE] [-q|-v]\n\n"
            "Renders N frames of demos/dojo.rsr (from tick 600) once into memory as I420,\n"
            "then encodes them with each software encoder of this FFmpeg at three presets\n"
            "and three CRF points, decodes the result with libavcodec and prints, per\n"
@@ -63,7 +64,7 @@ static void help(void)
            "  --codecs LIST      comma-separated among h264,hevc,vp9,av1 (default: all there are)\n"
            "  --quick            only each encoder's default preset and CRF (one row each)\n"
            "  --csv FILE         also write the table as CSV\n"
-           "  --quiet            no progress line while rendering\n");
+           CLI_LOG_HELP);
 }
 
 /* memory sink: frame i of the render into slot i */
@@ -208,15 +209,15 @@ int bench_encode(int argc, char **argv)
     static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
                                          {"render-size", required_argument, 0, 'r'}, {"codecs", required_argument, 0, 'C'},
                                          {"quick", no_argument, 0, 'k'},           {"csv", required_argument, 0, 'c'},
-                                         {"quiet", no_argument, 0, 'q'},           {"help", no_argument, 0, 'h'},
+                                         {"help", no_argument, 0, 'h'},
                                          {0}};
     long frames = 180;
     int w = 640, h = 360, sw = 1280, sh = 720, c;
     const char *csv = NULL, *codecs = NULL;
-    bool quick = false, quiet = false;
+    bool quick = false, quiet = !rs_log_on(RS_LOG_INFO);
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 1, 10000, &frames)) return RS_EXIT_USAGE; break;
         case 's': if (!cli_size("--size", optarg, 8192, &w, &h)) return RS_EXIT_USAGE; break;
@@ -237,7 +238,6 @@ int bench_encode(int argc, char **argv)
             break;
         case 'k': quick = true; break;
         case 'c': csv = optarg; break;
-        case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }

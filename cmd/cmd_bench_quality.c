@@ -22,6 +22,7 @@
 #include "../capture/cap_scale.h"
 #include "bench_chart.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "job_render.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
@@ -103,7 +104,7 @@ typedef struct result {
 static void help(void)
 {
     printf("usage: ringside bench quality [--size WxH] [--frames N] [--stages LIST] [--csv FILE]\n"
-           "                              [--chart FILE.png] [-y|-n] [--quiet]\n\n"
+           "                              [--chart FILE.png] [-y|-n] [-q|-v]\n\n"
            "Draws the same frames of every shipped demo under each knob of the renderer\n"
            "(render scale, FXAA, shadow and silhouette map sizes, the shadow mask at half\n"
            "size, bloom levels, LSPSM and fog map sizes, the water grid) and under\n"
@@ -125,7 +126,7 @@ static void help(void)
            "                  worst PSNR, as PNG and SVG beside it (default\n"
            "                  out/bench-quality.png; '' none)\n"
            "  -y, -n          replace a --csv or --chart FILE given here, or refuse it\n"
-           "  --quiet         no progress lines\n",
+           CLI_LOG_HELP,
            FRAME_STEP);
 }
 
@@ -346,24 +347,23 @@ static int parse_options(int argc, char **argv, quality_opts *o)
 {
     static const struct option opts[] = {{"size", required_argument, 0, 's'},   {"frames", required_argument, 0, 'f'},
                                          {"stages", required_argument, 0, 'S'}, {"csv", required_argument, 0, 'c'},
-                                         {"chart", required_argument, 0, 'C'},  {"quiet", no_argument, 0, 'q'},
-                                         {"help", no_argument, 0, 'h'},         {"overwrite", no_argument, 0, 'y'},
+                                         {"chart", required_argument, 0, 'C'},  {"help", no_argument, 0, 'h'},         {"overwrite", no_argument, 0, 'y'},
                                          {"no-overwrite", no_argument, 0, 'n'}, {0}};
     *o = (quality_opts){.w = 640, .h = 360, .frames = 4, .csv = "out/bench-quality.csv", .chart = "out/bench-quality.png"};
+    o->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     for (int d = 0; d < NDEMOS; d++)
         o->use[d] = true;
     long v;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "hynq", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "hyn", opts, NULL)) != -1) {
         switch (c) {
         case 's': if (!cli_out_size("--size", optarg, &o->w, &o->h)) return RS_EXIT_USAGE; break;
         case 'f': if (!cli_int("--frames", optarg, 1, 30, &v)) return RS_EXIT_USAGE; o->frames = (int)v; break;
         case 'S': if (!parse_stages(o, optarg)) return RS_EXIT_USAGE; break;
         case 'c': o->csv = optarg; o->user_csv = true; break;
         case 'C': o->chart = optarg; o->user_chart = true; break;
-        case 'q': o->quiet = true; break;
         case 'y': o->overwrite = true; break;
         case 'n': o->overwrite = false; break;
         case 'h': help(); return RS_EXIT_OK;

@@ -27,6 +27,7 @@
 #include "../player/mv_csp.h"
 #include "../player/mv_up.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_target.h"
@@ -63,7 +64,7 @@ typedef struct bench {
 static void help(void)
 {
     printf("usage: ringside bench upload [--frames N] [--size WxH] [--modes LIST] [--runs N]\n"
-           "                             [--csv FILE] [--backend egl|osmesa] [-y|-n] [--quiet]\n\n"
+           "                             [--csv FILE] [--backend egl|osmesa] [-y|-n] [-q|-v]\n\n"
            "Plays synthetic 4:2:0 movie frames (BT.709, 60 fps, %d distinct frames) through\n"
            "each texture upload path the movie player has, the way the player drives it on\n"
            "one 60 Hz tick, as fast as possible, and prints milliseconds per frame:\n"
@@ -84,7 +85,7 @@ static void help(void)
            "                   folder must exist\n"
            "  -y, -n           replace an existing --csv FILE, or refuse it (the default)\n"
            "  --backend B      egl or osmesa (default egl, falling back to osmesa)\n"
-           "  --quiet          no progress on stderr\n",
+           CLI_LOG_HELP,
            NFRAMES, NSLOTS, MAX_RUNS);
 }
 
@@ -340,13 +341,13 @@ static int parse_options(int argc, char **argv, upload *u)
     static const struct option opts[] = {{"frames", required_argument, 0, 'f'}, {"size", required_argument, 0, 's'},
                                          {"modes", required_argument, 0, 'm'},  {"runs", required_argument, 0, 'R'},
                                          {"csv", required_argument, 0, 'c'},    {"backend", required_argument, 0, 'b'},
-                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {"help", no_argument, 0, 'h'},
                                          {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {0}};
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "hyn", opts, NULL)) != -1) {
         switch (c) {
         case 'f': if (!cli_int("--frames", optarg, 1, 100000, &u->frames)) return RS_EXIT_USAGE; break;
         case 's': if (!cli_size("--size", optarg, 8192, &u->b.w, &u->b.h)) return RS_EXIT_USAGE; break;
@@ -362,7 +363,6 @@ static int parse_options(int argc, char **argv, upload *u)
             }
             u->backend = optarg;
             break;
-        case 'q': u->quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("bench", argv);
         }
@@ -577,6 +577,7 @@ int bench_upload(int argc, char **argv)
         return RS_EXIT_FAIL;
     *u = (upload){.b = {.w = 1280, .h = 768}, .frames = 300, .nrep = 3,
                   .modes = {MV_UP_DIRECT, MV_UP_PBO, MV_UP_PERSISTENT}, .nmode = 3};
+    u->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     int status = parse_options(argc, argv, u);
     if (status < 0)
         status = setup(u);

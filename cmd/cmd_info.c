@@ -4,17 +4,19 @@
 #include <string.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 
 static void help(void)
 {
-    printf("usage: ringside info [--backend egl|osmesa|glfw] [--debug]\n\n"
+    printf("usage: ringside info [--backend egl|osmesa|glfw] [--debug] [-q|-v]\n\n"
            "Creates a GL context and prints the backend, GL vendor, renderer, version,\n"
            "GLSL version, max texture size and which optional features exist.\n\n"
            "  --backend B   egl (headless), osmesa (software) or glfw (window, needs X);\n"
            "                default: egl, falling back to osmesa\n"
-           "  --debug       ask for a debug context (KHR_debug messages on stderr)\n");
+           "  --debug       ask for a debug context (KHR_debug messages on stderr)\n"
+           CLI_LOG_HELP);
 }
 
 static const char *yn(bool b)
@@ -48,7 +50,7 @@ int cmd_info(int argc, char **argv)
         cli_error("info", "%s", err.msg);
         return cli_plat_status(&err);
     }
-    if (plat_fallback_reason(p)[0])
+    if (plat_fallback_reason(p)[0] && rs_log_on(RS_LOG_WARNING))
         fprintf(stderr, "ringside info: egl unavailable, using %s: %s\n", plat_backend_name(p), plat_fallback_reason(p));
     printf("backend         %s (%s)\n", plat_backend_name(p), plat_detail(p));
     printf("vendor          %s\n", glcaps.vendor);

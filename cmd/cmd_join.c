@@ -12,13 +12,14 @@
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_progress.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "job_audio.h"
 #include "job_out.h"
 
 static void help(void)
 {
     printf("usage: ringside join --segment KEY -o OUT [-y|-n] [--hashes FILE] [--first T]\n"
-           "                     [--progress-fd N] [--progress tty|plain|off] [--quiet]\n"
+           "                     [--progress-fd N] [--progress tty|plain|off] [-q|-v]\n"
            "                     [--replay R [--audio-bitrate RATE] [--loudness LUFS]] SEG...\n\n"
            "Joins segments written by 'ringside render --ticks A:B --segment KEY' into one\n"
            "video by stream copy (no re-encoding): .mp4 (index at the front), .mkv or .webm,\n"
@@ -46,7 +47,7 @@ static void help(void)
            "                    position in SEG..., from 0), then 'frames DONE TOTAL' lines\n"
            "  --progress MODE   tty (a line redrawn in place), plain (a line every 5 s and\n"
            "                    the last, for logs) or off; default tty on a terminal, else plain\n"
-           "  --quiet           no progress line\n\n"
+           CLI_LOG_HELP
            "exit status: 0 joined; 1 the output failed (directory gone, disk full), nothing\n"
            "left; 2 bad usage; 3 one or more segments are bad (each named on stderr and in a\n"
            "'bad' line), nothing written.  REASON is one of missing, manifest, key, format,\n"
@@ -94,8 +95,7 @@ static void report_frames(void *ctx, uint64_t done, uint64_t total)
 static const struct option opts[] = {
     {"output", required_argument, 0, 'o'},     {"segment", required_argument, 0, 'S'},
     {"hashes", required_argument, 0, 'H'},     {"first", required_argument, 0, 'f'},
-    {"progress-fd", required_argument, 0, 'G'}, {"quiet", no_argument, 0, 'q'},
-    {"help", no_argument, 0, 'h'},
+    {"progress-fd", required_argument, 0, 'G'}, {"help", no_argument, 0, 'h'},
     {"overwrite", no_argument, 0, 'y'},        {"no-overwrite", no_argument, 0, 'n'},
     {"progress", required_argument, 0, 'g'},   {"replay", required_argument, 0, 'R'},
     {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
@@ -122,7 +122,6 @@ static int join_option(join_opts *o, int c, const char *arg, char **argv)
     case 'H': o->hashes = arg; return -1;
     case 'f': return cli_u64("--first", arg, &o->first) ? -1 : RS_EXIT_USAGE;
     case 'G': return cli_int("--progress-fd", arg, 3, 1023, &o->progress_fd) ? -1 : RS_EXIT_USAGE;
-    case 'q': o->quiet = true; return -1;
     case 'h': help(); return RS_EXIT_OK;
     case 'y': o->overwrite = true; return -1;
     case 'n': o->overwrite = false; return -1;
@@ -138,10 +137,11 @@ static int join_option(join_opts *o, int c, const char *arg, char **argv)
 static int parse_options(int argc, char **argv, join_opts *o)
 {
     *o = (join_opts){.progress_fd = -1, .progress = RS_PROGRESS_AUTO};
+    o->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1)
+    while ((c = getopt_long(argc, argv, "o:hyn", opts, NULL)) != -1)
         if ((status = join_option(o, c, optarg, argv)) >= 0)
             return status;
     if (!o->key || !cap_seg_key_ok(o->key)) {

@@ -17,6 +17,7 @@
 #include "../player/mv_csp.h"
 #include "../player/mv_player.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "snd_out.h"
 #include "../runtime/gl/rgl.h"
 #include "../runtime/input.h"
@@ -32,7 +33,7 @@ static void help(void)
 {
     printf("usage: ringside movie FILE [--dump DIR] [--hashes FILE] [-y|-n] [--headless] [--ticks N]\n"
            "                      [--upload pbo|direct|persistent] [--matrix bt601|bt709]\n"
-           "                      [--range limited|full] [--size WxH] [--fullscreen] [--loop] [--quiet]\n"
+           "                      [--range limited|full] [--size WxH] [--fullscreen] [--loop] [-q|-v]\n"
            "                      [--mute] [--volume V] [--audio-out FILE.wav] [--audio-device NAME]\n\n"
            "Plays a movie on the 60 Hz tick: Y4M (8-bit 4:2:0, 4:2:2, 4:4:4, mono) or anything\n"
            "FFmpeg decodes (H.264, VP9, AV1, ...).  Frames are decoded on their own thread,\n"
@@ -59,7 +60,7 @@ static void help(void)
            "  --size WxH      output size (default: the movie's display size)\n"
            "  --fullscreen    window: primary monitor\n"
            "  --loop          window: start again at the end (Escape quits)\n"
-           "  --quiet         no summary line\n"
+           CLI_LOG_HELP
            "  --mute          no sound (with --audio-out: a silent WAV of the same length)\n"
            "  --volume V      sound level, linear 0..1 (default 1; 0 is --mute)\n"
            "  --audio-out F   write the sound to F.wav (16-bit, 48 kHz stereo) instead of the device,\n"
@@ -229,7 +230,7 @@ static const struct option opts[] = {
     {"upload", required_argument, 0, 'u'},  {"matrix", required_argument, 0, 'm'},
     {"range", required_argument, 0, 'r'},   {"size", required_argument, 0, 'z'},
     {"fullscreen", no_argument, 0, 'f'},    {"loop", no_argument, 0, 'L'},
-    {"quiet", no_argument, 0, 'q'},         {"help", no_argument, 0, 'h'},
+    {"help", no_argument, 0, 'h'},
     {"overwrite", no_argument, 0, 'y'},     {"no-overwrite", no_argument, 0, 'n'},
     {"mute", no_argument, 0, 'M'},          {"volume", required_argument, 0, 'V'},
     {"audio-out", required_argument, 0, 'A'}, {"audio-device", required_argument, 0, 'D'},
@@ -291,7 +292,6 @@ static int movie_option(mv_cmd *s, movie_opts *o, int c, const char *arg, char *
     case 'z': return cli_size("--size", arg, 8192, &s->w, &s->h) ? -1 : RS_EXIT_USAGE;
     case 'f': o->pd.fullscreen = true; return -1;
     case 'L': s->loop = true; return -1;
-    case 'q': o->quiet = true; return -1;
     case 'y': s->overwrite = true; return -1;
     case 'n': s->overwrite = false; return -1;
     case 'M': o->snd.mute = true; return -1;
@@ -307,10 +307,11 @@ static int movie_option(mv_cmd *s, movie_opts *o, int c, const char *arg, char *
 static int parse_options(int argc, char **argv, mv_cmd *s, movie_opts *o)
 {
     *o = (movie_opts){.pd = {.title = "ringside movie"}};
+    o->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qhyn", opts, NULL)) != -1)
+    while ((c = getopt_long(argc, argv, "hyn", opts, NULL)) != -1)
         if ((status = movie_option(s, o, c, optarg, argv)) >= 0)
             return status;
     if (optind != argc - 1) {

@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "snd_out.h"
 #include "../runtime/audio/au_out.h"
 #include "../runtime/game/g_ai.h"
@@ -34,7 +35,7 @@ static void help(void)
 {
     printf("usage: ringside play [--p1 human|cpu] [--p2 human|cpu] [--stage NAME] [--seed S] [--level L]\n"
            "                     [--record FILE] [--replay FILE] [--seconds N] [--screenshot FILE]\n"
-           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [--quiet]\n"
+           "                     [--size WxH] [--fullscreen] [--no-vsync] [--headless] [-q|-v]\n"
            "                     [--stage-file FILE] [--passes[=summary|frames]]\n"
            "                     [--hdr-format rgba16f|r11g11b10f] [--quality draft|standard|high|reference]\n"
            "                     [--audio-out FILE.wav] [--mute] [--volume V] [--audio-device D]\n\n"
@@ -61,7 +62,7 @@ static void help(void)
            "  --fullscreen     primary monitor, its current mode\n"
            "  --no-vsync       do not wait for the display\n"
            "  --headless       no window: EGL/OSMesa, one tick per frame, as fast as possible\n"
-           "  --quiet          no summary line\n"
+           CLI_LOG_HELP
            "  --stage-file F   the look to use instead of stages/<stage>.stage (docs/stages.md)\n"
            "  --passes[=MODE]  time every render pass: a table at the end, or one line per frame\n"
            "  --hdr-format F   the HDR buffer: rgba16f (default) or r11g11b10f\n"
@@ -257,7 +258,7 @@ static bool audio_open(play *s, const char *wav, bool mute, float volume, const 
             s->err = err;
             return false;
         }
-        fprintf(stderr, "ringside play: warning: %s; the game runs silent\n", err.msg);
+        cli_warn("play", "%s; the game runs silent", err.msg);
         return true;
     }
     if (silent) /* --audio-out records what was played: silence, tick for tick */
@@ -296,7 +297,7 @@ static bool parse_kind(const char *opt, const char *arg, int *kind)
     else if (!strcmp(arg, "cpu") || !strcmp(arg, "ai"))
         *kind = RP_CPU;
     else {
-        fprintf(stderr, "ringside play: %s '%s': expected human or cpu\n", opt, arg);
+        cli_error("play", "%s '%s': expected human or cpu", opt, arg);
         return false;
     }
     return true;
@@ -309,8 +310,7 @@ static const struct option opts[] = {
     {"replay", required_argument, 0, 'R'}, {"seconds", required_argument, 0, 's'},
     {"screenshot", required_argument, 0, 'o'}, {"size", required_argument, 0, 'z'},
     {"fullscreen", no_argument, 0, 'f'},   {"no-vsync", no_argument, 0, 'v'},
-    {"headless", no_argument, 0, 'H'},     {"quiet", no_argument, 0, 'q'},
-    {"stage-file", required_argument, 0, 'T'}, {"passes", optional_argument, 0, 'P'},
+    {"headless", no_argument, 0, 'H'},     {"stage-file", required_argument, 0, 'T'}, {"passes", optional_argument, 0, 'P'},
     {"hdr-format", required_argument, 0, 'X'},
     {"audio-out", required_argument, 0, 'A'}, {"mute", no_argument, 0, 'M'},
     {"volume", required_argument, 0, 'V'}, {"audio-device", required_argument, 0, 'D'},
@@ -356,7 +356,6 @@ static int play_option(play *s, play_opts *o, int c, const char *arg, char **arg
             return RS_EXIT_USAGE;
         o->go.hdr_format = r_game_hdr_of(k);
         return -1;
-    case 'q': o->quiet = true; return -1;
     case 'A': o->audio_out = arg; return -1;
     case 'M': o->mute = true; return -1;
     case 'V': {
@@ -381,10 +380,11 @@ static int parse_options(int argc, char **argv, play *s, play_opts *o)
     s->h = 720;
     s->quality = &r_presets[R_PRESET_DEFAULT];
     *o = (play_opts){.level = 2, .seed = (uint64_t)time(NULL), .volume = 1, .pd = {.title = "ringside"}};
+    o->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1)
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1)
         if ((status = play_option(s, o, c, optarg, argv)) >= 0)
             return status;
     if (optind < argc) {
@@ -458,7 +458,7 @@ static int play_setup(play *s, play_opts *o, rp_replay *watch, rp_recorder *rec)
 static int play_run(play *s, const play_opts *o)
 {
     if (!o->headless && !o->replay && s->kind[0] == RP_CPU && s->kind[1] == RP_CPU && !o->seconds && !o->quiet)
-        fprintf(stderr, "ringside play: CPU vs CPU; Escape quits\n");
+        cli_info("play", "CPU vs CPU; Escape quits");
     /* the first frame compiles shaders and fills caches (a tenth of a
      * second and more): drawn here, it does not hold up the first ticks,
      * which would then come in a burst that the audio queue cannot hold */

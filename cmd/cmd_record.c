@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/game/g_ai.h"
 #include "../runtime/game/g_game.h"
 #include "../runtime/replay/rp.h"
@@ -16,7 +17,7 @@
 static void help(void)
 {
     printf("usage: ringside record --ai -o FILE [-y|-n] [--seconds N] [--seed S] [--stage NAME] [--level L]\n"
-           "                       [--progress tty|plain|off] [--quiet]\n\n"
+           "                       [--progress tty|plain|off] [-q|-v]\n\n"
            "Plays a CPU-vs-CPU match headless (no GL needed) and writes it as a replay\n"
            "(.rsr, see docs/replay-format.md).  The file is read back and compared with\n"
            "what was recorded before it is put in place.\n\n"
@@ -33,7 +34,7 @@ static void help(void)
            "  --level L     CPU skill 0..3 (default 2)\n"
            "  --progress M  tty (a line redrawn in place), plain (a line every 5 s and the\n"
            "                last, for logs) or off; default tty on a terminal, else plain\n"
-           "  --quiet       no progress line\n",
+           CLI_LOG_HELP,
            MATCH_LIMIT_S, G_STAGES - 1);
 }
 
@@ -42,19 +43,19 @@ int cmd_record(int argc, char **argv)
     static const struct option opts[] = {{"ai", no_argument, 0, 'a'},          {"output", required_argument, 0, 'o'},
                                          {"seconds", required_argument, 0, 's'}, {"seed", required_argument, 0, 'S'},
                                          {"stage", required_argument, 0, 't'},  {"level", required_argument, 0, 'l'},
-                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                         {"help", no_argument, 0, 'h'},
                                          {"overwrite", no_argument, 0, 'y'},    {"no-overwrite", no_argument, 0, 'n'},
                                          {"progress", required_argument, 0, 'g'},
                                          {0}};
     const char *out = NULL;
-    bool ai = false, quiet = false, overwrite = false;
+    bool ai = false, quiet = !rs_log_on(RS_LOG_INFO), overwrite = false;
     int progress = RS_PROGRESS_AUTO;
     long seconds = 0, level = 2;
     uint64_t seed = 1;
     int stage = 0, c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:hyn", opts, NULL)) != -1) {
         switch (c) {
         case 'a': ai = true; break;
         case 'o': out = optarg; break;
@@ -74,7 +75,6 @@ int cmd_record(int argc, char **argv)
             if (!cli_int("--level", optarg, 0, 3, &level))
                 return RS_EXIT_USAGE;
             break;
-        case 'q': quiet = true; break;
         case 'h': help(); return RS_EXIT_OK;
         case 'y': overwrite = true; break;
         case 'n': overwrite = false; break;
@@ -124,14 +124,14 @@ int cmd_record(int argc, char **argv)
     if (!rp_rec_save(&rec, out, &err))
         goto done;
     const rp_replay *rp = &rec.rp;
-    fprintf(stderr, "ringside record: wrote %s: %" PRIu64 " ticks (%.2f s), stage %s, seed %" PRIu64 ", ", out, rp->ticks,
-            rp->ticks / (double)G_HZ, g_stages[stage].name, seed);
+    char result[64];
     if (rp->winner > 0)
-        fprintf(stderr, "winner P%d (%d-%d)\n", rp->winner, rp->rounds[0], rp->rounds[1]);
-    else if (rp->winner == 0)
-        fprintf(stderr, "draw (%d-%d)\n", rp->rounds[0], rp->rounds[1]);
+        snprintf(result, sizeof result, "winner P%d (%d-%d)", rp->winner, rp->rounds[0], rp->rounds[1]);
     else
-        fprintf(stderr, "match unfinished (%d-%d)\n", rp->rounds[0], rp->rounds[1]);
+        snprintf(result, sizeof result, "%s (%d-%d)", rp->winner == 0 ? "draw" : "match unfinished", rp->rounds[0],
+                 rp->rounds[1]);
+    cli_info("record", "wrote %s: %" PRIu64 " ticks (%.2f s), stage %s, seed %" PRIu64 ", %s", out, rp->ticks,
+             rp->ticks / (double)G_HZ, g_stages[stage].name, seed, result);
     status = RS_EXIT_OK;
 done:
     if (status != RS_EXIT_OK)

@@ -13,6 +13,7 @@
 #include "../capture/cap.h"
 #include "../capture/cap_seg.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "job_audio.h"
 #include "job_poster.h"
 #include "job_out.h"
@@ -36,7 +37,7 @@ static void help(void)
            "                       [--quality draft|standard|high|reference]\n"
            "                       [--capture async|sequential] [--downscale gpu|cpu]\n"
            "                       [--filter box|bilinear|nearest|lanczos3] [--pbo N] [--queue N]\n"
-           "                       [--hashes FILE] [--backend egl|osmesa] [--quiet]\n"
+           "                       [--hashes FILE] [--backend egl|osmesa] [-q|-v]\n"
            "                       [-y|-n] [--format y4m|nut|mkv|mp4|webm] [--progress tty|plain|off]\n"
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
@@ -143,7 +144,7 @@ static void help(void)
            "  --progress MODE    tty: one line redrawn in place; plain: a line every 5 s and\n"
            "                     the last, for logs; off.  Default: tty when stderr is a\n"
            "                     terminal, else plain\n"
-           "  --quiet            no progress line (--progress off) and no summary\n"
+           CLI_LOG_HELP
            "\nThe replay's state-hash checkpoints are checked as the game runs: a replay that\n"
            "desyncs (inputs that no longer produce the recorded game) fails with the first\n"
            "tick that differs, and nothing is written.\n\n"
@@ -224,8 +225,7 @@ static const struct option opts[] = {
     {"render-size", required_argument, 0, 'r'}, {"capture", required_argument, 0, 'c'},
     {"downscale", required_argument, 0, 'd'},  {"pbo", required_argument, 0, 'p'},
     {"queue", required_argument, 0, 'Q'},      {"hashes", required_argument, 0, 'H'},
-    {"backend", required_argument, 0, 'b'},    {"quiet", no_argument, 0, 'q'},
-    {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
+    {"backend", required_argument, 0, 'b'},    {"filter", required_argument, 0, 'F'},    {"stage-file", required_argument, 0, 'T'},
     {"passes", optional_argument, 0, 'P'},     {"mask", no_argument, 0, 'M'},
     {"no-hud", no_argument, 0, 'U'},           {"hdr-format", required_argument, 0, 'X'},
     {"ticks", required_argument, 0, 'K'},      {"progress-fd", required_argument, 0, 'G'},
@@ -398,7 +398,6 @@ static int render_option(render_opts *o, int c, const char *arg, char **argv)
         o->segment = arg;
         return -1;
     case 'b': o->backend = arg; return -1;
-    case 'q': o->quiet = true; return -1;
     case 'G': return cli_int("--progress-fd", arg, 3, 1023, &o->progress_fd) ? -1 : RS_EXIT_USAGE;
     case 'h': help(); return RS_EXIT_OK;
     case 'y': o->overwrite = true; return -1;
@@ -493,10 +492,11 @@ static int parse_options(int argc, char **argv, render_opts *o)
 {
     *o = (render_opts){.progress = RS_PROGRESS_AUTO, .cd = {.w = 640, .h = 360}, .quality = &r_presets[R_PRESET_DEFAULT],
                        .end = -1, .progress_fd = -1, .from = -1, .to = -1, .duration = -1};
+    o->quiet = !rs_log_on(RS_LOG_INFO); /* -q, --loglevel (main took them) */
     int c, status;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1)
+    while ((c = getopt_long(argc, argv, "o:hyn", opts, NULL)) != -1)
         if ((status = render_option(o, c, optarg, argv)) >= 0)
             return status;
     if (optind + 1 != argc) {
@@ -570,7 +570,9 @@ static int prepare(render_run *run)
         return RS_EXIT_USAGE;
     }
     if (o->end > (long)run->rp.ticks) { /* as ffmpeg's -t past the end: clamped, with a word */
-        if (o->ticks_given)
+        if (!rs_log_on(RS_LOG_WARNING))
+            ;
+        else if (o->ticks_given)
             fprintf(stderr, "ringside render: --ticks %ld:%ld: the replay ends at tick %" PRIu64 ", so ticks %ld:%" PRIu64
                             " are drawn\n",
                     o->first, o->end, run->rp.ticks, o->first, run->rp.ticks);
@@ -599,7 +601,7 @@ static int prepare(render_run *run)
     if (!cap_sink_encoder(&run->sink, &o->enc, err))
         return err->code == CAP_ERR_ENC_SETTING ? RS_EXIT_USAGE : RS_EXIT_FAIL;
     if (run->sink.enc_note[0])
-        fprintf(stderr, "ringside render: %s\n", run->sink.enc_note); /* once: the choice is made here, for the whole run */
+        cli_info("render", "%s", run->sink.enc_note); /* once: the choice is made here, for the whole run */
     /* --jobs: segments drawn at once by processes of their own, then joined
      * (job_split.h), where the output can be joined */
     return plan_split(run);
@@ -650,7 +652,7 @@ static int render_split(render_run *run, int argc, char **argv)
     const char *pass[96];
     int np = 0, c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "o:qhyn", opts, NULL)) != -1 && np < 94) {
+    while ((c = getopt_long(argc, argv, "o:hyn", opts, NULL)) != -1 && np < 94) {
         if (!for_segments(c))
             continue;
         for (const struct option *op = opts; op->name; op++)
@@ -663,6 +665,10 @@ static int render_split(render_run *run, int argc, char **argv)
                     pass[np++] = optarg;
                 break;
             }
+    }
+    if (rs_log_explicit && np < 94) { /* main took --loglevel from argv: the segments say as much (or as little) */
+        pass[np++] = "--loglevel";
+        pass[np++] = rs_log_name(rs_log_level);
     }
     pass[np] = NULL;
     char exe[1100], what[160];
@@ -726,7 +732,7 @@ static bool draw_frames(render_run *run, cap *cp, job_render *j, double *secs)
     return ok;
 }
 
-/* The lines a finished render prints (not with --quiet). */
+/* The lines a finished render prints (at the info level). */
 static void summary(const render_run *run, const cap_stats *st, const job_render *j, double secs)
 {
     const render_opts *o = run->o;
@@ -763,11 +769,16 @@ static int render_here(render_run *run)
     o->cd.hashes_name = o->hashes;
     if (!job_audio_plan(&o->audio, &run->sink, &run->rp, o->replay, run->first, run->end, err))
         return RS_EXIT_FAIL;
+    double t0 = rs_now();
     if (!run->p && !(run->p = plat_create(&(plat_desc){.backend = o->backend, .hidden = true}, err)))
         return cli_plat_status(err);
+    double t1 = rs_now();
     if (!(run->r = r_game_create_opts(&o->go, err)) || !r_game_prepare(run->r, run->rp.stage, err) ||
         !r_target_create(&run->t, o->cd.src_w, o->cd.src_h, err))
         return RS_EXIT_FAIL;
+    cli_debug("render", "GL: %s (%s), %s, %s; start-up %.3f s: context %.3f s, renderer and stage %.3f s",
+              plat_backend_name(run->p), plat_detail(run->p), glcaps.renderer, glcaps.version, rs_now() - t0, t1 - t0,
+              rs_now() - t1);
     if (o->passes)
         r_game_passes(run->r, o->passes == 2, stderr);
     cap *cp = cap_open(&o->cd, &run->sink, err);
@@ -783,9 +794,9 @@ static int render_here(render_run *run)
         return RS_EXIT_FAIL;
     if (!o->quiet)
         summary(run, &st, &j, secs);
-    /* a poster asked for and not written says so, even with --quiet (a
+    /* a poster asked for and not written says so, even without the summary (a
      * segment's is skipped on purpose: the segment that draws it writes it) */
-    if (o->poster && !run->poster.due && !o->segment)
+    if (o->poster && !run->poster.due && !o->segment && rs_log_on(RS_LOG_WARNING))
         fprintf(stderr,
                 "ringside render: --poster %s: not written: its frame, tick %" PRIu64 " (%s), is outside --ticks %" PRIu64
                 ":%" PRIu64 "\n",

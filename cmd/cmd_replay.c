@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "job_poster.h"
 #include "../runtime/audio/au.h"
 #include "../runtime/replay/rp.h"
@@ -18,7 +19,7 @@
 static void help(void)
 {
     printf("usage: ringside replay info FILE\n"
-           "       ringside replay verify FILE [--hashes OUT] [-y|-n] [--progress tty|plain|off] [--quiet]\n"
+           "       ringside replay verify FILE [--hashes OUT] [-y|-n] [--progress tty|plain|off] [-q|-v]\n"
            "       ringside replay sound FILE -o OUT.wav [--ticks A:B] [--loudness LUFS|off] [--float] [-y|-n]\n"
            "       ringside replay events FILE [--ticks A:B]\n\n"
            "info    prints the header: stage, seed, duration, players, winner, sizes.\n"
@@ -35,7 +36,7 @@ static void help(void)
            "  -y, -n        replace an existing OUT, or refuse it, naming it (the default)\n"
            "  --progress M  tty (a line redrawn in place), plain (a line every 5 s and the\n"
            "                last, for logs) or off; default tty on a terminal, else plain\n"
-           "  --quiet       no progress line\n"
+           CLI_LOG_HELP
            "  -o OUT.wav    the WAV to write ('-' for stdout)\n"
            "  --ticks A:B   only ticks A to B-1 (default: the whole replay)\n"
            "  --loudness L  integrated loudness target in LUFS, -70..0 (default -16; true\n"
@@ -140,21 +141,20 @@ static int verify(const char *path, const char *hashes_path, bool overwrite, rs_
     if (!ran) {
         cli_error("replay", "%s: %s", path, err.msg);
     } else if (res.header_mismatch) {
-        fprintf(stderr,
+        if (rs_log_on(RS_LOG_ERROR))
+            fprintf(stderr,
                 "ringside replay: %s: the header says winner %d, rounds %d-%d, but the simulation gives winner %d, "
                 "rounds %d-%d (byte 32; the inputs themselves verify)\n",
                 path, rp.winner, rp.rounds[0], rp.rounds[1], res.winner, res.rounds[0], res.rounds[1]);
     } else if (!res.ok) {
         char what[400];
         rp_desync_text(&res, what, sizeof what);
-        fprintf(stderr, "ringside replay: %s: %s\n", path, what);
+        cli_error("replay", "%s: %s", path, what);
     } else {
         char win[64];
         winner_text(res.winner, res.rounds, win, sizeof win);
-        fprintf(stderr,
-                "ringside replay: %s: ok: %" PRIu64 " ticks, %zu checkpoints and the final hash match; winner %s "
-                "(%.0f ticks/s)\n",
-                path, rp.ticks, rp.ncheck, win, secs > 0 ? rp.ticks / secs : 0.0);
+        cli_info("replay", "%s: ok: %" PRIu64 " ticks, %zu checkpoints and the final hash match; winner %s (%.0f ticks/s)",
+                 path, rp.ticks, rp.ncheck, win, secs > 0 ? rp.ticks / secs : 0.0);
         status = RS_EXIT_OK;
     }
     rp_free(&rp);
@@ -230,7 +230,9 @@ static int sound(const char *path, const char *out, uint64_t first, uint64_t end
     if (!ok) {
         cli_error("replay", "%s", err.msg);
     } else {
-        if (isnan(lufs))
+        if (!rs_log_on(RS_LOG_INFO))
+            ;
+        else if (isnan(lufs))
             fprintf(stderr, "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames, not normalized\n", out,
                     t->first, t->end, t->frames);
         else
@@ -298,14 +300,14 @@ int cmd_replay(int argc, char **argv)
         return RS_EXIT_USAGE;
     }
     static const struct option opts[] = {
-        {"hashes", required_argument, 0, 'H'}, {"quiet", no_argument, 0, 'q'}, {"help", no_argument, 0, 'h'},
+        {"hashes", required_argument, 0, 'H'}, {"help", no_argument, 0, 'h'},
         {"overwrite", no_argument, 0, 'y'},   {"no-overwrite", no_argument, 0, 'n'},
         {"progress", required_argument, 0, 'g'}, {"output", required_argument, 0, 'o'},
         {"ticks", required_argument, 0, 'K'},     {"loudness", required_argument, 0, 'L'},
         {"float", no_argument, 0, 'F'},          {0}};
     const char *hashes = NULL;
     const char *out = NULL;
-    bool quiet = false, overwrite = false, float32 = false, any_sound_opt = false;
+    bool quiet = !rs_log_on(RS_LOG_INFO), overwrite = false, float32 = false, any_sound_opt = false;
     uint64_t first = 0, end = 0;
     double lufs = 0;
     int progress = RS_PROGRESS_AUTO;
@@ -315,7 +317,6 @@ int cmd_replay(int argc, char **argv)
     while ((c = getopt_long(argc - 1, argv + 1, "qhyno:", opts, NULL)) != -1) {
         switch (c) {
         case 'H': hashes = optarg; break;
-        case 'q': quiet = true; break;
         case 'y': overwrite = true; break;
         case 'n': overwrite = false; break;
         case 'g': if (!cli_progress_mode("replay", optarg, &progress)) return RS_EXIT_USAGE; break;

@@ -11,12 +11,13 @@
 
 #include "../service/svc.h"
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 
 static void help(void)
 {
     printf("usage: ringside serve [--config FILE] [--listen ADDR:PORT] [--workers N] [--data DIR]\n"
            "                      [--queue sqlite:PATH|postgres://...] [--output DIR] [--SETTING VALUE ...]\n"
-           "                      [--print-config]\n"
+           "                      [--print-config] [-q|-v]\n"
            "       ringside serve token add|list|revoke ...   (API tokens: 'ringside serve token --help')\n"
            "       ringside serve routes                    (the HTTP API's routes, from its route table)\n\n"
            "The replay-to-video service: an HTTP API and dashboard, a durable job queue and\n"
@@ -34,6 +35,8 @@ static void help(void)
            "  --config FILE    settings file: 'name = value' lines, # comments; the options\n"
            "                   below override it\n"
            "  --print-config   print every setting's value after the file and options, and exit\n"
+           CLI_LOG_HELP
+           "                   (the daemon's log_level; --log-level and the config file win)\n"
            "\nSettings (as --name or --name-with-dashes on the command line):\n");
     svc_config_print_table(stdout);
     printf("\nAPI tokens: 'ringside serve token --help'.  A daemon listening beyond loopback\n"
@@ -51,7 +54,7 @@ static void help(void)
 
 static void token_help(void)
 {
-    printf("usage: ringside serve token add NAME [--operator] [--max-queued N] [--seconds-per-hour N]\n"
+    printf("usage: ringside serve token add NAME [--operator] [--max-queued N] [--seconds-per-hour N] [-q|-v]\n"
            "       ringside serve token list\n"
            "       ringside serve token revoke NAME|ID\n"
            "       (each also takes serve's --config FILE, --data DIR and --queue Q: the queue they act on)\n\n"
@@ -64,6 +67,7 @@ static void token_help(void)
            "                         default: the setting token_max_queued)\n"
            "  --seconds-per-hour N   game seconds it may submit in any hour (0: no cap;\n"
            "                         default: the setting token_seconds_per_hour)\n"
+           CLI_LOG_HELP
            "\nexit status: 0 done, 1 failed (no such token, a name taken, the queue), 2 bad usage\n");
 }
 
@@ -145,6 +149,12 @@ static int read_settings(int argc, char **argv, svc_config *cfg, bool *print, to
     const struct option *opts = serve_opts;
     svc_config_defaults(cfg);
     rs_err err = {0};
+    /* the global --loglevel / -q / -v as the daemon's log_level: a default
+     * that --config and --log-level still override */
+    if (rs_log_explicit) {
+        static const char *const as_setting[] = {"error", "error", "warn", "info", "debug"};
+        svc_config_set(cfg, "log_level", as_setting[rs_log_level], &err);
+    }
     int c, idx;
     /* pass 1: --help, --config */
     optind = 1;

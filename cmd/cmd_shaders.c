@@ -6,13 +6,14 @@
 #include <string.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_shader.h"
 #include "../runtime/util/rs_file.h"
 
 static void help(void)
 {
-    printf("usage: ringside shaders [--backend egl|osmesa|glfw] [--quiet] [--emit DIR]\n\n"
+    printf("usage: ringside shaders [--backend egl|osmesa|glfw] [-q|-v] [--emit DIR]\n\n"
            "Compiles every .vert, .frag, .geom and .comp file in the shaders directory\n"
            "(found through RINGSIDE_DATA, the source tree or the install prefix) and\n"
            "prints each error as shaders/FILE:LINE: message.  .glsl files are include\n"
@@ -21,7 +22,7 @@ static void help(void)
            "and then '#define B 1' and '#define C 1' ('-' is the variant with none).\n"
            "Exit status 1 if any shader fails.\n\n"
            "  --backend B   GL backend (default egl, falling back to osmesa)\n"
-           "  --quiet       print only failures\n"
+           CLI_LOG_HELP
            "  --emit DIR    compile nothing: write each variant's whole source, as the\n"
            "                driver is given it (includes and defines in place), to\n"
            "                DIR/NAME.VARIANT.EXT, for another compiler (the tests run\n"
@@ -74,20 +75,18 @@ static int emit_all(const char *root, char **names, int n, const char *dir, bool
 int cmd_shaders(int argc, char **argv)
 {
     static const struct option opts[] = {{"backend", required_argument, 0, 'b'},
-                                         {"quiet", no_argument, 0, 'q'},
                                          {"help", no_argument, 0, 'h'},
                                          {"emit", required_argument, 0, 'e'},
                                          {0}};
     plat_desc d = {.hidden = true};
-    bool quiet = false;
+    bool quiet = !rs_log_on(RS_LOG_INFO);
     const char *emit = NULL;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
         case 'b': d.backend = optarg; break;
-        case 'q': quiet = true; break;
         case 'e': emit = optarg; break;
         case 'h': help(); return RS_EXIT_OK;
         default: return cli_bad_option("shaders", argv);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/render/r_smoke.h"
 #include "../runtime/util/rs_file.h"
@@ -14,7 +15,8 @@
 
 static void help(void)
 {
-    printf("usage: ringside smoke [-o FILE] [-y|-n] [--size WxH] [--backend egl|osmesa|glfw] [--no-check]\n\n"
+    printf("usage: ringside smoke [-o FILE] [-y|-n] [--size WxH] [--backend egl|osmesa|glfw] [--no-check]\n"
+           "                      [-q|-v]\n\n"
            "Renders the smoke test scene headless through shaders/smoke.* and writes it\n"
            "as .png or .ppm.  The picture is compared with its exact CPU\n"
            "reference; if any pixel differs, nothing is written and the exit status is 1.\n\n"
@@ -24,7 +26,8 @@ static void help(void)
            "  -n             refuse an existing FILE, naming it (--no-overwrite; the default)\n"
            "  --size WxH     picture size (default 1280x720; %d..max texture size)\n"
            "  --backend B    GL backend (default egl, falling back to osmesa)\n"
-           "  --no-check     skip the comparison with the CPU reference\n",
+           "  --no-check     skip the comparison with the CPU reference\n"
+           CLI_LOG_HELP,
            R_SMOKE_MIN_SIZE);
 }
 
@@ -89,7 +92,8 @@ int cmd_smoke(int argc, char **argv)
         goto fail;
     }
     if (plat_fallback_reason(p)[0])
-        fprintf(stderr, "ringside smoke: egl unavailable, using %s: %s\n", plat_backend_name(p),
+        if (rs_log_on(RS_LOG_WARNING))
+            fprintf(stderr, "ringside smoke: egl unavailable, using %s: %s\n", plat_backend_name(p),
                 plat_fallback_reason(p));
     if (!(s = r_smoke_create(w, h, &err)))
         goto fail;
@@ -116,7 +120,8 @@ int cmd_smoke(int argc, char **argv)
     }
     if ((!named && !rs_mkdirs_for(out, &err)) || !rs_image_write(out, w, h, 4, px, &err))
         goto fail;
-    fprintf(stderr, "ringside smoke: wrote %s (%dx%d, %s%s)\n", out, w, h, plat_backend_name(p),
+    if (rs_log_on(RS_LOG_INFO))
+        fprintf(stderr, "ringside smoke: wrote %s (%dx%d, %s%s)\n", out, w, h, plat_backend_name(p),
             check ? ", matches the reference exactly" : "");
     status = RS_EXIT_OK;
 fail:

@@ -11,6 +11,7 @@
  * is left behind by a failure, a signal or a killed child. */
 #define _GNU_SOURCE /* pipe2, sched_getaffinity */
 #include "job_split.h"
+#include "../runtime/util/rs_log.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -448,7 +449,7 @@ int job_split_run(const job_split_desc *d, rs_err *err)
                 unlink(d->out);
                 goto done;
             }
-        } else if (!d->quiet) {
+        } else if (rs_log_on(RS_LOG_WARNING)) {
             fprintf(stderr, "ringside render: no poster written: its frame is outside --ticks %" PRIu64 ":%" PRIu64 "\n",
                     d->first, d->end);
         }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "../runtime/util/rs_log.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/util/rs_version.h"
 
@@ -37,6 +38,12 @@ static void usage(FILE *f)
         fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
     fprintf(f, "  %-9s %s\n", "help", "this text; 'ringside COMMAND --help' for one command");
     fprintf(f, "  %-9s %s\n", "version", "print the version");
+    fprintf(f, "\noptions every command takes, anywhere before --:\n"
+               "  -q, --quiet            warnings and errors only (--loglevel warning)\n"
+               "  -v, --verbose          everything (--loglevel debug): the GL driver, start-up\n"
+               "                         times, the encoder's own log\n"
+               "  --loglevel LEVEL       quiet (nothing: the exit status alone), error, warning,\n"
+               "                         info (the default: what was done, progress) or debug\n");
     fprintf(f, "\nGL backends built in: %s (headless default: egl, then osmesa)\n"
                "\nenvironment:\n"
                "  RINGSIDE_DATA          the directory holding shaders/ and stages/ (default: found\n"
@@ -74,6 +81,8 @@ static void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
+    if (!cli_log_options(&argc, argv))
+        return RS_EXIT_USAGE;
     if (argc < 2) {
         usage(stderr);
         return RS_EXIT_USAGE;
@@ -99,6 +108,7 @@ int main(int argc, char **argv)
             cli_command = name;
             return commands[i].run(argc - 1, argv + 1);
         }
-    fprintf(stderr, "ringside: unknown command '%s' (see 'ringside --help')\n", name);
+    if (rs_log_on(RS_LOG_ERROR))
+        fprintf(stderr, "ringside: unknown command '%s' (see 'ringside --help')\n", name);
     return RS_EXIT_USAGE;
 }

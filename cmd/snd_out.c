@@ -1,5 +1,6 @@
 /* movie's and attract's sound options and output (snd_out.h). */
 #include "snd_out.h"
+#include "../runtime/util/rs_log.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,13 +44,13 @@ au_out *snd_open(const char *cmd, const snd_opts *o, bool headless, bool overwri
         return NULL;
     au_out *out = au_out_open(&(au_out_opts){.backend = AU_OUT_OPENAL, .device = o->device, .volume = o->volume}, &err);
     if (!out)
-        fprintf(stderr, "ringside %s: warning: %s; running silent\n", cmd, err.msg);
+        cli_warn(cmd, "%s; running silent", err.msg);
     return out;
 }
 
 void snd_summary(const char *cmd, const au_out *out, const char *source)
 {
-    if (!out)
+    if (!out || !rs_log_on(RS_LOG_INFO))
         return;
     au_out_stats st;
     au_out_stats_get(out, &st);

@@ -188,7 +188,59 @@ t_help_lists_every_subcommand() {
     done
 }
 
-t_run help_lists_every_subcommand oiio_loaded_when_used help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
+# --loglevel, -q and -v: every command takes them anywhere on its line, and
+# each level shows what it says and no more (README, "How much a command says")
+t_loglevel_on_every_command() {
+    "$RS_BIN" --help >top.txt
+    for cmd in $(sed -n '/^commands:/,/^$/p' top.txt | awk '/^  [a-z]/ { print $1 }' | grep -v '^help$\|^version$') \
+        "bench sim" "bench capture" "bench accuracy" "bench upload" "bench encode" "bench audio" "bench quality" \
+        "replay verify" "serve token"; do
+        # shellcheck disable=SC2086
+        "$RS_BIN" $cmd --loglevel warning --help >h.txt 2>&1 || { echo "$cmd --loglevel warning --help failed"; cat h.txt; return 1; }
+        grep -q -- "--loglevel LEVEL" h.txt || { echo "$cmd --help does not list --loglevel"; return 1; }
+    done
+    grep -q -- "--loglevel LEVEL" top.txt || return 1
+    expect_fail 2 "--loglevel 'loud': expected quiet, error, warning, info or debug" \
+        "$RS_BIN" render x.rsr -o x.y4m --loglevel loud || return 1
+    "$RS_BIN" record --ai --seconds 1 --seed 3 -o m.rsr 2>rec.txt || return 1
+    grep -q "ringside record: wrote m.rsr" rec.txt || { cat rec.txt; return 1; }
+    "$RS_BIN" record --ai --seconds 1 --seed 3 -o m2.rsr -q 2>rec.txt || return 1
+    [ ! -s rec.txt ] || { echo "record -q said:"; cat rec.txt; return 1; }
+    r="render m.rsr --size 160x90 --ticks 0:30 -y"
+    # shellcheck disable=SC2086
+    "$RS_BIN" $r -o a.y4m 2>info.txt || return 1
+    grep -q "ringside render: wrote a.y4m" info.txt || { cat info.txt; return 1; }
+    ! grep -q "ringside render: GL: " info.txt || { echo "a debug line at info"; return 1; }
+    for q in "-q" "--quiet" "--loglevel error" "--loglevel=warning" "--loglevel quiet"; do
+        # shellcheck disable=SC2086
+        "$RS_BIN" $r -o a.y4m $q 2>q.txt || return 1
+        [ ! -s q.txt ] || { echo "render $q said:"; cat q.txt; return 1; }
+    done
+    # before the command too, and for a split render's segments
+    # shellcheck disable=SC2086
+    "$RS_BIN" -q $r -o a.mp4 --jobs 2 2>q.txt || return 1
+    [ ! -s q.txt ] || { echo "render --jobs 2 -q said:"; cat q.txt; return 1; }
+    # shellcheck disable=SC2086
+    "$RS_BIN" $r -o a.y4m -v 2>v.txt || return 1
+    grep -q "ringside render: GL: .*start-up [0-9.]* s" v.txt || { echo "no debug line with -v"; cat v.txt; return 1; }
+    grep -q "ringside render: wrote a.y4m" v.txt || return 1
+    # a warning: shown with -q (warning), not at error
+    # shellcheck disable=SC2086
+    "$RS_BIN" render m.rsr --size 160x90 -y -o a.y4m --ticks 0:9999 -q 2>w.txt || return 1
+    grep -q "the replay ends at tick 60" w.txt && ! grep -q "wrote a.y4m" w.txt || { cat w.txt; return 1; }
+    # shellcheck disable=SC2086
+    "$RS_BIN" render m.rsr --size 160x90 -y -o a.y4m --ticks 0:9999 --loglevel error 2>w.txt || return 1
+    [ ! -s w.txt ] || { cat w.txt; return 1; }
+    # errors: shown with -q and at error, not with quiet; the status is the same
+    "$RS_BIN" render nope.rsr -o a.y4m -q 2>e.txt
+    [ $? = 1 ] && grep -q "nope.rsr: cannot open" e.txt || { cat e.txt; return 1; }
+    "$RS_BIN" render nope.rsr -o a.y4m --loglevel quiet 2>e.txt
+    [ $? = 1 ] && [ ! -s e.txt ] || { echo "quiet said:"; cat e.txt; return 1; }
+    "$RS_BIN" replay verify m.rsr -q 2>e.txt && [ ! -s e.txt ] || { cat e.txt; return 1; }
+    "$RS_BIN" replay verify m.rsr 2>e.txt && grep -q "m.rsr: ok" e.txt || { cat e.txt; return 1; }
+}
+
+t_run help_lists_every_subcommand loglevel_on_every_command oiio_loaded_when_used help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \
     smoke_both_backends broken_shader_names_file_line wrong_picture_is_caught missing_data_dir \
     bench_platform
 t_done

@@ -21,7 +21,7 @@ t_demos_are_current() {
         "$RS_BIN" record --ai --quiet --stage "$stage" --seed "$seed" -o "$stage.rsr" 2>/dev/null || return 1
         cmp "$stage.rsr" "$SRC/demos/$stage.rsr" ||
             { echo "demos/$stage.rsr is stale: run 'make demo-replays' and commit"; return 1; }
-        "$RS_BIN" replay verify --quiet "$SRC/demos/$stage.rsr" 2>v.txt || { cat v.txt; return 1; }
+        "$RS_BIN" replay verify --progress off "$SRC/demos/$stage.rsr" 2>v.txt || { cat v.txt; return 1; }
         grep -q "ok: .* checkpoints and the final hash match" v.txt || { cat v.txt; return 1; }
     done
 }

@@ -13,6 +13,7 @@
 #include "r_tex.h"
 #include "r_tone.h"
 #include "r_local.h"
+#include "../util/rs_log.h"
 
 static bool build_look_programs(r_game *r, rs_err *err);
 
@@ -75,7 +76,7 @@ static bool load_look(r_game *r, const r_stage *st, int game_stage, rs_err *err)
         }
         return false;
     }
-    if (!r->opts.quiet && !ibl.from_cache && ibl.ms > 500)
+    if (!r->opts.quiet && !ibl.from_cache && ibl.ms > 500 && rs_log_on(RS_LOG_INFO))
         fprintf(stderr, "ringside: %s: prefiltered the environment in %.1f s (cached for next time)\n", st->name,
                 ibl.ms / 1000);
     for (int m = 0; m < R_IBL_MAPS; m++)

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "../util/rs_file.h"
+#include "../util/rs_log.h"
 
 /* ---------- the cache key ---------- */
 
@@ -222,7 +223,7 @@ void r_ibl_cache_write(const char *path, const r_ibl_params *p, const r_ibl *ibl
         fnv(&h, buf, (size_t)(b - buf));
         put_u64(b, h);
     }
-    if (!buf || !rs_mkdirs_for(path, &e) || !write_unique(path, buf, len, &e))
+    if ((!buf || !rs_mkdirs_for(path, &e) || !write_unique(path, buf, len, &e)) && rs_log_on(RS_LOG_WARNING))
         fprintf(stderr, "ringside: warning: %s (IBL cache not saved; going on without it)\n", e.msg);
     free(buf);
 }
@@ -295,7 +296,8 @@ bool r_ibl_cache_read(const char *path, const r_ibl_params *p, uint64_t hash, r_
     else
         why = cache_check(b, len, want, p, hash, whyb, sizeof whyb);
     if (why) {
-        fprintf(stderr, "ringside: %s: corrupt IBL cache (%s); rebuilding\n", path, why);
+        if (rs_log_on(RS_LOG_WARNING))
+            fprintf(stderr, "ringside: %s: corrupt IBL cache (%s); rebuilding\n", path, why);
         free(b);
         return false;
     }

@@ -1,6 +1,7 @@
 /* Progress lines on stderr (rs_progress.h): tty redraws one line, plain
  * appends one every few seconds. */
 #include "rs_progress.h"
+#include "rs_log.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,7 +37,10 @@ void rs_progress_start(rs_progress *p, const char *label, const char *unit, uint
     p->label = label;
     p->unit = unit;
     p->total = total;
-    p->mode = mode != RS_PROGRESS_AUTO ? mode : isatty(2) ? RS_PROGRESS_TTY : RS_PROGRESS_PLAIN;
+    p->mode = !rs_log_on(RS_LOG_INFO) ? RS_PROGRESS_OFF /* -q, --loglevel error */
+              : mode != RS_PROGRESS_AUTO ? mode
+              : isatty(2) ? RS_PROGRESS_TTY
+                          : RS_PROGRESS_PLAIN;
     p->start = p->last = rs_now();
     p->interval = 5;
     const char *env = getenv("RS_PROGRESS_INTERVAL"); /* tests shorten it */
