@@ -155,7 +155,7 @@ t_outputs_on_a_full_disk() {
         { t_skip_env "cannot mount a tmpfs here ($(head -c 120 mount.err))"; return 0; }
     echo keep >full/keep.txt
     head -c 110k /dev/zero >full/filler # about 50 KiB left: a frame or two
-    for out in full/f%04d.png full/f%04d.exr full/f%04d.tif full/v.mp4 full/v.y4m; do
+    for out in full/f%04d.png full/f%04d.exr full/f%04d.tif full/v.mp4 full/v.y4m full/v.webm full/v.mkv full/v.nut; do
         case $out in *%*) what="--ticks 0:40 --size 320x180" ;; *) what="--ticks 0:120 --size 640x360" ;; esac
         "$RS_BIN" render short.rsr $what -q -o "$out" 2>err.txt
         rc=$?
@@ -166,6 +166,22 @@ t_outputs_on_a_full_disk() {
         case $out in *%*) grep -q "^ringside render: full/f00[0-9][0-9]\.[a-z]*: cannot write frame [0-9]*: No space left on device" err.txt ||
             { echo "$out:"; cat err.txt; umount full; return 1; } ;; esac
     done
+    # the stream: a full disk behind standard output is a write error on it
+    "$RS_BIN" render short.rsr --ticks 0:120 --size 640x360 -q -o - >full/stream.y4m 2>err.txt
+    rc=$?
+    rm -f full/stream.y4m # the shell's file, not ours
+    [ $rc = 1 ] && grep -q "^ringside render: standard output: .*No space left on device" err.txt ||
+        { echo "-o - on a full disk: exit $rc"; cat err.txt; umount full; return 1; }
+    # the join: segments made elsewhere, joined onto the full disk
+    for r in 0:60 60:120; do
+        "$RS_BIN" render short.rsr --ticks "$r" --size 640x360 -q --segment fulljob -y -o "s${r%:*}.mp4" 2>err.txt ||
+            { cat err.txt; umount full; return 1; }
+    done
+    "$RS_BIN" join --segment fulljob -q -o full/j.mp4 s0.mp4 s60.mp4 2>err.txt
+    rc=$?
+    left=$(ls -A full | grep -Ev '^(keep.txt|filler)$' | tr '\n' ' ')
+    [ $rc = 1 ] && [ -z "$left" ] && grep -q "^ringside join: full/j.mp4: .*No space left on device" err.txt ||
+        { echo "join on a full disk: exit $rc, left: '$left'"; cat err.txt; umount full; return 1; }
     # a side output that cannot be written takes the video with it
     : >full/filler2
     head -c 200k /dev/zero >>full/filler2 2>/dev/null # now nothing is left
