@@ -1,6 +1,6 @@
 /* libFuzzer target for the replay reader: `make fuzz` builds it,
  * `make fuzz-run FUZZ_SECONDS=600` runs it on the demo replays as seeds.
- * The seeds hold both formats (the format-2 demos, with the game version,
+ * The seeds hold two formats (the format-3 demos, with the game version,
  * and tests/golden/dojo-format1.rsr without).  A decoded replay is also
  * verified (as this build's game, whatever game version it records, so the
  * simulation sees every input the parser accepts), and whatever is accepted

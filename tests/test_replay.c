@@ -110,10 +110,11 @@ static void t_corruption_cases(void)
     uint8_t *g;
     size_t n;
     encode(&rp, &g, &n);
-    const uint8_t v3[2] = {3, 0}, zero4[4] = {0}, zero8[8] = {0}, big8[8] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0, 0};
+    const uint8_t v4[2] = {4, 0}, v0[2] = {0, 0}, zero4[4] = {0}, zero8[8] = {0}, big8[8] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0, 0};
     const uint8_t st99[4] = {99, 0, 0, 0}, iv0[2] = {0, 0}, k3 = 3, w7 = 7, flag[2] = {1, 0}, r9 = 9;
     expect_bad(g, n, 0, "RSRQ", 4, false, RP_ERR_MAGIC, "not a ringside replay", "byte 0");
-    expect_bad(g, n, 4, v3, 2, false, RP_ERR_VERSION, "format version 3 at byte 4", "this build reads 1 and 2");
+    expect_bad(g, n, 4, v4, 2, false, RP_ERR_VERSION, "format version 4 at byte 4", "this build reads 1 to 3");
+    expect_bad(g, n, 4, v0, 2, false, RP_ERR_VERSION, "format version 0 at byte 4", "this build reads 1 to 3");
     expect_bad(g, n, 100, "\xAA", 1, false, RP_ERR_CHECKSUM, "checksum mismatch", "file damaged");
     expect_bad(g, n, 6, flag, 2, true, RP_ERR_FIELD, "unknown flags", "byte 6");
     expect_bad(g, n, 8, st99, 4, true, RP_ERR_FIELD, "stage id 99 at byte 8", NULL);
@@ -365,7 +366,8 @@ static void t_demos_verify(void)
 }
 
 /* A format-1 file (the demos before the game version: tests/golden keeps
- * dojo as it was) reads as the same match as its format-2 successor,
+ * dojo as it was) reads as the same match as today's demo (its hashes the
+ * same state hashes, which format 3 keys with the kinds),
  * records no game version, verifies, and re-encodes to itself byte for
  * byte; its own field offsets (input section at 40) are still checked. */
 static void t_format1_still_read(void)
@@ -382,8 +384,10 @@ static void t_format1_still_read(void)
     T_EQ(b.version, RP_VERSION);
     T_EQ(b.game_version, G_GAME_VERSION);
     T_ASSERT(a.stage == b.stage && a.seed == b.seed && a.ticks == b.ticks && a.winner == b.winner &&
-             a.final_hash == b.final_hash && a.ncheck == b.ncheck && a.input_bytes == b.input_bytes);
-    T_ASSERT(!memcmp(a.inputs, b.inputs, (size_t)a.ticks * 2) && !memcmp(a.checkpoints, b.checkpoints, a.ncheck * 8));
+             a.final_hash == rp_recorded_hash(&b, b.final_hash) && a.ncheck == b.ncheck && a.input_bytes == b.input_bytes);
+    T_ASSERT(!memcmp(a.inputs, b.inputs, (size_t)a.ticks * 2));
+    for (size_t k = 0; k < a.ncheck; k++)
+        T_ASSERTF(a.checkpoints[k] == rp_recorded_hash(&b, b.checkpoints[k]), "checkpoint %zu", k);
     rp_verify_result res;
     T_ASSERTF(rp_verify(&a, NULL, NULL, NULL, &res, &e) && res.ok, "%s", e.msg);
     uint8_t *re;
@@ -451,11 +455,12 @@ static void t_game_version_pinned_to_rules(void)
     } pin = {1, 0x56d8bf9bdcd7e1d4ull};
     rp_replay rp;
     record(&rp, 1, 0, 600);
-    T_ASSERTF(G_GAME_VERSION != pin.game_version || rp.final_hash == pin.hash,
+    uint64_t state = rp_recorded_hash(&rp, rp.final_hash); /* the game's own hash, whatever the format keys it with */
+    T_ASSERTF(G_GAME_VERSION != pin.game_version || state == pin.hash,
               "the rules changed (hash %016llx, pinned %016llx) but G_GAME_VERSION is still %d: bump it",
-              (unsigned long long)rp.final_hash, (unsigned long long)pin.hash, G_GAME_VERSION);
+              (unsigned long long)state, (unsigned long long)pin.hash, G_GAME_VERSION);
     T_ASSERTF(G_GAME_VERSION == pin.game_version, "G_GAME_VERSION %d: pin its hash %016llx here", G_GAME_VERSION,
-              (unsigned long long)rp.final_hash);
+              (unsigned long long)state);
     rp_free(&rp);
 }
 
@@ -495,7 +500,59 @@ static void t_check_tick_agrees_with_verify(void)
     rp_free(&rp);
 }
 
-T_MAIN({"roundtrip", t_roundtrip}, {"three_minutes_under_16k", t_three_minutes_under_16k},
+/* Format 3 binds the header's player kinds into the hashes: a CPU player
+ * relabelled human, with the CRC made right again, no longer verifies, and
+ * the message says which kinds it was recorded with; format 2 (kinds not
+ * bound) still verifies, and re-keying the hashes is all a format change is. */
+static void t_kinds_bound_to_hashes(void)
+{
+    rp_replay rp;
+    record(&rp, 5, 0, 300);
+    T_EQ(rp.version, 3);
+    uint8_t *g;
+    size_t n;
+    encode(&rp, &g, &n);
+    g[30] = RP_HUMAN; /* P1 relabelled */
+    uint32_t c = rs_crc32(0, g, n - 4);
+    for (int i = 0; i < 4; i++)
+        g[n - 4 + (size_t)i] = (uint8_t)(c >> (8 * i));
+    rp_replay back;
+    rs_err e = {0};
+    T_ASSERTF(rp_decode(g, n, "x.rsr", &back, &e), "%s", e.msg);
+    rp_verify_result res;
+    T_ASSERT(rp_verify(&back, NULL, NULL, NULL, &res, &e));
+    T_ASSERT(!res.ok && res.kinds_altered && res.kinds_recorded[0] == RP_CPU && res.kinds_recorded[1] == RP_CPU);
+    char why[300];
+    rp_desync_text(&res, why, sizeof why);
+    T_ASSERTF(strstr(why, "not the ones it was recorded with (P1 cpu, P2 cpu)"), "%s", why);
+    /* the renderer's tick-by-tick check says the same */
+    g_state st;
+    g_init(&st, back.stage, back.seed);
+    size_t next = 0;
+    bool ok = true;
+    for (uint64_t t = 0; t < back.ticks && ok; t++) {
+        g_step(&st, &back.inputs[2 * t], NULL);
+        ok = rp_check_tick(&back, &st, t + 1, &next, "x.rsr", &e);
+    }
+    T_ASSERTF(!ok && strstr(e.msg, "the header was altered"), "%s", e.msg);
+    rp_free(&back);
+    free(g);
+    /* the same match as format 2: the state hashes themselves, kinds free */
+    rp_replay v2 = rp, was = rp;
+    v2.version = 2;
+    v2.checkpoints = malloc(rp.ncheck * 8);
+    for (size_t k = 0; k < rp.ncheck; k++)
+        v2.checkpoints[k] = rp_recorded_hash(&v2, rp_recorded_hash(&was, rp.checkpoints[k]));
+    v2.final_hash = rp_recorded_hash(&v2, rp_recorded_hash(&was, rp.final_hash));
+    T_ASSERT(v2.final_hash != rp.final_hash);
+    T_ASSERT(rp_verify(&v2, NULL, NULL, NULL, &res, &e) && res.ok);
+    v2.kind[0] = RP_HUMAN;
+    T_ASSERT(rp_verify(&v2, NULL, NULL, NULL, &res, &e) && res.ok);
+    free(v2.checkpoints);
+    rp_free(&rp);
+}
+
+T_MAIN({"kinds_bound_to_hashes", t_kinds_bound_to_hashes}, {"roundtrip", t_roundtrip}, {"three_minutes_under_16k", t_three_minutes_under_16k},
        {"corruption_cases", t_corruption_cases}, {"oversized_file", t_oversized_file},
        {"random_corruption", t_random_corruption},
        {"flipped_input_desyncs_at_its_checkpoint", t_flipped_input_desyncs_at_its_checkpoint},

@@ -29,7 +29,7 @@ t_demos_are_current() {
 t_info() {
     "$RS_BIN" record --ai --quiet --seed 3 --stage harbor -o m.rsr 2>/dev/null || return 1
     "$RS_BIN" replay info m.rsr >i.txt || return 1
-    for k in "stage        1 (harbor)" "seed         3" "players      P1 cpu, P2 cpu" "format       version 2" \
+    for k in "stage        1 (harbor)" "seed         3" "players      P1 cpu, P2 cpu" "format       version 3" \
         "game         version 1 (this build: 1)" \
         "every 60 ticks"; do
         grep -q "$k" i.txt || { echo "info lacks '$k'"; cat i.txt; return 1; }
@@ -73,6 +73,20 @@ t_header_tampering_is_reported() {
     "$BIN_DIR/tests/simhash-O2" --winner 0 "$SRC/demos/dojo.rsr" lie.rsr || return 1
     expect_fail 1 "lie.rsr: the header says winner 0.*but the simulation gives winner" \
         "$RS_BIN" replay verify --quiet lie.rsr || return 1
+    # a CPU player relabelled human (byte 30), the CRC made right again:
+    # format 3's hashes carry the kinds, so verify, a render and an upload
+    # all refuse it and say what was done
+    python3 -c "
+import sys, zlib
+b = bytearray(open(sys.argv[1], 'rb').read())
+b[30] = 0
+b[-4:] = zlib.crc32(bytes(b[:-4])).to_bytes(4, 'little')
+open(sys.argv[2], 'wb').write(bytes(b))" "$SRC/demos/dojo.rsr" human.rsr || return 1
+    "$RS_BIN" replay info human.rsr | grep -q "P1 human, P2 cpu" || return 1
+    expect_fail 1 "human.rsr: the header's player kinds \\(bytes 30-31\\) are not the ones it was recorded with \\(P1 cpu, P2 cpu\\): the header was altered" \
+        "$RS_BIN" replay verify --quiet human.rsr || return 1
+    expect_fail 1 "human.rsr: the header's player kinds \\(P1 human, P2 cpu, bytes 30-31\\) are not the ones it was recorded with" \
+        "$RS_BIN" render human.rsr --ticks 0:61 --size 160x90 -o h.y4m || return 1
 }
 
 t_flipped_bit_reports_tick() {
@@ -103,9 +117,9 @@ t_bad_files() {
     expect_fail 1 "trunc.rsr: checksum mismatch at byte 96" "$RS_BIN" replay verify trunc.rsr || return 1
     : >empty.rsr
     expect_fail 1 "empty.rsr: not a ringside replay: expected \"RSRP\" at byte 0" "$RS_BIN" replay info empty.rsr || return 1
-    printf 'RSRP\003\000' >v3.rsr
-    expect_fail 1 "v3.rsr: format version 3 at byte 4 is not supported \\(this build reads 1 and 2\\)" \
-        "$RS_BIN" replay info v3.rsr || return 1
+    printf 'RSRP\004\000' >v4.rsr
+    expect_fail 1 "v4.rsr: format version 4 at byte 4 is not supported \\(this build reads 1 to 3\\)" \
+        "$RS_BIN" replay info v4.rsr || return 1
     # one flipped bit in the middle: the checksum catches it
     size=$(wc -c <good.rsr)
     dd if=good.rsr of=flip.rsr bs=1 count=$((size / 2)) 2>/dev/null
@@ -119,7 +133,7 @@ t_bad_files() {
 }
 
 # Format 1 (no game version) is still read: the demos as they were before
-# format 2 verify, and are the same match as today's demos.
+# format 3 verify, and are the same match as today's demos.
 t_format1_verifies() {
     "$RS_BIN" replay verify --quiet --hashes v1.txt "$SRC/tests/golden/dojo-format1.rsr" 2>v.txt || { cat v.txt; return 1; }
     "$RS_BIN" replay verify --quiet --hashes v2.txt "$SRC/demos/dojo.rsr" 2>/dev/null || return 1
@@ -127,7 +141,7 @@ t_format1_verifies() {
     "$RS_BIN" replay info "$SRC/tests/golden/dojo-format1.rsr" >i.txt || return 1
     grep -q "^game         none recorded (format 1: taken as this build's, 1)" i.txt || { cat i.txt; return 1; }
     "$BIN_DIR/tests/simhash-O2" --game-version 0 "$SRC/demos/dojo.rsr" back.rsr || return 1
-    cmp back.rsr "$SRC/tests/golden/dojo-format1.rsr" || { echo "format 2 -> 1 is not the old file"; return 1; }
+    cmp back.rsr "$SRC/tests/golden/dojo-format1.rsr" || { echo "format 3 -> 1 is not the old file"; return 1; }
 }
 
 # Three failures, three messages: another game version, damage, desync.

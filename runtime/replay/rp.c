@@ -96,10 +96,11 @@ static void encode_inputs(wbuf *w, const rp_replay *rp)
 bool rp_encode(const rp_replay *rp, uint8_t **out, size_t *len, rs_err *err)
 {
     wbuf w = {0};
-    /* the format the struct says: a format-1 replay re-encodes as it was read */
+    /* the format the struct says: a replay re-encodes as it was read (its
+     * hashes are of its format: rp_recorded_hash) */
     bool v1 = rp->version == 1;
     wb_put(&w, RP_MAGIC, 4);
-    wb_u(&w, v1 ? 1 : RP_VERSION, 2);
+    wb_u(&w, rp->version >= 1 && rp->version <= RP_VERSION ? (uint64_t)rp->version : RP_VERSION, 2);
     wb_u(&w, 0, 2); /* flags */
     wb_u(&w, (uint64_t)rp->stage, 4);
     wb_u(&w, rp->seed, 8);
@@ -202,8 +203,8 @@ static bool rd_frame(rbuf *r, rp_replay *rp)
         return rs_fail(err, RP_ERR_MAGIC, "%s: not a ringside replay: expected \"RSRP\" at byte 0", name);
     if (!rd_u(r, 4, &v, "magic") || !rd_u(r, 2, &v, "format version"))
         return false;
-    if (v != 1 && v != RP_VERSION)
-        return rs_fail(err, RP_ERR_VERSION, "%s: format version %llu at byte 4 is not supported (this build reads 1 and %d)",
+    if (v < 1 || v > RP_VERSION)
+        return rs_fail(err, RP_ERR_VERSION, "%s: format version %llu at byte 4 is not supported (this build reads 1 to %d)",
                        name, (unsigned long long)v, RP_VERSION);
     rp->version = (int)v;
     size_t header = v == 1 ? RP_HEADER_BYTES_V1 : RP_HEADER_BYTES;
@@ -517,7 +518,7 @@ bool rp_rec_tick(rp_recorder *r, const g_input in[2], const g_state *after, rs_e
     rp->inputs[2 * rp->ticks] = g_input_clean(in[0]);
     rp->inputs[2 * rp->ticks + 1] = g_input_clean(in[1]);
     rp->ticks++;
-    uint64_t h = g_hash(after);
+    uint64_t h = rp_recorded_hash(rp, g_hash(after));
     rp->final_hash = h;
     if (rp->ticks % (uint64_t)rp->interval == 0) {
         if (rp->ncheck == r->cap_check) {
@@ -549,6 +550,33 @@ bool rp_rec_save(rp_recorder *r, const char *path, rs_err *err)
 }
 
 /* ---------- verification ---------- */
+
+/* The key of a pair of player kinds (format 3): splitmix64 of the pair,
+ * never 0, different for each of the four pairs. */
+static uint64_t kinds_key(int k0, int k1)
+{
+    uint64_t z = 0x5253525020000000ull + (uint64_t)(k0 * 2 + k1 + 1) * 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (z ^ (z >> 31)) | 1;
+}
+
+uint64_t rp_recorded_hash(const rp_replay *rp, uint64_t state_hash)
+{
+    return rp->version >= 3 ? state_hash ^ kinds_key(rp->kind[0], rp->kind[1]) : state_hash;
+}
+
+/* A format-3 hash that does not match: do other player kinds make it match? */
+static bool kinds_that_match(const rp_replay *rp, uint64_t state_hash, uint64_t want, int kinds[2])
+{
+    for (int a = 0; rp->version >= 3 && a < 2; a++)
+        for (int b = 0; b < 2; b++)
+            if ((a != rp->kind[0] || b != rp->kind[1]) && (state_hash ^ kinds_key(a, b)) == want) {
+                kinds[0] = a, kinds[1] = b;
+                return true;
+            }
+    return false;
+}
 
 bool rp_check_game(const rp_replay *rp, const char *name, rs_err *err)
 {
@@ -583,21 +611,23 @@ bool rp_verify(const rp_replay *rp, FILE *hashes, void (*progress)(uint64_t, uin
             if (hashes && fprintf(hashes, "%llu %016llx\n", (unsigned long long)(t + 1), (unsigned long long)h) < 0)
                 return rs_fail(err, RP_ERR_WRITE, "writing the hash list failed at tick %llu",
                                (unsigned long long)(t + 1));
-            uint64_t want = at_check ? rp->checkpoints[next] : rp->final_hash;
-            if ((at_check || last) && h != want) {
+            uint64_t want = at_check ? rp->checkpoints[next] : rp->final_hash, hr = rp_recorded_hash(rp, h);
+            if ((at_check || last) && hr != want) {
                 res->desync_tick = t + 1;
                 res->want = want;
-                res->got = h;
+                res->got = hr;
+                res->kinds_altered = kinds_that_match(rp, h, want, res->kinds_recorded);
                 return true; /* verified: not ok */
             }
             if (at_check) {
                 next++;
                 res->last_good_tick = t + 1;
             }
-            if (last && h != rp->final_hash) {
+            if (last && hr != rp->final_hash) {
                 res->desync_tick = t + 1;
                 res->want = rp->final_hash;
-                res->got = h;
+                res->got = hr;
+                res->kinds_altered = kinds_that_match(rp, h, rp->final_hash, res->kinds_recorded);
                 return true;
             }
         }
@@ -619,11 +649,18 @@ bool rp_check_tick(const rp_replay *rp, const g_state *st, uint64_t done, size_t
     bool last = done == rp->ticks;
     if (!at_check && !last)
         return true;
-    uint64_t h = g_hash(st), want = at_check ? rp->checkpoints[(*next)++] : rp->final_hash;
+    uint64_t sh = g_hash(st), h = rp_recorded_hash(rp, sh), want = at_check ? rp->checkpoints[(*next)++] : rp->final_hash;
     if (h == want && (!last || h == rp->final_hash))
         return true;
     if (h == want) /* the checkpoint matched, the final hash (same tick) did not */
         want = rp->final_hash;
+    int kinds[2];
+    if (kinds_that_match(rp, sh, want, kinds))
+        return rs_fail(err, RP_ERR_DESYNC,
+                       "%s: the header's player kinds (P1 %s, P2 %s, bytes 30-31) are not the ones it was recorded "
+                       "with (P1 %s, P2 %s): the header was altered",
+                       name, rp->kind[0] ? "cpu" : "human", rp->kind[1] ? "cpu" : "human", kinds[0] ? "cpu" : "human",
+                       kinds[1] ? "cpu" : "human");
     rs_fail(err, RP_ERR_DESYNC,
             "%s: desync at tick %llu: the game's state hash %016llx is not the replay's %016llx (its inputs "
             "no longer reproduce the recorded match)",
@@ -651,7 +688,12 @@ bool rp_peek_ticks(const uint8_t *buf, size_t len, uint64_t *ticks)
 
 void rp_desync_text(const rp_verify_result *res, char *out, size_t n)
 {
-    if (res->desync_tick <= res->last_good_tick) /* the same state matched a checkpoint: the final hash is bad */
+    if (res->kinds_altered)
+        snprintf(out, n,
+                 "the header's player kinds (bytes 30-31) are not the ones it was recorded with (P1 %s, P2 %s): the "
+                 "header was altered",
+                 res->kinds_recorded[0] ? "cpu" : "human", res->kinds_recorded[1] ? "cpu" : "human");
+    else if (res->desync_tick <= res->last_good_tick) /* the same state matched a checkpoint: the final hash is bad */
         snprintf(out, n,
                  "the final hash at tick %" PRIu64 " is %016" PRIx64 ", recorded %016" PRIx64
                  ", though the checkpoint at tick %" PRIu64 " matched: the recorded final hash is damaged",

@@ -17,7 +17,7 @@
 #include "../util/rs_err.h"
 
 #define RP_MAGIC "RSRP"
-#define RP_VERSION 2         /* what the recorder writes; the reader also takes 1 */
+#define RP_VERSION 3         /* what the recorder writes; the reader also takes 1 and 2 */
 #define RP_HEADER_BYTES 40    /* version 2; version 1 has no game version: 36 */
 #define RP_HEADER_BYTES_V1 36
 #define RP_MAX_FILE (64u << 20)
@@ -114,7 +114,15 @@ typedef struct rp_verify_result {
     int winner;             /* of the first match, as simulated */
     int rounds[2];
     bool header_mismatch;   /* every hash matched, but the header's winner or rounds do not */
+    bool kinds_altered;     /* format 3: the hashes match with other player kinds than the header's */
+    int kinds_recorded[2];  /* those kinds */
 } rp_verify_result;
+
+/* A state hash as a replay of this format records it: format 3 binds the
+ * header's player kinds into every checkpoint and the final hash (the
+ * state hash XOR a key of the two kinds), so a header whose kinds were
+ * changed no longer verifies; formats 1 and 2 record the state hash. */
+uint64_t rp_recorded_hash(const rp_replay *rp, uint64_t state_hash);
 
 /* What a failed verification found, as one clause for a message: "desync
  * at tick T: state hash X, recorded Y (last matching checkpoint: tick L;
