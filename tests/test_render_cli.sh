@@ -198,7 +198,8 @@ t_outputs_on_a_full_disk() {
     # read-only for root too: a read-only mount, not a mode
     mkdir ro && mount -t tmpfs -o ro,size=16k tmpfs ro || { echo "cannot mount a read-only tmpfs"; return 1; }
     # the error names what the user wrote (the frame's name for a sequence) and the system's reason
-    for out in ro/f%04d.png ro/x.mp4 ro/x.y4m nowhere/f%04d.png nowhere/x.mp4; do
+    for out in ro/f%04d.png ro/f%04d.exr ro/f%04d.tif ro/x.mp4 ro/x.y4m ro/x.webm ro/x.mkv ro/x.nut \
+        nowhere/f%04d.png nowhere/x.mp4 nowhere/x.webm nowhere/x.nut; do
         "$RS_BIN" render short.rsr --ticks 0:4 --size 160x90 -q -o "$out" 2>err.txt && { echo "$out: exit 0"; return 1; }
         [ -z "$(ls -A ro)" ] || { echo "$out left: $(ls -A ro)"; umount ro; return 1; }
         name=$(printf '%s' "$out" | sed 's/%04d/0000/')
@@ -207,6 +208,15 @@ t_outputs_on_a_full_disk() {
         *) want="^ringside render: $name: folder nowhere does not exist" ;;
         esac
         grep -q "$want" err.txt || { echo "$out: want '$want':"; cat err.txt; umount ro; return 1; }
+    done
+    # the side outputs, read-only or in no folder: the video goes with them
+    for side in "--hashes ro/h.txt" "--wav ro/a.wav" "--poster ro/p.png" "--hashes nowhere/h.txt" "--wav nowhere/a.wav"; do
+        rm -f v.mp4
+        "$RS_BIN" render short.rsr --ticks 140:160 --size 160x90 -q -o v.mp4 $side 2>err.txt && { echo "$side: exit 0"; umount ro; return 1; }
+        name=${side#* }
+        [ ! -e v.mp4 ] && [ -z "$(ls -A ro)" ] || { echo "$side left: $(ls v.mp4 ro 2>&1)"; umount ro; return 1; }
+        grep -q "^ringside render: $name: .*\(Read-only file system\|folder nowhere does not exist\)" err.txt ||
+            { echo "$side:"; cat err.txt; umount ro; return 1; }
     done
     umount ro
 }
