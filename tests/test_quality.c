@@ -15,6 +15,8 @@
 #include "../runtime/platform/plat.h"
 #include "../runtime/fx/fx_fog.h"
 #include "../runtime/render/r_game.h"
+#include "../runtime/render/r_quality.h"
+#include "../runtime/util/rs_file.h"
 #include "../runtime/replay/rp.h"
 #include "t.h"
 #include "t_render.h"
@@ -474,7 +476,83 @@ static void t_out_of_range_refused(void)
     plat_destroy(p);
 }
 
-T_MAIN({"defaults_spelled_out_are_zero", t_defaults_spelled_out_are_zero}, {"fxaa", t_fxaa},
+/* The presets are pinned to the table users read (docs/accuracy.md, "The
+ * presets"), not to a copy of r_presets: each row's scale, budget and
+ * knobs are parsed from the doc and must be exactly the program's, every
+ * field of r_quality, so a knob changed on one side only fails here. */
+static void t_presets_are_the_documented_table(void)
+{
+    size_t n;
+    rs_err e = {0};
+    char *doc = rs_read_file(RS_SOURCE_DIR "/docs/accuracy.md", 1 << 22, &n, &e);
+    T_ASSERTF(doc, "%s", e.msg);
+    for (int i = 0; i < R_PRESETS; i++) {
+        const r_preset *p = &r_presets[i];
+        char key[40];
+        snprintf(key, sizeof key, "\n| `%s`", p->name);
+        const char *row = strstr(doc, key);
+        T_ASSERTF(row, "docs/accuracy.md has no row for the preset %s", p->name);
+        if (!row)
+            continue;
+        row += 1;
+        const char *end = strchr(row, '\n');
+        char line[512];
+        snprintf(line, sizeof line, "%.*s", (int)(end ? end - row : (long)strlen(row)), row);
+        /* | `name` | budget | what it is | ... */
+        char *col[6] = {0};
+        int nc = 0;
+        for (char *c = strchr(line, '|'); c && nc < 6; c = strchr(c + 1, '|'))
+            col[nc++] = c + 1;
+        T_ASSERTF(nc >= 4, "%s: a row of %d columns", p->name, nc);
+        if (nc < 4)
+            continue;
+        double budget = 0;
+        bool is_ref = !strncmp(col[1], " the reference", 14);
+        T_ASSERTF(is_ref || sscanf(col[1], " >= %lf dB", &budget) == 1, "%s: budget '%.20s'", p->name, col[1]);
+        T_ASSERTF(fabs(budget - p->budget_db) < 1e-9, "%s: budget %.1f dB in the doc, %.1f in r_presets", p->name, budget,
+                  p->budget_db);
+        /* the knobs, as the doc spells them */
+        r_quality q = {0};
+        double scale = 0;
+        char what[256];
+        snprintf(what, sizeof what, "%.*s", (int)(col[3] - col[2] - 1), col[2]);
+        for (char *tok = strtok(what, ",("); tok; tok = strtok(NULL, ",(")) {
+            while (*tok == ' ')
+                tok++;
+            int v, a, b;
+            if (sscanf(tok, "%dx%d", &a, &b) == 2 && a == b)
+                scale = a;
+            else if (sscanf(tok, "%dx", &a) == 1)
+                scale = a;
+            else if (!strncmp(tok, "FXAA", 4))
+                q.aa = R_AA_FXAA;
+            else if (!strncmp(tok, "mask half", 9))
+                q.mask_half = true;
+            else if (sscanf(tok, "shadow %d", &v) == 1)
+                q.shadow_size = v;
+            else if (sscanf(tok, "silhouette %d", &v) == 1)
+                q.sil_size = v;
+            else if (sscanf(tok, "LSPSM %d", &v) == 1)
+                q.lspsm_size = v;
+            else if (sscanf(tok, "water %d", &v) == 1)
+                q.water_grid = v;
+            else if (sscanf(tok, "fog %d", &v) == 1)
+                q.fog_size = v;
+            else if (sscanf(tok, "bloom %d", &v) == 1)
+                q.bloom_levels = v;
+        }
+        T_ASSERTF(scale == p->scale, "%s: scale %g in the doc, %g in r_presets", p->name, scale, p->scale);
+        T_ASSERTF(!memcmp(&q, &p->q, sizeof q),
+                  "%s: the doc's knobs (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, fog %d, bloom %d) "
+                  "are not r_presets' (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, fog %d, bloom %d)",
+                  p->name, q.aa, q.mask_half, q.shadow_size, q.sil_size, q.lspsm_size, q.water_grid, q.fog_size,
+                  q.bloom_levels, p->q.aa, p->q.mask_half, p->q.shadow_size, p->q.sil_size, p->q.lspsm_size,
+                  p->q.water_grid, p->q.fog_size, p->q.bloom_levels);
+    }
+    free(doc);
+}
+
+T_MAIN({"presets_are_the_documented_table", t_presets_are_the_documented_table}, {"defaults_spelled_out_are_zero", t_defaults_spelled_out_are_zero}, {"fxaa", t_fxaa},
        {"fxaa_early_out_same_bytes", t_fxaa_early_out_same_bytes},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
        {"silhouette_mips_whole", t_silhouette_mips_whole},
