@@ -383,8 +383,9 @@ static void t_loudness_normalize_holds_peak(void)
     au_loudness b, a, m;
     T_ASSERTF(au_loud_normalize(x, n, -16, -1, &b, &a, &err), "%s", err.msg);
     T_ASSERT(au_loud_measure(x, n, &m, &err));
-    T_ASSERTF(m.true_peak <= -1.0 + 0.1, "true peak %.2f dBTP", m.true_peak);
-    T_ASSERTF(fabs(m.integrated - -16) < 1.0, "integrated %.2f LUFS (before %.2f)", m.integrated, b.integrated);
+    /* held at the ceiling, not under it by any margin: -1.13 dBTP measured */
+    T_ASSERTF(m.true_peak <= -1.0 + 0.1 && m.true_peak >= -1.25, "true peak %.2f dBTP", m.true_peak);
+    T_ASSERTF(fabs(m.integrated - -16) < 0.2, "integrated %.2f LUFS (before %.2f)", m.integrated, b.integrated);
     T_ASSERT(m.integrated == a.integrated && b.integrated < -25);
     /* silence stays silence */
     memset(x, 0, n * 2 * sizeof *x);
@@ -527,8 +528,12 @@ static void t_track_identical_and_sliced(void)
     /* the whole match, measured again from outside: on target, under the ceiling */
     au_loudness l;
     T_ASSERT(au_loud_measure(a.pcm, a.frames, &l, &err));
-    T_ASSERTF(fabs(l.integrated - -16) <= 1.0, "%.2f LUFS", l.integrated);
-    T_ASSERTF(l.true_peak <= -1.0, "%.2f dBTP", l.true_peak);
+    /* from both sides, at a tolerance a 0.5 dB change in the target or the
+     * ceiling breaks: temple's gain to -16 LUFS takes its peaks over -1 dBTP,
+     * so the limiter holds them at the default ceiling (-1.20 dBTP measured
+     * by libebur128's 4x true peak, -16.01 LUFS) */
+    T_ASSERTF(fabs(l.integrated - -16) <= 0.2, "%.2f LUFS", l.integrated);
+    T_ASSERTF(l.true_peak <= -1.0 && l.true_peak >= -1.3, "%.2f dBTP: the limiter's ceiling is -1", l.true_peak);
     au_track_free(&s); /* s is written again below (and left empty by a refusal) */
     T_ASSERT(!au_replay_track(&rp, DEMO, 10, 10, NULL, &s, &err) && err.code == AU_ERR_ARG);
     T_ASSERT(!au_replay_track(&rp, DEMO, 0, rp.ticks + 1, NULL, &s, &err) && err.code == AU_ERR_ARG);
