@@ -90,8 +90,8 @@ bool cli_log_options(int *argc, char **argv)
     for (int i = 1; i < *argc; i++) {
         const char *a = argv[i];
         int level = -1;
+        ended |= !strcmp(a, "--"); /* what follows is the command's, as it is */
         if (ended || a[0] != '-') {
-            ended |= !strcmp(a, "--");
             argv[out++] = argv[i];
             continue;
         }

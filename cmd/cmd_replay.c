@@ -230,12 +230,10 @@ static int sound(const char *path, const char *out, uint64_t first, uint64_t end
     if (!ok) {
         cli_error("replay", "%s", err.msg);
     } else {
-        if (!rs_log_on(RS_LOG_INFO))
-            ;
-        else if (isnan(lufs))
+        if (rs_log_on(RS_LOG_INFO) && isnan(lufs))
             fprintf(stderr, "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames, not normalized\n", out,
                     t->first, t->end, t->frames);
-        else
+        else if (rs_log_on(RS_LOG_INFO))
             fprintf(stderr,
                     "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames; match %.1f LUFS %.1f dBTP -> "
                     "%.1f LUFS %.1f dBTP (gain %+.1f dB)\n",

@@ -53,12 +53,7 @@ int main(int argc, char **argv)
             rp.winner = atoi(argv[2]);
         else {
             rp.game_version = (uint32_t)strtoul(argv[2], NULL, 10);
-            /* the hashes as the new format records them (format 3 keys them with the kinds) */
-            rp_replay was = rp;
-            rp.version = rp.game_version ? RP_VERSION : 1;
-            for (size_t k = 0; k < rp.ncheck; k++)
-                rp.checkpoints[k] = rp_recorded_hash(&rp, rp_recorded_hash(&was, rp.checkpoints[k]));
-            rp.final_hash = rp_recorded_hash(&rp, rp_recorded_hash(&was, rp.final_hash));
+            rp_set_format(&rp, rp.game_version ? RP_VERSION : 1);
         }
         bool ok = rp_write(argv[4], &rp, &err);
         if (!ok)

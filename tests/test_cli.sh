@@ -238,6 +238,8 @@ t_loglevel_on_every_command() {
     [ $? = 1 ] && [ ! -s e.txt ] || { echo "quiet said:"; cat e.txt; return 1; }
     "$RS_BIN" replay verify m.rsr -q 2>e.txt && [ ! -s e.txt ] || { cat e.txt; return 1; }
     "$RS_BIN" replay verify m.rsr 2>e.txt && grep -q "m.rsr: ok" e.txt || { cat e.txt; return 1; }
+    # after --, -q is the command's: here a replay named -q
+    expect_fail 1 "ringside render: -q: cannot open" "$RS_BIN" render -o a.y4m -y -- -q || return 1
 }
 
 t_run help_lists_every_subcommand loglevel_on_every_command oiio_loaded_when_used help usage_errors shader_variants_all_compile shaders_valid_for_glslang info_egl info_osmesa info_glfw_xvfb info_glfw_no_display info_falls_back \

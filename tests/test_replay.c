@@ -538,12 +538,10 @@ static void t_kinds_bound_to_hashes(void)
     rp_free(&back);
     free(g);
     /* the same match as format 2: the state hashes themselves, kinds free */
-    rp_replay v2 = rp, was = rp;
-    v2.version = 2;
+    rp_replay v2 = rp;
     v2.checkpoints = malloc(rp.ncheck * 8);
-    for (size_t k = 0; k < rp.ncheck; k++)
-        v2.checkpoints[k] = rp_recorded_hash(&v2, rp_recorded_hash(&was, rp.checkpoints[k]));
-    v2.final_hash = rp_recorded_hash(&v2, rp_recorded_hash(&was, rp.final_hash));
+    memcpy(v2.checkpoints, rp.checkpoints, rp.ncheck * 8);
+    rp_set_format(&v2, 2);
     T_ASSERT(v2.final_hash != rp.final_hash);
     T_ASSERT(rp_verify(&v2, NULL, NULL, NULL, &res, &e) && res.ok);
     v2.kind[0] = RP_HUMAN;

@@ -932,12 +932,8 @@ static void t_upload_verified(void)
     T_EQ(upload(&cfg, buf, n, SVC_ERR_GAME_VERSION, want), 0);
     free(buf);
     /* format 1: no game version, and the plain state hashes (format 3 keys them with the kinds) */
-    rp_replay v3 = rp;
     rp.game_version = 0;
-    rp.version = 1;
-    for (size_t k = 0; k < rp.ncheck; k++)
-        rp.checkpoints[k] = rp_recorded_hash(&v3, rp.checkpoints[k]);
-    rp.final_hash = rp_recorded_hash(&v3, rp.final_hash);
+    rp_set_format(&rp, 1);
     T_ASSERTF(rp_encode(&rp, &buf, &n, &e), "%s", e.msg);
     T_EQ(upload(&cfg, buf, n, 0, NULL), 1000);
     free(buf);

@@ -566,6 +566,16 @@ uint64_t rp_recorded_hash(const rp_replay *rp, uint64_t state_hash)
     return rp->version >= 3 ? state_hash ^ kinds_key(rp->kind[0], rp->kind[1]) : state_hash;
 }
 
+void rp_set_format(rp_replay *rp, int version)
+{
+    rp_replay was = *rp;
+    rp->version = version;
+    /* XOR is its own inverse: the old key off, the new one on */
+    for (size_t k = 0; k < rp->ncheck; k++)
+        rp->checkpoints[k] = rp_recorded_hash(rp, rp_recorded_hash(&was, rp->checkpoints[k]));
+    rp->final_hash = rp_recorded_hash(rp, rp_recorded_hash(&was, rp->final_hash));
+}
+
 /* A format-3 hash that does not match: do other player kinds make it match? */
 static bool kinds_that_match(const rp_replay *rp, uint64_t state_hash, uint64_t want, int kinds[2])
 {

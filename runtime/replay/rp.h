@@ -123,6 +123,9 @@ typedef struct rp_verify_result {
  * state hash XOR a key of the two kinds), so a header whose kinds were
  * changed no longer verifies; formats 1 and 2 record the state hash. */
 uint64_t rp_recorded_hash(const rp_replay *rp, uint64_t state_hash);
+/* The replay as another format version records it: rp->version set and
+ * every hash re-keyed (the same match, verifying as before). */
+void rp_set_format(rp_replay *rp, int version);
 
 /* What a failed verification found, as one clause for a message: "desync
  * at tick T: state hash X, recorded Y (last matching checkpoint: tick L;
