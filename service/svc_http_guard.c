@@ -392,11 +392,14 @@ static void *lingerer(void *arg)
         double t = now_s();
         for (int i = 0; i < k; i++) {
             net_linger *l = ev[i].data.ptr;
+            /* a bounded read per wake: a fast sender must neither pass
+             * LINGER_BYTES inside this loop nor starve the others (the
+             * epoll is level-triggered: what is left wakes it again) */
             ssize_t r = -1;
-            while (sink && (r = read(l->fd, sink, SINK)) > 0) {
+            uint64_t woke = l->bytes;
+            while (sink && l->bytes <= LINGER_BYTES && l->bytes - woke < (1u << 20) &&
+                   (r = read(l->fd, sink, SINK)) > 0)
                 l->bytes += (uint64_t)r;
-                l->last = t;
-            }
             l->last = t;
             if (r == 0 || (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) || l->bytes > LINGER_BYTES)
                 linger_end(n, l);
