@@ -231,6 +231,8 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_SUNVIS, "cap_fullscreen.vert", "sun_vis.frag", NULL},
         {P_FLARE, "cap_fullscreen.vert", "flare.frag", NULL},
         {P_HUD, "hud.vert", "hud.frag", NULL},
+        {P_HUD_RECT, "hud.vert", "hud.frag", "#define RECT 1\n"},
+        {P_HUD_2TAPS, "hud.vert", "hud.frag", "#define TAPS 2\n"},
         {P_FXAA, "cap_fullscreen.vert", "fxaa.frag", NULL},
         {P_FXAA_MARK, "cap_fullscreen.vert", "fxaa.frag", "#define MARK 1\n"},
         {P_GLOW, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n"},

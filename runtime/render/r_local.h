@@ -44,7 +44,7 @@ typedef struct prog {
  * without them). */
 enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK_END,
        P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_BLUR_TEXELS, /* + 3: reaching 1..4 texels */
-       P_DOWN = P_BLUR_TEXELS + 4, P_SUNVIS, P_FLARE, P_HUD, P_FXAA, P_FXAA_MARK,
+       P_DOWN = P_BLUR_TEXELS + 4, P_SUNVIS, P_FLARE, P_HUD, P_HUD_RECT, P_HUD_2TAPS, P_FXAA, P_FXAA_MARK,
        P_GLOW, /* + 4 variants: bloom's last blur with its second level x the flare (r_post.c) */
        P_TONE = P_GLOW + 4, /* + 1 variant: with the glow */
        P_COUNT = P_TONE + 2 };
