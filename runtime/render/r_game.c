@@ -544,6 +544,10 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         r->sil_fbo[k] = r_fbo_for(r->sil_tex, k, 0);
         r->sil_tmp_fbo[k] = r_fbo_for(r->sil_tmp, k, 0);
     }
+    if (r->shadow_size == r->sil_size) { /* one draw of the fighters makes both (r_shadow.c) */
+        r->shadow_sil_fbo = r_fbo_for(r->sil_tex, 0, 0);
+        gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r->shadow_tex, 0);
+    }
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     RGL_CHECK("r_game_create");
@@ -568,6 +572,7 @@ void r_game_destroy(r_game *r)
     GLuint tex[] = {r->font_tex, r->normal_tex, r->spec_tex, r->flare_tex, r->lut_tex, r->shadow_tex, r->sil_tex, r->sil_tmp};
     gl.DeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     gl.DeleteFramebuffers(1, &r->shadow_fbo);
+    gl.DeleteFramebuffers(1, &r->shadow_sil_fbo);
     gl.DeleteFramebuffers(SIL_LEVELS, r->sil_fbo);
     gl.DeleteFramebuffers(SIL_LEVELS, r->sil_tmp_fbo);
     for (int i = 0; i < P_COUNT; i++)

@@ -78,6 +78,7 @@ struct r_game {
     /* light-space targets, sides from r_quality (0: SHADOW_SIZE, SIL_SIZE) */
     int shadow_size, sil_size;
     GLuint shadow_tex, shadow_fbo;
+    GLuint shadow_sil_fbo; /* the shadow map and silhouette level 0 together, when their sides agree (else 0) */
     GLuint sil_tex, sil_tmp, sil_fbo[SIL_LEVELS], sil_tmp_fbo[SIL_LEVELS];
     /* screen targets */
     int tw, th;

@@ -22,29 +22,45 @@ static void light_view_draw(r_game *r, GLuint p)
     r_draw_fighters(r, p);
 }
 
+/* With the shadow map and the silhouette the same size (the standard
+ * preset's 512), one draw of the fighters makes both: the silhouette is
+ * every fragment drawn, and with GL_LEQUAL the first fragment at a texel
+ * always passes (the depth is cleared to 1, and the polygon offset may
+ * clamp one to 1), so depth-testing it covers what the silhouette's own
+ * draw without a depth test did; a fragment that fails lands on a texel
+ * already covered.  Equal depths write the same value, so the map is
+ * LESS's too.  Most of either pass was the fighters' vertices and
+ * triangles, not their fragments (llvmpipe, single-threaded: 1.2 ms of
+ * 1.4 for the silhouette at 640x360). */
 static void run_shadow_map(void *u)
 {
     r_game *r = u;
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->shadow_fbo);
+    bool both = r->shadow_sil_fbo != 0;
+    gl.BindFramebuffer(GL_FRAMEBUFFER, both ? r->shadow_sil_fbo : r->shadow_fbo);
     gl.Viewport(0, 0, r->shadow_size, r->shadow_size);
     gl.Enable(GL_DEPTH_TEST);
-    gl.DepthFunc(GL_LESS);
+    gl.DepthFunc(both ? GL_LEQUAL : GL_LESS);
     gl.DepthMask(GL_TRUE);
-    gl.Clear(GL_DEPTH_BUFFER_BIT);
+    if (both)
+        gl.ClearColor(0, 0, 0, 0);
+    gl.Clear(GL_DEPTH_BUFFER_BIT | (both ? GL_COLOR_BUFFER_BIT : 0));
     gl.Enable(GL_POLYGON_OFFSET_FILL);
     gl.PolygonOffset(2.0f, 4.0f);
     /* the capsules are closed: the nearest surface faces the light, so
      * the back faces only cost fragments (most of this pass on llvmpipe) */
     gl.Enable(GL_CULL_FACE);
     gl.CullFace(GL_BACK);
-    light_view_draw(r, r->prog[P_DEPTH]);
+    light_view_draw(r, r->prog[both ? P_SIL : P_DEPTH]);
     gl.Disable(GL_POLYGON_OFFSET_FILL);
     gl.Disable(GL_CULL_FACE);
+    gl.DepthFunc(GL_LESS);
 }
 
 static void run_silhouette(void *u)
 {
     r_game *r = u;
+    if (r->shadow_sil_fbo) /* drawn with the shadow map */
+        return;
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->sil_fbo[0]);
     gl.Viewport(0, 0, r->sil_size, r->sil_size);
     gl.Disable(GL_DEPTH_TEST);
