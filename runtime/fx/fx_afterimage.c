@@ -151,7 +151,21 @@ static void run(void *u)
         gl.UniformMatrix4fv(r_loc(p, "u_bones_tick"), G_BONES, GL_FALSE, &f->bones_tick[i][0][0]);
         gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &f->colors[i][0][0]);
         gl.Uniform1fv(r_loc(p, "u_fast"), 16, a->fast[i]);
-        gl.DrawElements(GL_TRIANGLES, core.fighter_count, GL_UNSIGNED_INT, NULL);
+        /* only the fast bones' triangles, in the mesh's order (the others
+         * would be clipped by the vertex shader after it ran on them:
+         * about 0.7 ms a frame single-threaded at 640x360) */
+        for (int b = 0; b < G_BONES;) {
+            if (!a->fast[i][b]) {
+                b++;
+                continue;
+            }
+            int e = b + 1;
+            while (e < G_BONES && a->fast[i][e])
+                e++;
+            GLsizei first = core.fighter_bone_first[b], n = core.fighter_bone_first[e] - first;
+            gl.DrawElements(GL_TRIANGLES, n, GL_UNSIGNED_INT, (const void *)((size_t)first * sizeof(GLuint)));
+            b = e;
+        }
     }
     gl.Disable(GL_BLEND);
     gl.Disable(GL_STENCIL_TEST);

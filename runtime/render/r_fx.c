@@ -58,7 +58,7 @@ const r_quality *r_fx_quality(const r_game *r)
 
 r_fx_gl r_fx_core_gl(const r_game *r)
 {
-    return (r_fx_gl){
+    r_fx_gl g = {
         .hdr_fbo = r->hdr_fbo,
         .hdr_tex = r->hdr_tex,
         .depth_tex = r->depth_tex,
@@ -73,6 +73,8 @@ r_fx_gl r_fx_core_gl(const r_game *r)
         .prog_depth = r->prog[P_DEPTH],
         .prog_sky = r->prog[P_SKY],
     };
+    memcpy(g.fighter_bone_first, r->fighter_bone_first, sizeof g.fighter_bone_first);
+    return g;
 }
 
 int r_fx_units(void)

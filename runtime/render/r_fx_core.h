@@ -94,6 +94,9 @@ typedef struct r_fx_gl {
     GLuint empty_vao;                   /* no attributes: full-screen passes */
     GLuint fighter_vao, ring_vao;       /* the fighter mesh, the ring mesh */
     GLsizei fighter_count, ring_count;  /* their index counts */
+    /* the fighter mesh's triangles by bone: bone b's indices are
+     * [fighter_bone_first[b], fighter_bone_first[b + 1]) */
+    GLsizei fighter_bone_first[G_BONES + 1];
     GLuint prog_depth;                  /* depth only (scene.vert, bones or not) */
     GLuint prog_sky;                    /* the sky (sky.frag) */
 } r_fx_gl;

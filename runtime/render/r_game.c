@@ -409,6 +409,22 @@ static bool check_quality(const r_quality *q, rs_err *err)
     return true;
 }
 
+/* Where each bone's triangles start in the fighter mesh's indices
+ * (r_mesh_fighter appends the bones' capsules in order): first[b] ..
+ * first[b + 1].  A bone with no triangles gets an empty range. */
+static void fighter_bone_ranges(const r_mesh_data *m, GLsizei first[G_BONES + 1])
+{
+    int b = 0;
+    first[0] = 0;
+    for (size_t t = 0; t + 2 < m->ni; t += 3) {
+        int bone = (int)(m->v[m->idx[t]].bone + 0.5f);
+        while (b < bone && b < G_BONES)
+            first[++b] = (GLsizei)t;
+    }
+    while (b < G_BONES)
+        first[++b] = (GLsizei)m->ni;
+}
+
 r_game *r_game_create(rs_err *err)
 {
     return r_game_create_opts(NULL, err);
@@ -456,6 +472,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     if (ok) {
         r_upload_mesh(&m, &r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
         r->fighter_count = (GLsizei)m.ni;
+        fighter_bone_ranges(&m, r->fighter_bone_first);
     }
     r_mesh_free(&m);
     if (ok && (ok = r_build_lens(&m))) {

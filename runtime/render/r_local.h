@@ -57,6 +57,7 @@ struct r_game {
     char look_defines[320]; /* what the look's programs were compiled with */
     GLuint fighter_vao, fighter_vbo, fighter_ibo;
     GLsizei fighter_count;
+    GLsizei fighter_bone_first[G_BONES + 1]; /* r_fx_gl's */
     GLuint lens_vao, lens_vbo, lens_ibo;
     GLsizei lens_count;
     GLuint ring_vao, ring_vbo, ring_ibo;
