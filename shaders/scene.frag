@@ -124,13 +124,23 @@ void main()
     exponent = glass ? 128.0 : 16.0;
 #endif
     float key = 1.0;
+#if MATERIAL == 2
+    // the buildings are always drawn with u_shadows 0 (fx_lspsm.c,
+    // run_buildings: the fighters' silhouette stops short of them, the
+    // LSPSM map casts the fighters there): a constant, so their program
+    // has neither the silhouette's tap nor the fighter flag's four, which
+    // llvmpipe would run (and throw away) on every building pixel
+    const bool ssfsm = false;
+#else
+    bool ssfsm = u_shadows == 1;
+#endif
 #ifdef SHADOWS
-    if (u_shadows == 1 && v_proj.z > 0.5)
+    if (ssfsm && v_proj.z > 0.5)
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
 #endif
 #ifdef FX_LSPSM
     if (u_lspsm_on == 1) // with the SSFSM shadows on, the fighters' come from the silhouette
-        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), u_shadows == 1);
+        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), ssfsm);
 #endif
     float alpha = 0.0;
 #endif
