@@ -222,6 +222,60 @@ static void t_fxaa_early_out_same_bytes(void)
     plat_destroy(p);
 }
 
+/* With the shadow map and the silhouette the same size (the standard
+ * preset's 512), shadow_map draws both at once: the depth map, every
+ * silhouette level and the frame must be those of the two passes apart. */
+static void t_shadow_and_silhouette_in_one_draw(void)
+{
+    plat *p = t_context("egl");
+    enum { W = 320, H = 180, N = 512, LEVELS = 5 }; /* SIL_LEVELS */
+    static const struct {
+        const char *demo;
+        uint64_t tick;
+    } cases[] = {{"temple", 900}, {"dojo", 1500}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        g_state prev, cur;
+        t_state_at(cases[c].demo, cases[c].tick, &prev, &cur);
+        t_fb f;
+        t_fb_make(&f, W, H);
+        uint8_t *img[2];
+        float *map[2], *lv[2][LEVELS];
+        for (int apart = 0; apart < 2; apart++) {
+            r_game *r = t_game_opts(&(r_game_opts){.q = {.shadow_size = N, .sil_size = N}, .light_apart = apart == 1});
+            img[apart] = malloc((size_t)W * H * 4);
+            T_ASSERT(img[apart]);
+            t_draw_read(r, &f, &prev, &cur, W, H, img[apart], true);
+            map[apart] = t_read(r, "shadow", 1, N, N);
+            for (int k = 0; k < LEVELS; k++) {
+                char name[16] = "silhouette";
+                if (k)
+                    snprintf(name, sizeof name, "silhouette%d", k);
+                lv[apart][k] = t_read(r, name, 4, N >> k, N >> k);
+            }
+            T_ASSERT(t_pass_ran(r, "shadow_map") && t_pass_ran(r, "silhouette"));
+            r_game_destroy(r);
+        }
+        int covered = 0;
+        for (int i = 0; i < N * N; i++)
+            covered += lv[0][0][4 * i] > 0.5f;
+        fprintf(stderr, "    %s@%llu: silhouette %d texels covered\n", cases[c].demo, (unsigned long long)cases[c].tick,
+                covered);
+        T_ASSERTF(covered > N * N / 1000, "%s: the one draw's silhouette is empty (%d texels)", cases[c].demo, covered);
+        T_ASSERTF(!memcmp(map[0], map[1], sizeof(float) * N * N), "%s: the depth maps differ", cases[c].demo);
+        for (int k = 0; k < LEVELS; k++)
+            T_ASSERTF(!memcmp(lv[0][k], lv[1][k], sizeof(float) * 4 * (N >> k) * (N >> k)), "%s: silhouette level %d differs",
+                      cases[c].demo, k);
+        T_ASSERTF(!memcmp(img[0], img[1], (size_t)W * H * 4), "%s: the frames differ", cases[c].demo);
+        for (int a = 0; a < 2; a++) {
+            free(img[a]), free(map[a]);
+            for (int k = 0; k < LEVELS; k++)
+                free(lv[a][k]);
+        }
+        t_fb_free(&f);
+    }
+    plat_destroy(p);
+}
+
 /* The pass is in the graph: runs with aa on, skipped (and no target) off. */
 static void t_fxaa_pass_in_graph(void)
 {
@@ -555,5 +609,6 @@ static void t_presets_are_the_documented_table(void)
 T_MAIN({"presets_are_the_documented_table", t_presets_are_the_documented_table}, {"defaults_spelled_out_are_zero", t_defaults_spelled_out_are_zero}, {"fxaa", t_fxaa},
        {"fxaa_early_out_same_bytes", t_fxaa_early_out_same_bytes},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
+       {"shadow_and_silhouette_in_one_draw", t_shadow_and_silhouette_in_one_draw},
        {"silhouette_mips_whole", t_silhouette_mips_whole},
        {"water_grid", t_water_grid}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})

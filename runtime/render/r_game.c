@@ -561,7 +561,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
         r->sil_fbo[k] = r_fbo_for(r->sil_tex, k, 0);
         r->sil_tmp_fbo[k] = r_fbo_for(r->sil_tmp, k, 0);
     }
-    if (r->shadow_size == r->sil_size) { /* one draw of the fighters makes both (r_shadow.c) */
+    if (r->shadow_size == r->sil_size && !r->opts.light_apart) { /* one draw of the fighters makes both (r_shadow.c) */
         r->shadow_sil_fbo = r_fbo_for(r->sil_tex, 0, 0);
         gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r->shadow_tex, 0);
     }
