@@ -113,6 +113,40 @@ static float *hdr_frame(r_game *r, t_fb *f, r_afterimage mode, const g_state *pr
     return px;
 }
 
+/* The pass draws only the fast bones' runs of the mesh's indices: the
+ * same bytes as the whole mesh with the vertex shader clipping the slow
+ * ones (r_game_opts.whole_meshes), on frames where some bones are fast
+ * and some are not. */
+static void t_afterimage_by_bone_ranges(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    static const uint64_t ticks[] = {408, 1500, 2200};
+    int runs = 0;
+    for (size_t k = 0; k < sizeof ticks / sizeof ticks[0]; k++) {
+        g_state prev, cur;
+        t_state_at("dojo", ticks[k], &prev, &cur);
+        float *img[2];
+        bool ran[2];
+        for (int whole = 0; whole < 2; whole++) {
+            r_game *r = t_game_opts(&(r_game_opts){.mask = true, .whole_meshes = whole == 1});
+            img[whole] = hdr_frame(r, &f, R_AFTERIMAGE_VIEW, &prev, &cur);
+            ran[whole] = t_pass_ran(r, "afterimage");
+            r_game_destroy(r);
+        }
+        T_EQ(ran[0], ran[1]);
+        runs += ran[0];
+        T_ASSERTF(!memcmp(img[0], img[1], (size_t)W * H * 4 * sizeof(float)),
+                  "dojo@%llu: the bones' ranges draw other pixels than the whole mesh", (unsigned long long)ticks[k]);
+        free(img[0]), free(img[1]);
+    }
+    fprintf(stderr, "    the pass ran on %d of 3 frames\n", runs);
+    T_ASSERTF(runs > 0, "the pass never ran");
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 /* Tick 408 of the dojo demo: a blow lands, limbs move fast. */
 static void t_afterimage_trails_fast_limbs_only(void)
 {
@@ -325,5 +359,5 @@ T_MAIN({"stage_switch_leaves_nothing_behind", t_stage_switch_leaves_nothing_behi
        {"empty_frame_is_refused", t_empty_frame_is_refused},
        {"effects_run_only_where_asked", t_effects_run_only_where_asked},
        {"afterimage_trails_fast_limbs_only", t_afterimage_trails_fast_limbs_only},
-       {"afterimage_extremes", t_afterimage_extremes},
+       {"afterimage_extremes", t_afterimage_extremes}, {"afterimage_by_bone_ranges", t_afterimage_by_bone_ranges},
        {"afterimage_still_fighter_leaves_none", t_afterimage_still_fighter_leaves_none})

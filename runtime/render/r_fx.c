@@ -74,6 +74,7 @@ r_fx_gl r_fx_core_gl(const r_game *r)
         .prog_sky = r->prog[P_SKY],
     };
     memcpy(g.fighter_bone_first, r->fighter_bone_first, sizeof g.fighter_bone_first);
+    g.whole_meshes = r->opts.whole_meshes;
     return g;
 }
 

@@ -97,6 +97,7 @@ typedef struct r_fx_gl {
     /* the fighter mesh's triangles by bone: bone b's indices are
      * [fighter_bone_first[b], fighter_bone_first[b + 1]) */
     GLsizei fighter_bone_first[G_BONES + 1];
+    bool whole_meshes; /* r_game_opts.whole_meshes: draw whole meshes, not bone ranges (tests) */
     GLuint prog_depth;                  /* depth only (scene.vert, bones or not) */
     GLuint prog_sky;                    /* the sky (sky.frag) */
 } r_fx_gl;

@@ -61,6 +61,8 @@ typedef struct r_game_opts {
     int lut_size;           /* 0: R_TONE_LUT_DEFAULT */
     bool quiet;             /* no note when prefiltering takes a while */
     bool aa_plain;          /* tests: FXAA as one full pass over every pixel (no early out; the same bytes) */
+    bool whole_meshes;      /* tests: effects draw the fighters' whole mesh where they draw some bones (the
+                               afterimage; the same bytes) */
     bool light_apart;       /* tests: the shadow map and the silhouette in passes of their own even when their
                                sides agree (r_shadow.c draws both at once then; the same bytes) */
     r_quality q;            /* zero: full quality */
