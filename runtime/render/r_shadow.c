@@ -30,8 +30,8 @@ static void light_view_draw(r_game *r, GLuint p)
  * draw without a depth test did; a fragment that fails lands on a texel
  * already covered.  Equal depths write the same value, so the map is
  * LESS's too.  Most of either pass was the fighters' vertices and
- * triangles, not their fragments (llvmpipe, single-threaded: 1.2 ms of
- * 1.4 for the silhouette at 640x360). */
+ * triangles, not their fragments (llvmpipe, single-threaded at 640x360:
+ * a mesh with half the triangles took the silhouette's 1.2 ms to 0.6). */
 static void run_shadow_map(void *u)
 {
     r_game *r = u;
