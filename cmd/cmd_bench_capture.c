@@ -337,15 +337,20 @@ static void print_table(const bench *b, const capture_opts *o, const run *runs, 
     printf("fps: median of %ld interleaved runs; stage times and peaks: the last run\n", o->nrep);
     printf("%-16s %7s %8s %8s %8s %8s %8s %8s %8s %5s %7s\n", "config", "fps", "render", "dscale", "readbk", "fence",
            "map+cp", "q-wait", "write", "hwm", "rss MB");
+    bool null_sink = !strcmp(o->sink, "null");
     for (int i = 0; i < nrun; i++) {
         const run *r = &runs[i];
         double n = (double)b->frames;
+        if (null_sink && r->kind == 2) { /* nothing to write: no rate to show */
+            printf("%-16s %7s %8s %8s %8s %8s %8s %8s %8s %5s %7s\n", r->name, "-", "-", "-", "-", "-", "-", "-", "-", "-",
+                   "-");
+            continue;
+        }
         printf("%-16s %7.1f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %5d %7.0f\n", r->name, r->fps, r->ms_render,
                r->st.ms_downscale / n, r->st.ms_readback / n, r->st.ms_fence_wait / n, r->st.ms_map_copy / n,
                r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water, r->rss_mb);
     }
     printf("(ms per frame; render = simulate + draw calls on the game thread; write = writer thread in the sink)\n");
-    bool null_sink = !strcmp(o->sink, "null");
     double render_only = runs[0].fps, writer_only = null_sink ? 1e300 : runs[1].fps, seq = runs[2].fps;
     const run *def = &runs[3 + 1 * 3 + 2]; /* pbo 2, queue 120: the defaults */
     double slowest = render_only < writer_only ? render_only : writer_only;
@@ -363,6 +368,7 @@ static void print_table(const bench *b, const capture_opts *o, const run *runs, 
 static bool write_outputs(const bench *b, const capture_opts *o, run *runs, int nrun, rs_err *err)
 {
     const char *csv = o->csv, *chart = o->chart, *sink = o->sink;
+    bool null_sink = !strcmp(sink, "null");
     if (csv && *csv) {
         FILE *f = cli_bench_open("bench", csv, o->user_csv, o->overwrite);
         bool ok = f != NULL;
@@ -372,6 +378,10 @@ static bool write_outputs(const bench *b, const capture_opts *o, run *runs, int 
         for (int i = 0; ok && i < nrun; i++) {
             const run *r = &runs[i];
             double n = (double)b->frames;
+            if (null_sink && r->kind == 2) { /* empty fields: no writer stage */
+                ok = fprintf(f, "%s,,,,,,,,,,,%d,%d,%d,%d,%d,%s\n", r->name, b->frames, b->sw, b->sh, b->w, b->h, sink) > 0;
+                continue;
+            }
             ok = fprintf(f, "%s,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%.0f,%d,%d,%d,%d,%d,%s\n", r->name, r->fps,
                          r->ms_render, r->st.ms_downscale / n, r->st.ms_readback / n, r->st.ms_fence_wait / n,
                          r->st.ms_map_copy / n, r->st.ms_queue_wait / n, r->st.ms_write / n, r->st.high_water,
@@ -383,7 +393,6 @@ static bool write_outputs(const bench *b, const capture_opts *o, run *runs, int 
             return rs_fail(err, JOB_ERR_WRITE, "%s: cannot write", csv);
     }
     if (chart && *chart) {
-        bool null_sink = !strcmp(sink, "null");
         const run *def = &runs[3 + 1 * 3 + 2];
         bench_bar bars[16];
         int nb = 0;
