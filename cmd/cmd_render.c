@@ -570,13 +570,15 @@ static int prepare(render_run *run)
         return RS_EXIT_USAGE;
     }
     if (o->end > (long)run->rp.ticks) { /* as ffmpeg's -t past the end: clamped, with a word */
-        if (rs_log_on(RS_LOG_WARNING) && o->ticks_given)
-            fprintf(stderr, "ringside render: --ticks %ld:%ld: the replay ends at tick %" PRIu64 ", so ticks %ld:%" PRIu64
-                            " are drawn\n",
-                    o->first, o->end, run->rp.ticks, o->first, run->rp.ticks);
-        else if (rs_log_on(RS_LOG_WARNING))
-            fprintf(stderr, "ringside render: the replay ends at %.3f s, so %.3f s to %.3f s are drawn (not to %.3f s)\n",
-                    len_s, o->first / 60.0, len_s, o->end / 60.0);
+        if (rs_log_on(RS_LOG_WARNING)) {
+            if (o->ticks_given)
+                fprintf(stderr, "ringside render: --ticks %ld:%ld: the replay ends at tick %" PRIu64 ", so ticks %ld:%" PRIu64
+                                " are drawn\n",
+                        o->first, o->end, run->rp.ticks, o->first, run->rp.ticks);
+            else
+                fprintf(stderr, "ringside render: the replay ends at %.3f s, so %.3f s to %.3f s are drawn (not to %.3f s)\n",
+                        len_s, o->first / 60.0, len_s, o->end / 60.0);
+        }
         o->end = (long)run->rp.ticks;
     }
     run->first = (uint64_t)o->first, run->end = o->end < 0 ? run->rp.ticks : (uint64_t)o->end;

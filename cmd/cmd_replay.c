@@ -230,15 +230,17 @@ static int sound(const char *path, const char *out, uint64_t first, uint64_t end
     if (!ok) {
         cli_error("replay", "%s", err.msg);
     } else {
-        if (rs_log_on(RS_LOG_INFO) && isnan(lufs))
-            fprintf(stderr, "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames, not normalized\n", out,
-                    t->first, t->end, t->frames);
-        else if (rs_log_on(RS_LOG_INFO))
-            fprintf(stderr,
-                    "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames; match %.1f LUFS %.1f dBTP -> "
-                    "%.1f LUFS %.1f dBTP (gain %+.1f dB)\n",
-                    out, t->first, t->end, t->frames, t->lufs_before, t->peak_before, t->lufs_after, t->peak_after,
-                    t->gain_db);
+        if (rs_log_on(RS_LOG_INFO)) {
+            if (isnan(lufs))
+                fprintf(stderr, "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames, not normalized\n", out,
+                        t->first, t->end, t->frames);
+            else
+                fprintf(stderr,
+                        "ringside replay: %s: ticks %" PRIu64 ":%" PRIu64 ", %zu frames; match %.1f LUFS %.1f dBTP -> "
+                        "%.1f LUFS %.1f dBTP (gain %+.1f dB)\n",
+                        out, t->first, t->end, t->frames, t->lufs_before, t->peak_before, t->lufs_after, t->peak_after,
+                        t->gain_db);
+        }
         status = RS_EXIT_OK;
     }
     free(buf);
