@@ -19,6 +19,11 @@ vec3 ibl_specular16(vec3 r, float key)
     return mix(texture(u_spec16_off, r).rgb, texture(u_spec16_on, r).rgb, key);
 }
 
+vec3 ibl_specular128(vec3 r, float key)
+{
+    return mix(texture(u_spec128_off, r).rgb, texture(u_spec128_on, r).rgb, key);
+}
+
 vec3 ibl_specular(vec3 r, float exponent, float key)
 {
     vec3 s16 = mix(texture(u_spec16_off, r).rgb, texture(u_spec16_on, r).rgb, key);

@@ -58,6 +58,57 @@ vec3 hdr_out(vec3 c)
     return mix(clamp(c, vec3(0.0), vec3(65504.0)), vec3(0.0), isnan(c));
 }
 
+#ifdef STAGE
+// The procedural patterns below, box-filtered over the pixel's footprint
+// (hw: half its width along the pattern's axis, from fwidth): their
+// periodic functions' integrals, differenced across the footprint, so a
+// window, a joint or a seam narrower than a pixel gives its share of the
+// pixel, not a hit or a miss that crawls from frame to frame.  The shift
+// by floor(x) keeps the difference exact far from the origin.
+// fract(x) in [a, b]: its integral from 0
+float pulse_int(float x, float a, float b)
+{
+    return floor(x) * (b - a) + clamp(fract(x) - a, 0.0, b - a);
+}
+
+float pulse_cover(float x, float hw, float a, float b)
+{
+    x -= floor(x);
+    hw = max(hw, 1e-4);
+    return (pulse_int(x + hw, a, b) - pulse_int(x - hw, a, b)) / (2.0 * hw);
+}
+
+// clamp(fract(x) / a, 0, 1): a ramp up from each integer (a seam on one side)
+float ramp_int(float x, float a)
+{
+    float f = fract(x);
+    return floor(x) * (1.0 - 0.5 * a) + (f < a ? f * f / (2.0 * a) : f - 0.5 * a);
+}
+
+float ramp_cover(float x, float hw, float a)
+{
+    x -= floor(x);
+    hw = max(hw, 1e-4);
+    return (ramp_int(x + hw, a) - ramp_int(x - hw, a)) / (2.0 * hw);
+}
+
+#if MATERIAL == 1
+// clamp(min(fract(x), 1 - fract(x)) / a, 0, 1): a joint on both sides of each integer
+float joint_int(float x, float a)
+{
+    float f = fract(x), g = 1.0 - f;
+    return floor(x) * (1.0 - a) + (f < a ? f * f / (2.0 * a) : g < a ? 1.0 - a - g * g / (2.0 * a) : f - 0.5 * a);
+}
+
+float joint_cover(float x, float hw, float a)
+{
+    x -= floor(x);
+    hw = max(hw, 1e-4);
+    return (joint_int(x + hw, a) - joint_int(x - hw, a)) / (2.0 * hw);
+}
+#endif
+#endif
+
 void main()
 {
     vec3 n = normalize(v_normal);
@@ -89,19 +140,22 @@ void main()
 #endif
 #ifdef STAGE
     // planks: a procedural albedo variation, matte with a faint sheen
-    float plank = floor(v_world.x * 2.5);
+    float px = v_world.x * 2.5;
+    float plank = floor(px);
     float grain = 0.85 + 0.15 * fract(sin(plank * 12.9898) * 43758.5453);
-    float seam = smoothstep(0.0, 0.02, fract(v_world.x * 2.5)) * 0.3 + 0.7;
+    float seam = ramp_cover(px, 0.5 * fwidth(px), 0.02) * 0.3 + 0.7;
     vec3 albedo = u_ring_color * grain * seam;
     vec3 spec_color = vec3(0.04);
     float exponent = 16.0;
 #if MATERIAL == 1
     if (v_world.y < -2.95) {
         // paving: 1 m slabs, each a little different, dark joints
-        vec2 slab = floor(v_world.xz);
+        vec2 slab = floor(v_world.xz), hw = 0.5 * fwidth(v_world.xz);
         float tone = 0.85 + 0.15 * fract(sin(dot(slab, vec2(12.9898, 78.233))) * 43758.5453);
-        vec2 f = fract(v_world.xz);
-        float joint = min(smoothstep(0.0, 0.03, min(f.x, f.y)), smoothstep(0.0, 0.03, min(1.0 - f.x, 1.0 - f.y)));
+        // where a pixel spans several slabs, their mean (what a box filter
+        // of many random tones gives) instead of one slab's tone at random
+        tone = mix(tone, 0.925, smoothstep(0.5, 2.0, 2.0 * max(hw.x, hw.y)));
+        float joint = joint_cover(v_world.x, hw.x, 0.03) * joint_cover(v_world.z, hw.y, 0.03);
         albedo = vec3(0.46, 0.44, 0.41) * tone * (0.6 + 0.4 * joint);
     }
 #elif MATERIAL == 3
@@ -113,15 +167,15 @@ void main()
     albedo *= (0.7 + 0.3 * grit) * mix(1.0, 0.6, depth);
 #elif MATERIAL == 2
     // concrete with a grid of glass windows (3.5 m floors, 2.5 m bays)
-    float along = abs(n.x) > 0.5 ? v_world.z : v_world.x;
-    vec2 cell = fract(vec2(along / 2.5, (v_world.y + 3.0) / 3.5));
-    bool wall = abs(n.y) < 0.5 && v_world.y > -1.0;
-    bool glass = wall && cell.x > 0.18 && cell.x < 0.82 && cell.y > 0.28 && cell.y < 0.86;
+    // glass: the share of the pixel on a window pane (both materials are
+    // shaded and mixed by it below)
+    vec2 cell = vec2((abs(n.x) > 0.5 ? v_world.z : v_world.x) / 2.5, (v_world.y + 3.0) / 3.5);
+    vec2 hw = 0.5 * fwidth(cell);
+    float glass = abs(n.y) < 0.5 ? clamp((v_world.y + 1.0) / (7.0 * max(hw.y, 1e-5)) + 0.5, 0.0, 1.0) : 0.0; // walls above -1 m
+    glass *= pulse_cover(cell.x, hw.x, 0.18, 0.82) * pulse_cover(cell.y, hw.y, 0.28, 0.86);
     vec3 block = floor(v_world / 12.0);
     float tone = 0.8 + 0.2 * fract(sin(dot(block, vec3(12.9898, 78.233, 37.719))) * 43758.5453);
-    albedo = glass ? vec3(0.03, 0.035, 0.04) : vec3(0.56, 0.53, 0.49) * tone;
-    spec_color = glass ? vec3(0.6) : vec3(0.03);
-    exponent = glass ? 128.0 : 16.0;
+    albedo = mix(vec3(0.56, 0.53, 0.49) * tone, vec3(0.03, 0.035, 0.04), glass);
 #endif
     float key = 1.0;
 #if MATERIAL == 2
@@ -154,6 +208,10 @@ void main()
 #endif
 #if defined(STAGE) && MATERIAL < 2
     vec3 specular = ibl_specular16(r, key);
+#elif defined(STAGE) && MATERIAL == 2
+    // concrete (0.03, exponent 16) and glass (0.6, exponent 128) by their shares
+    vec3 specular = mix(0.03 * ibl_specular16(r, key), 0.6 * ibl_specular128(r, key), glass);
+    spec_color = vec3(1.0);
 #else
     vec3 specular = ibl_specular(r, exponent, key);
 #endif
