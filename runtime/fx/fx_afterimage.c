@@ -40,7 +40,7 @@ static bool create(r_game *r, rs_err *err)
     if (!a->prog)
         return false;
     r_mesh_data m = {0};
-    if (!r_mesh_fighter(&m)) {
+    if (!r_mesh_fighter(&m, R_FIGHTER_FINE)) { /* the coarse one has the same extent */
         r_mesh_free(&m);
         return rs_fail(err, R_ERR_NOMEM, "out of memory for the fighter mesh");
     }

@@ -468,13 +468,16 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     gl.GenVertexArrays(1, &r->empty_vao);
 
     r_mesh_data m = {0};
-    bool ok = r_mesh_fighter(&m);
-    if (ok) {
-        r_upload_mesh(&m, &r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
-        r->fighter_count = (GLsizei)m.ni;
-        fighter_bone_ranges(&m, r->fighter_bone_first);
+    bool ok = true;
+    for (int lod = 0; ok && lod < R_FIGHTER_LODS; lod++) {
+        struct fighter_mesh *fm = &r->fighter_lod[lod];
+        if ((ok = r_mesh_fighter(&m, lod))) {
+            r_upload_mesh(&m, &fm->vao, &fm->vbo, &fm->ibo);
+            fm->count = (GLsizei)m.ni;
+            fighter_bone_ranges(&m, fm->bone_first);
+        }
+        r_mesh_free(&m);
     }
-    r_mesh_free(&m);
     if (ok && (ok = r_build_lens(&m))) {
         r_upload_mesh(&m, &r->lens_vao, &r->lens_vbo, &r->lens_ibo);
         r->lens_count = (GLsizei)m.ni;
@@ -581,7 +584,8 @@ void r_game_destroy(r_game *r)
     free_look(r);
     free_targets(r);
     r_graph_release(&r->graph);
-    r_free_mesh(&r->fighter_vao, &r->fighter_vbo, &r->fighter_ibo);
+    for (int lod = 0; lod < R_FIGHTER_LODS; lod++)
+        r_free_mesh(&r->fighter_lod[lod].vao, &r->fighter_lod[lod].vbo, &r->fighter_lod[lod].ibo);
     r_free_mesh(&r->lens_vao, &r->lens_vbo, &r->lens_ibo);
     gl.DeleteVertexArrays(1, &r->hud_vao);
     gl.DeleteVertexArrays(1, &r->empty_vao);
@@ -670,6 +674,18 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     return draw(r, prev, cur, alpha, w, h, 0, err);
 }
 
+/* The fighter mesh for a frame drawn at h rows: the coarse one below
+ * R_FIGHTER_COARSE_ROWS, where its facets are under a pixel (docs/renderer.md,
+ * "HDR, materials, mask"), unless the options ask for the fine one. */
+static void select_fighter_mesh(r_game *r, int h)
+{
+    const struct fighter_mesh *fm =
+        &r->fighter_lod[h < R_FIGHTER_COARSE_ROWS && !r->opts.fine_mesh ? R_FIGHTER_COARSE : R_FIGHTER_FINE];
+    r->fighter_vao = fm->vao;
+    r->fighter_count = fm->count;
+    memcpy(r->fighter_bone_first, fm->bone_first, sizeof r->fighter_bone_first);
+}
+
 static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip,
                  rs_err *err)
 {
@@ -695,6 +711,7 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     memset(f, 0, sizeof *f);
     f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = w, f->h = h, f->out_fbo = out;
     f->depth_only = skip != 0; /* only r_game_advance skips: a warm-up frame */
+    select_fighter_mesh(r, h);
     r_frame_setup(r, f);
     r->mask_final = 0;
     r_graph_run_skip(&r->graph, r, skip);

@@ -65,6 +65,8 @@ typedef struct r_game_opts {
                                afterimage; the same bytes) */
     bool light_apart;       /* tests: the shadow map and the silhouette in passes of their own even when their
                                sides agree (r_shadow.c draws both at once then; the same bytes) */
+    bool fine_mesh;         /* the fine fighter mesh at any size (r_mesh_fighter; by default the coarse one
+                               below R_FIGHTER_COARSE_ROWS rows drawn) */
     r_quality q;            /* zero: full quality */
 } r_game_opts;
 

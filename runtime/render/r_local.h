@@ -55,7 +55,13 @@ struct r_game {
     char stage_file[1024];
     GLuint prog[P_COUNT];
     char look_defines[320]; /* what the look's programs were compiled with */
-    GLuint fighter_vao, fighter_vbo, fighter_ibo;
+    /* the fighter mesh at each level of detail (r_mesh_fighter), and the
+     * one this frame draws (draw(), by the rows it is drawn at) */
+    struct fighter_mesh {
+        GLuint vao, vbo, ibo;
+        GLsizei count, bone_first[G_BONES + 1];
+    } fighter_lod[R_FIGHTER_LODS];
+    GLuint fighter_vao;
     GLsizei fighter_count;
     GLsizei fighter_bone_first[G_BONES + 1]; /* r_fx_gl's */
     GLuint lens_vao, lens_vbo, lens_ibo;

@@ -113,12 +113,13 @@ int r_mesh_box(r_mesh_data *m, const float lo[3], const float hi[3])
     return 1;
 }
 
-int r_mesh_fighter(r_mesh_data *m)
+int r_mesh_fighter(r_mesh_data *m, int lod)
 {
+    bool fine = lod == R_FIGHTER_FINE;
     for (int i = 0; i < G_BONES; i++) {
         const g_bone_def *b = &g_bones[i];
-        int seg = b->radius > FX(0.1) ? 20 : 14;
-        if (!r_mesh_capsule(m, fx_to_float(b->length), fx_to_float(b->radius), i, seg, 5))
+        int seg = b->radius > FX(0.1) ? (fine ? 20 : 14) : (fine ? 14 : 10);
+        if (!r_mesh_capsule(m, fx_to_float(b->length), fx_to_float(b->radius), i, seg, fine ? 5 : 4))
             return 0;
     }
     return 1;

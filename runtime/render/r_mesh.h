@@ -27,8 +27,15 @@ typedef struct r_mesh_data {
 int r_mesh_capsule(r_mesh_data *m, float length, float r, int bone, int segments, int rings);
 /* An axis-aligned box from lo to hi (bone index -1: world space). */
 int r_mesh_box(r_mesh_data *m, const float lo[3], const float hi[3]);
-/* The whole fighter: one capsule per bone of g_bones. */
-int r_mesh_fighter(r_mesh_data *m);
+/* The whole fighter: one capsule per bone of g_bones, at a level of
+ * detail.  Fine: 20 segments round the thick bones, 14 round the thin
+ * ones, 5 rings a cap; coarse: 14, 10 and 4, a little under half the
+ * triangles, for frames drawn at few rows (r_game.c, R_FIGHTER_COARSE_ROWS),
+ * where the fine mesh's extra triangles are smaller than the pixels but
+ * still cost a software rasteriser every pass that draws the fighters. */
+enum { R_FIGHTER_COARSE, R_FIGHTER_FINE, R_FIGHTER_LODS };
+#define R_FIGHTER_COARSE_ROWS 540 /* frames drawn at fewer rows take the coarse mesh */
+int r_mesh_fighter(r_mesh_data *m, int lod);
 void r_mesh_free(r_mesh_data *m);
 
 #endif
