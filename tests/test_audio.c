@@ -395,6 +395,33 @@ static void t_loudness_normalize_holds_peak(void)
     free(x);
 }
 
+/* A loudness known without a meter: BS.1770 gives a stereo 1 kHz sine the
+ * loudness of its peak level (its -0.691 takes back the K-weighting's gain
+ * at 1 kHz), so EBU Tech 3341's first case, a stereo 1 kHz sine at -23
+ * dBFS, reads -23.0 +- 0.1 LUFS.  Normalized to -16 LUFS, with no peak near
+ * the ceiling, the sine must come out at -16 dBFS: its sample peak, read
+ * here (sample 12 of every 48 is the crest), within 0.1 dB.  A target or a
+ * gain 0.5 dB off fails, whatever the meter says. */
+static void t_loudness_of_a_sine(void)
+{
+    size_t n = 5 * AU_RATE;
+    float *x = malloc(n * 2 * sizeof *x);
+    const double a = pow(10, -23 / 20.0), pi = acos(-1);
+    for (size_t i = 0; i < n; i++)
+        x[2 * i] = x[2 * i + 1] = (float)(a * sin(2 * pi * 1000 * (double)i / AU_RATE));
+    rs_err err = {0};
+    au_loudness m, b, after;
+    T_ASSERTF(au_loud_measure(x, n, &m, &err), "%s", err.msg);
+    T_ASSERTF(fabs(m.integrated - -23) <= 0.1, "a stereo 1 kHz sine at -23 dBFS: %.3f LUFS (EBU Tech 3341: -23.0 +- 0.1)",
+              m.integrated);
+    T_ASSERTF(fabs(m.true_peak - -23) <= 0.1, "a stereo 1 kHz sine at -23 dBFS: true peak %.3f dBTP", m.true_peak);
+    T_ASSERTF(au_loud_normalize(x, n, -16, -1, &b, &after, &err), "%s", err.msg);
+    double pk = 20 * log10(peak_of(x, 2 * n));
+    fprintf(stderr, "    sine: %.3f LUFS; normalized to -16: peak %.3f dBFS, %.3f LUFS\n", m.integrated, pk,
+            after.integrated);
+    T_ASSERTF(fabs(pk - -16) <= 0.1, "normalized to -16 LUFS, the sine peaks at %.3f dBFS, not -16", pk);
+    free(x);
+}
 
 /* The limiter streams: the normalized track read through au_norm_stream in
  * pieces of 1, 97, 800 and 48001 frames is, byte for byte, what
@@ -603,6 +630,7 @@ T_MAIN({"wav_round_trip", t_wav_round_trip}, {"wav_reads_other_formats", t_wav_r
        {"mixer_pan_gain_offset", t_mixer_pan_gain_offset},
        {"mixer_voice_limit_and_limiter", t_mixer_voice_limit_and_limiter}, {"mixer_music_phase", t_mixer_music_phase},
        {"cues_pan_and_diffs", t_cues_pan_and_diffs}, {"loudness_normalize_holds_peak", t_loudness_normalize_holds_peak},
+       {"loudness_of_a_sine", t_loudness_of_a_sine},
        {"loudness_stream_any_pieces", t_loudness_stream_any_pieces},
        {"track_streamed_equals_buffer", t_track_streamed_equals_buffer},
        {"track_identical_and_sliced", t_track_identical_and_sliced},

@@ -37,14 +37,37 @@ t_sound_wav_and_its_slices() {
     grep -q "ticks 600:660, 48000 frames; match .* -> -16.0 LUFS" part.txt || { cat part.txt; return 1; }
 }
 
+# Loudness as another meter measures it: ffmpeg's ebur128 filter (its own
+# BS.1770 code, not the libebur128 we normalize with) on the 16-bit WAV, to
+# a thousandth of a LU (its metadata; the summary rounds to 0.1).  The
+# integrated loudness within 0.2 LU of the target and of what we report;
+# the true peak within 0.2 dB of ours and under the -1 dBTP ceiling, and at
+# the default target, where temple's peaks need the limiter (which aims 0.2
+# dB under the ceiling), over -1.45 dBTP.  A target or a ceiling 0.5 dB off
+# fails.  Measured: -16.01 LUFS -1.20 dBTP, -23.00 LUFS -5.7 dBTP.
 t_sound_loudness_measured_by_ffmpeg() {
-    "$RS_BIN" replay sound "$DEMO" -o a.wav 2>/dev/null || return 1
-    "$RS_BIN" replay sound "$DEMO" -o b.wav --loudness -23 2>/dev/null || return 1
-    for f in a:-16 b:-23; do
-        ffmpeg -hide_banner -nostats -i "${f%%:*}.wav" -af ebur128=peak=true -f null - 2>m.txt
-        awk -v want="${f#*:}" '/I:/ { i = $2 } /Peak:/ { p = $2 }
-            END { d = i - want; if (d < 0) d = -d; if (d > 1 || p > -1.0) { print "I " i " (want " want "), peak " p; exit 1 } }' m.txt ||
-            return 1
+    "$RS_BIN" replay sound "$DEMO" -o a.wav 2>a.txt || { cat a.txt; return 1; }
+    "$RS_BIN" replay sound "$DEMO" -o b.wav --loudness -23 2>b.txt || { cat b.txt; return 1; }
+    for f in a:-16:limited b:-23:free; do
+        set -- $(echo "$f" | tr : ' ')
+        ffmpeg -hide_banner -nostats -loglevel error -i "$1.wav" \
+            -af "ebur128=peak=true:metadata=1,ametadata=mode=print:file=$1.meta" -f null - || return 1
+        # ours, from "... -> -16.0 LUFS -1.2 dBTP (gain +2.5 dB)"
+        ours=$(sed -n 's/.* -> \(-[0-9.]*\) LUFS \(-[0-9.]*\) dBTP.*/\1 \2/p' "$1.txt")
+        [ -n "$ours" ] || { cat "$1.txt"; return 1; }
+        awk -F= -v want="$2" -v mode="$3" -v ours="$ours" '
+            $1 == "lavfi.r128.I" { i = $2 }
+            $1 ~ /^lavfi\.r128\.true_peaks_ch/ && $2 > p { p = $2 }
+            function off(a, b) { return a > b ? a - b : b - a }
+            END {
+                split(ours, o, " "); tp = 20 * log(p) / log(10)
+                printf "    target %s: ffmpeg %.3f LUFS %.2f dBTP; ours %s LUFS %s dBTP\n", want, i, tp, o[1], o[2]
+                if (i == "" || off(i, want) > 0.2) { print "integrated " i " LUFS, the target " want; exit 1 }
+                if (off(i, o[1]) > 0.2) { print "ffmpeg says " i " LUFS, we said " o[1]; exit 1 }
+                if (off(tp, o[2]) > 0.2) { printf "ffmpeg says %.2f dBTP, we said %s\n", tp, o[2]; exit 1 }
+                if (tp > -1.0) { printf "true peak %.2f dBTP over the -1 dBTP ceiling\n", tp; exit 1 }
+                if (mode == "limited" && tp < -1.45) { printf "true peak %.2f dBTP: the limiter held it too low\n", tp; exit 1 }
+            }' "$1.meta" || return 1
     done
     "$RS_BIN" replay sound "$DEMO" -o c.wav --loudness off --ticks 0:60 2>c.txt || return 1
     grep -q "not normalized" c.txt || { cat c.txt; return 1; }

@@ -1,5 +1,6 @@
 /* capture/: the writer queue (cap, order, errors), the CPU reference
- * conversions, and the GPU path against the CPU path. */
+ * conversions, the GPU path against the CPU path, and both against BT.709
+ * as the test writes it from the standard (bt709_reference). */
 #define _GNU_SOURCE /* usleep */
 #include <math.h>
 #include <stdio.h>
@@ -362,6 +363,58 @@ static double psnr(const uint8_t *a, const uint8_t *b, size_t n)
     return se == 0 ? 99.0 : 10 * log10(255.0 * 255.0 * n / se);
 }
 
+/* The I420 frame a w x h RGBA picture (GL rows, bottom up) should make,
+ * unrounded, from the standard and not from capture/: BT.709's Kr 0.2126
+ * and Kb 0.0722, E'Y = Kr R + (1 - Kr - Kb) G + Kb B, E'Cb = (B - E'Y) /
+ * (2 (1 - Kb)), E'Cr = (R - E'Y) / (2 (1 - Kr)), limited range Y = 16 +
+ * 219 E'Y, C = 128 + 224 E'C; chroma from the mean of each 2x2 block (sited
+ * at the centre, as the capture documents). */
+static void bt709_reference(const uint8_t *px, int w, int h, double *out)
+{
+    const double kr = 0.2126, kb = 0.0722;
+    double *cb = out + (size_t)w * h, *cr = cb + (size_t)(w / 2) * (h / 2);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const uint8_t *p = px + ((size_t)(h - 1 - y) * w + x) * 4; /* frame rows top down */
+            out[(size_t)y * w + x] = 16 + 219 * (kr * p[0] + (1 - kr - kb) * p[1] + kb * p[2]) / 255;
+        }
+    for (int y = 0; y < h / 2; y++)
+        for (int x = 0; x < w / 2; x++) {
+            double rgb[3] = {0, 0, 0};
+            for (int k = 0; k < 4; k++) {
+                const uint8_t *p = px + ((size_t)(h - 1 - (2 * y + k / 2)) * w + 2 * x + k % 2) * 4;
+                for (int c = 0; c < 3; c++)
+                    rgb[c] += p[c] / (4 * 255.0);
+            }
+            double l = kr * rgb[0] + (1 - kr - kb) * rgb[1] + kb * rgb[2];
+            cb[(size_t)y * (w / 2) + x] = 128 + 224 * (rgb[2] - l) / (2 * (1 - kb));
+            cr[(size_t)y * (w / 2) + x] = 128 + 224 * (rgb[0] - l) / (2 * (1 - kr));
+        }
+}
+
+/* Every sample is the reference rounded, but those within 0.01 of a
+ * rounding tie (float arithmetic may go either way there): a conversion
+ * constant off by 0.002 moves samples by up to 0.4 LSB and shows as
+ * hundreds of differences. */
+static void check_bt709(const uint8_t *frame, const double *ref, size_t n, const char *what, int index)
+{
+    size_t bad = 0, first = n, ties = 0;
+    for (size_t k = 0; k < n; k++) {
+        double f = ref[k] - floor(ref[k]);
+        if (fabs(f - 0.5) < 0.01) {
+            ties++;
+            T_ASSERTF(abs(frame[k] - (int)floor(ref[k])) <= 1, "%s frame %d sample %zu: %u, reference %.4f", what, index, k,
+                      frame[k], ref[k]);
+        } else if (frame[k] != (int)floor(ref[k] + 0.5)) {
+            bad++;
+            first = k < first ? k : first;
+        }
+    }
+    T_ASSERTF(bad == 0, "%s frame %d: %zu of %zu samples are not BT.709 rounded, the first sample %zu: %u, reference %.4f",
+              what, index, bad, n, first, first < n ? frame[first] : 0, first < n ? ref[first] : 0);
+    T_ASSERTF(ties * 20 < n, "%s frame %d: %zu of %zu samples near a tie", what, index, ties, n);
+}
+
 /* sw x sh frames (320x180: a 2x downscale; 160x90: the output's size,
  * where the conversion reads the frame itself) through every path */
 static void gpu_vs_cpu(const char *backend, int sw, int sh)
@@ -391,6 +444,12 @@ static void gpu_vs_cpu(const char *backend, int sw, int sh)
         /* GPU and CPU implement the same maths: only rounding may differ */
         double q = psnr(gpu_async.frame[i], cpu_seq.frame[i], n);
         T_ASSERTF(q > 50, "frame %d: GPU vs CPU conversion PSNR %.1f dB", i, q);
+        if (sw == 160 && sh == 90) { /* the frame itself converted: each against the standard */
+            static double ref[sizeof gpu_async.frame[0]];
+            bt709_reference(px[i], sw, sh, ref);
+            check_bt709(gpu_async.frame[i], ref, n, "GPU", i);
+            check_bt709(cpu_seq.frame[i], ref, n, "CPU", i);
+        }
     }
     /* orientation: the texture's GL row 0 (bottom) has green 0, the top 255 */
     uint8_t top_left_y = gpu_async.frame[0][0], bottom_left_y = gpu_async.frame[0][(size_t)89 * 160];

@@ -1,5 +1,6 @@
 /* runtime/render/r_tone and shaders/tonemap.frag: the YCbCr tone curve
- * (docs/renderer.md, "Tone map, bloom, flare"), its lookup table, and the shader that uses it. */
+ * (docs/renderer.md, "Tone map, bloom, flare"), its lookup table, and the shader that uses it,
+ * against the curve and against points of it worked out outside the code (KNOWN). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +32,29 @@ static void t_curve_shape(void)
     }
     T_ASSERT(1 - r_tone_curve(R_TONE_X_MAX, 2.2) < 1e-6);
     T_ASSERT(r_tone_curve(1e30, 2.2) == 1);
+}
+
+/* Known points of the curve, worked outside the code: Python's decimal
+ * module at 40 digits, ((1 - exp(-x^2))^1.5)^(1/gamma) as exp(1.5 ln(1 -
+ * exp(-x^2)) / gamma), rounded to 10 places (Python's floats give the same
+ * 10 places).  1e-9: the literals' own rounding.  An exponent of 1.55 instead
+ * of 1.5 moves them by up to 0.012, exp(-1.01 x^2) by up to 0.003. */
+static const struct {
+    double x, gamma, want;
+} KNOWN[] = {
+    {0.18, 1, 0.0056923639},  {0.5, 1, 0.1040340194},  {1, 1, 0.5025738332},  {2, 1, 0.9726527268},
+    {4, 1, 0.9999998312},     {16, 1, 1.0},            {0.18, 2.2, 0.0954285838}, {0.5, 2.2, 0.3574880553},
+    {1, 2.2, 0.7314451431},   {2, 2.2, 0.9874753804},  {4, 2.2, 0.9999999233}, {16, 2.2, 1.0},
+    {0.18, 10, 0.5963885067}, {1, 10, 0.9335121768},   {0, 2.2, 0},
+};
+
+static void t_curve_known_points(void)
+{
+    for (size_t k = 0; k < sizeof KNOWN / sizeof KNOWN[0]; k++) {
+        double got = r_tone_curve(KNOWN[k].x, KNOWN[k].gamma);
+        T_ASSERTF(fabs(got - KNOWN[k].want) < 1e-9, "curve(%g) at gamma %g: %.10f, worked out %.10f", KNOWN[k].x,
+                  KNOWN[k].gamma, got, KNOWN[k].want);
+    }
 }
 
 static void t_lut_entries_are_the_curve(void)
@@ -98,28 +122,17 @@ static void t_small_tables_fail_the_goal(void)
     T_ASSERT(r_tone_max_error(R_TONE_LUT_DEFAULT, 1.0, 0) < 0.1 * STEP);
 }
 
-/* The shader against the double-precision curve: a ramp of grey HDR
- * values (and colours) through tonemap.frag into a float target. */
-enum { N = 512 };
-
-static void shader_vs_curve(double gamma, float saturation)
+/* w x rows RGBA float pixels through tonemap.frag, with the default-size
+ * table for gamma, into a float target: out gets them back (RGBA). */
+static void tone_draw(double gamma, float exposure, float saturation, const float *in, int w, int rows, float *out)
 {
-    plat *p = t_context("egl");
     rs_err e = {0};
     GLuint prog = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "tonemap.frag"}, &e);
     T_ASSERTF(prog, "%s", e.msg);
-    /* input: row 0 grey ramp x in [0, 6]; row 1 colours of the same luminance */
-    static float in[2 * N * 4];
-    for (int i = 0; i < N; i++) {
-        float x = 6.0f * i / (N - 1) * (6.0f * i / (N - 1)) / 6.0f; /* denser near 0 */
-        float *g = in + 4 * i, *c = in + 4 * (N + i);
-        g[0] = g[1] = g[2] = x, g[3] = 1;
-        c[0] = 1.5f * x, c[1] = 0.9f * x, c[2] = 0.4f * x, c[3] = 1;
-    }
     GLuint tex[3], fbo;
     gl.GenTextures(3, tex);
     gl.BindTexture(GL_TEXTURE_2D, tex[0]);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, N, 2, 0, GL_RGBA, GL_FLOAT, in);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, rows, 0, GL_RGBA, GL_FLOAT, in);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     float lut[R_TONE_LUT_DEFAULT];
@@ -129,12 +142,12 @@ static void shader_vs_curve(double gamma, float saturation)
     gl.TexParameteri(GL_TEXTURE_1D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl.TexParameteri(GL_TEXTURE_1D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     gl.BindTexture(GL_TEXTURE_2D, tex[2]);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, N, 2, 0, GL_RGBA, GL_FLOAT, NULL);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, rows, 0, GL_RGBA, GL_FLOAT, NULL);
     gl.GenFramebuffers(1, &fbo);
     gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex[2], 0);
     T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-    gl.Viewport(0, 0, N, 2);
+    gl.Viewport(0, 0, w, rows);
     gl.UseProgram(prog);
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindTexture(GL_TEXTURE_2D, tex[0]);
@@ -145,16 +158,38 @@ static void shader_vs_curve(double gamma, float saturation)
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_lut"), 1);
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_lut_size"), R_TONE_LUT_DEFAULT);
     gl.Uniform1f(gl.GetUniformLocation(prog, "u_lut_inv_power"), (float)(1.0 / r_tone_index_power(gamma)));
-    gl.Uniform1f(gl.GetUniformLocation(prog, "u_exposure"), 1.0f);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "u_exposure"), exposure);
     gl.Uniform1f(gl.GetUniformLocation(prog, "u_saturation"), saturation);
     gl.Uniform1i(gl.GetUniformLocation(prog, "u_write_mask"), 0);
     GLuint vao;
     gl.GenVertexArrays(1, &vao);
     gl.BindVertexArray(vao);
     gl.DrawArrays(GL_TRIANGLES, 0, 3);
-    static float out[2 * N * 4];
-    gl.ReadPixels(0, 0, N, 2, GL_RGBA, GL_FLOAT, out);
+    gl.ReadPixels(0, 0, w, rows, GL_RGBA, GL_FLOAT, out);
     T_EQ(gl.GetError(), GL_NO_ERROR);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteVertexArrays(1, &vao);
+    gl.DeleteFramebuffers(1, &fbo);
+    gl.DeleteTextures(3, tex);
+    gl.DeleteProgram(prog);
+}
+
+/* The shader against the double-precision curve: a ramp of grey HDR
+ * values (and colours) through tonemap.frag into a float target. */
+enum { N = 512 };
+
+static void shader_vs_curve(double gamma, float saturation)
+{
+    plat *p = t_context("egl");
+    /* input: row 0 grey ramp x in [0, 6]; row 1 colours of the same luminance */
+    static float in[2 * N * 4], out[2 * N * 4];
+    for (int i = 0; i < N; i++) {
+        float x = 6.0f * i / (N - 1) * (6.0f * i / (N - 1)) / 6.0f; /* denser near 0 */
+        float *g = in + 4 * i, *c = in + 4 * (N + i);
+        g[0] = g[1] = g[2] = x, g[3] = 1;
+        c[0] = 1.5f * x, c[1] = 0.9f * x, c[2] = 0.4f * x, c[3] = 1;
+    }
+    tone_draw(gamma, 1.0f, saturation, in, N, 2, out);
     double worst = 0;
     for (int i = 0; i < N; i++) {
         const float *g = out + 4 * i, *c = out + 4 * (N + i);
@@ -179,10 +214,70 @@ static void shader_vs_curve(double gamma, float saturation)
             worst / STEP);
     /* float math on the GPU, the table's own error < 0.1 step: allow 0.15 */
     T_ASSERTF(worst < 0.15 * STEP, "shader vs curve: %.5f of an 8-bit step", worst / STEP);
-    gl.DeleteVertexArrays(1, &vao);
-    gl.DeleteFramebuffers(1, &fbo);
-    gl.DeleteTextures(3, tex);
-    gl.DeleteProgram(prog);
+    plat_destroy(p);
+}
+
+/* The shader against the worked-out points (KNOWN), and colour by the
+ * curve's definition (docs/renderer.md): with Y the BT.709 luminance
+ * (Kr 0.2126, Kb 0.0722) of the exposed input and Y' its curve, each
+ * channel c goes to Y' + saturation (Y'/Y) (c - Y), i.e. c Y'/Y at
+ * saturation 1; worked out as KNOWN's at gamma 2.2 for a red (1, 0.1,
+ * 0.05: Y 0.28773, Y' 0.1778606094) and a blue (0.1, 0.15, 1.2: Y 0.21518,
+ * Y' 0.1211589667).  0.05 of an 8-bit step: the table and float arithmetic
+ * cost 0.015 (measured on llvmpipe); exp(-1.01 x^2) instead of exp(-x^2)
+ * moves the greys by 0.13 to 0.74 of a step, an exponent of 1.55 by 0.1 to
+ * 3.1, a luminance weight off by 0.002 the colours by 0.3 to 0.56. */
+static void t_shader_known_points(void)
+{
+    const double TOL = 0.05 * STEP;
+    static const float col[2][3] = {{1.0f, 0.1f, 0.05f}, {0.1f, 0.15f, 1.2f}};
+    static const double want_col[2][2][3] = { /* [saturation 1, 0.5][colour][channel] */
+        {{0.6181510770, 0.0618151077, 0.0309075539}, {0.0563058680, 0.0844588019, 0.6756704154}},
+        {{0.3980058432, 0.1198378585, 0.1043840816}, {0.0887324173, 0.1028088843, 0.3984146911}},
+    };
+    plat *p = t_context("egl");
+    enum { M = 16 };
+    float in[M * 4] = {0}, out[M * 4];
+    int n = 0, half = -1;
+    for (size_t k = 0; k < sizeof KNOWN / sizeof KNOWN[0]; k++)
+        if (KNOWN[k].gamma == 2.2) {
+            half = KNOWN[k].x == 0.5 ? n : half;
+            float *g = in + 4 * n++;
+            g[0] = g[1] = g[2] = (float)KNOWN[k].x, g[3] = 1;
+        }
+    for (int c = 0; c < 2; c++)
+        for (int ch = 0; ch < 4; ch++)
+            in[4 * (n + c) + ch] = ch < 3 ? col[c][ch] : 1;
+    double worst = 0;
+    /* saturation 1, saturation 0.5, and exposure 2 (grey 0.5 becomes the curve at 1) */
+    for (int pass = 0; pass < 3; pass++) {
+        tone_draw(2.2, pass == 2 ? 2.0f : 1.0f, pass == 1 ? 0.5f : 1.0f, in, n + 2, 1, out);
+        if (pass == 2) {
+            double d = fabs(out[4 * half] - 0.7314451431);
+            worst = fmax(worst, d);
+            T_ASSERTF(d < TOL, "exposure 2 on grey 0.5: %.6f, worked out 0.7314451431", out[4 * half]);
+            continue;
+        }
+        for (int i = 0, k = 0; pass == 0 && i < n; k++) {
+            if (KNOWN[k].gamma != 2.2)
+                continue;
+            for (int ch = 0; ch < 3; ch++) {
+                double d = fabs(out[4 * i + ch] - KNOWN[k].want);
+                worst = fmax(worst, d);
+                T_ASSERTF(d < TOL, "grey %g channel %d: %.6f, worked out %.6f (%.2f steps off)", KNOWN[k].x, ch,
+                          out[4 * i + ch], KNOWN[k].want, d / STEP);
+            }
+            i++;
+        }
+        for (int c = 0; c < 2; c++)
+            for (int ch = 0; ch < 3; ch++) {
+                double got = out[4 * (n + c) + ch], want = want_col[pass][c][ch], d = fabs(got - want);
+                worst = fmax(worst, d);
+                T_ASSERTF(d < TOL, "(%g, %g, %g) at saturation %.1f, channel %d: %.6f, worked out %.6f (%.2f steps off)",
+                          col[c][0], col[c][1], col[c][2], pass ? 0.5 : 1.0, ch, got, want, d / STEP);
+            }
+    }
+    fprintf(stderr, "    shader vs worked-out points: max error %.5f steps\n", worst / STEP);
     plat_destroy(p);
 }
 
@@ -191,11 +286,13 @@ static void t_shader_matches_curve_gamma_1(void) { shader_vs_curve(1.0, 1.0f); }
 static void t_shader_saturation_0_is_grey(void) { shader_vs_curve(2.2, 0.0f); }
 static void t_shader_matches_curve_gamma_10(void) { shader_vs_curve(10.0, 1.0f); }
 
-T_MAIN({"curve_shape", t_curve_shape}, {"lut_entries_are_the_curve", t_lut_entries_are_the_curve},
+T_MAIN({"curve_shape", t_curve_shape}, {"curve_known_points", t_curve_known_points},
+       {"lut_entries_are_the_curve", t_lut_entries_are_the_curve},
        {"default_lut_error_under_a_tenth_step", t_default_lut_error_under_a_tenth_step},
        {"small_tables_fail_the_goal", t_small_tables_fail_the_goal},
        {"shader_matches_curve_gamma_22", t_shader_matches_curve_gamma_22},
        {"shader_matches_curve_gamma_1", t_shader_matches_curve_gamma_1},
        {"shader_saturation_0_is_grey", t_shader_saturation_0_is_grey},
+       {"shader_known_points", t_shader_known_points},
        {"shader_matches_curve_gamma_10", t_shader_matches_curve_gamma_10},
        {"every_gamma_meets_the_goal", t_every_gamma_meets_the_goal})
