@@ -152,7 +152,7 @@ static void help(void)
            "  ringside render demos/dojo.rsr -o dojo.mp4\n"
            "                     the default job: 640x360, standard quality, AAC sound\n"
            "  ringside render m.rsr -o m.webm --size 1280x720 --quality high\n"
-           "                     720p VP9, 3x3 pixels drawn per output pixel\n"
+           "                     720p VP9, 2x2 pixels drawn per output pixel\n"
            "  ringside render m.rsr --from 1:00 --duration 10 -o clip.mkv\n"
            "                     ten seconds from the first minute\n"
            "  cat m.rsr | ringside render - -o - | ffplay -\n"

@@ -393,7 +393,7 @@ static void t_fp16_extremes(void)
     g_init(&st, snowfield(), 1);
     const r_stage base = *r_game_stage(r);
     static float hdr[W * H * 4];
-    const int nl = fx_snow_light_size();
+    const int nl = fx_snow_light_size(r);
     float *light = malloc((size_t)nl * nl * 4 * sizeof *light);
     T_ASSERT(light);
     const struct {

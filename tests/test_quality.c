@@ -14,6 +14,7 @@
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
 #include "../runtime/fx/fx_fog.h"
+#include "../runtime/fx/fx_snow_tex.h"
 #include "../runtime/render/r_game.h"
 #include "../runtime/render/r_quality.h"
 #include "../runtime/util/rs_file.h"
@@ -387,6 +388,37 @@ static void t_light_maps_at_the_asked_size(void)
     plat_destroy(p);
 }
 
+/* snow_light: the snow's light map at the asked side (0: 256), and a
+ * smaller map moves snowfield's picture a little, not a lot. */
+static void t_snow_light(void)
+{
+    plat *p = t_context("egl");
+    enum { W = 320, H = 180 };
+    uint8_t *a = frame_of("snowfield", 900, 10, NULL, W, H);
+    uint8_t *b = frame_of("snowfield", 900, 10, &(r_game_opts){.q = {.snow_light = 128}}, W, H);
+    double se = 0;
+    for (size_t i = 0; i < (size_t)W * H * 4; i += 4)
+        for (int c = 0; c < 3; c++)
+            se += (double)(a[i + c] - b[i + c]) * (a[i + c] - b[i + c]);
+    double psnr = se > 0 ? 10 * log10(255.0 * 255.0 / (se / (W * H * 3))) : 99;
+    fprintf(stderr, "    snowfield, snow light 128 vs 256: PSNR %.1f dB\n", psnr);
+    T_ASSERTF(se > 0, "snow_light 128 drew the same bytes as 256: the knob is ignored");
+    T_ASSERTF(psnr > 40, "snow_light 128 differs too much from 256: %.1f dB", psnr);
+    free(a), free(b);
+    for (int k = 0; k < 2; k++) {
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.snow_light = k ? 64 : 0}});
+        t_fb f;
+        t_fb_make(&f, 64, 36);
+        g_state prev, cur;
+        t_state_at("snowfield", 900, &prev, &cur);
+        t_draw(r, &f, &prev, &cur, 64, 36);
+        T_EQ(fx_snow_light_size(r), k ? 64 : 256);
+        t_fb_free(&f);
+        r_game_destroy(r);
+    }
+    plat_destroy(p);
+}
+
 static void t_water_grid(void)
 {
     plat *p = t_context("egl");
@@ -556,6 +588,8 @@ static void t_out_of_range_refused(void)
     refused((r_quality){.fog_size = 32}, "fog_size 32 out of range");
     refused((r_quality){.fog_size = 2048}, "64..1024");
     refused((r_quality){.bloom_levels = 3}, "bloom_levels 3 out of range");
+    refused((r_quality){.snow_light = 32}, "snow_light 32 out of range");
+    refused((r_quality){.snow_light = 512}, "64..256");
     /* the ends of the ranges are taken */
     r_game_destroy(t_game_opts(&(r_game_opts){.q = {.shadow_size = 128, .sil_size = 64, .water_grid = 256,
                                                      .fog_size = 1024, .bloom_levels = 1}}));
@@ -622,6 +656,8 @@ static void t_presets_are_the_documented_table(void)
                 q.lspsm_size = v;
             else if (sscanf(tok, "water %d", &v) == 1)
                 q.water_grid = v;
+            else if (sscanf(tok, "snow light %d", &v) == 1)
+                q.snow_light = v;
             else if (sscanf(tok, "fog %d", &v) == 1)
                 q.fog_size = v;
             else if (sscanf(tok, "bloom %d", &v) == 1)
@@ -629,11 +665,12 @@ static void t_presets_are_the_documented_table(void)
         }
         T_ASSERTF(scale == p->scale, "%s: scale %g in the doc, %g in r_presets", p->name, scale, p->scale);
         T_ASSERTF(!memcmp(&q, &p->q, sizeof q),
-                  "%s: the doc's knobs (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, fog %d, bloom %d) "
-                  "are not r_presets' (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, fog %d, bloom %d)",
+                  "%s: the doc's knobs (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, fog %d, bloom %d, "
+                  "snow light %d) are not r_presets' (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, "
+                  "fog %d, bloom %d, snow light %d)",
                   p->name, q.aa, q.mask_half, q.shadow_size, q.sil_size, q.lspsm_size, q.water_grid, q.fog_size,
-                  q.bloom_levels, p->q.aa, p->q.mask_half, p->q.shadow_size, p->q.sil_size, p->q.lspsm_size,
-                  p->q.water_grid, p->q.fog_size, p->q.bloom_levels);
+                  q.bloom_levels, q.snow_light, p->q.aa, p->q.mask_half, p->q.shadow_size, p->q.sil_size, p->q.lspsm_size,
+                  p->q.water_grid, p->q.fog_size, p->q.bloom_levels, p->q.snow_light);
     }
     free(doc);
 }
@@ -643,4 +680,4 @@ T_MAIN({"presets_are_the_documented_table", t_presets_are_the_documented_table},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
        {"shadow_and_silhouette_in_one_draw", t_shadow_and_silhouette_in_one_draw},
        {"silhouette_mips_whole", t_silhouette_mips_whole},
-       {"water_grid", t_water_grid}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})
+       {"water_grid", t_water_grid}, {"snow_light", t_snow_light}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})

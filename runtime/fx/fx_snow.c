@@ -42,7 +42,7 @@
 extern const r_fx_module fx_snow_module;
 #define SNOW(r) ((struct fx_snow_state *)r_fx_state((r), &fx_snow_module))
 
-#define SNOW_LIGHT 256              /* texture-space lighting texels per side */
+#define SNOW_LIGHT 256              /* texture-space lighting texels per side: r_quality.snow_light overrides it */
 /* The surface grid: a vertex on every SNOW_COL_STRIDE-th map texel along
  * x; along z on every texel row within SNOW_BAND rows of the fight line
  * (z = 0: about +-0.5 m on a 4 m ring), where the fighters' bones reach
@@ -57,7 +57,7 @@ extern const r_fx_module fx_snow_module;
 #define MAX_STAMPS (4 * G_BONES)    /* both fighters, this tick and the one before */
 #define COLOR_TILE 0.8f             /* metres per repeat of the colour textures */
 #define DETAIL_TILE 2.0f            /* metres per repeat of the crust normal map: lumps of ~8 cm, which
-                                       the 3 cm texels of the lighting can hold */
+                                       the 3 cm texels of the default lighting can hold */
 
 enum { S_RESET, S_STAMP, S_LIGHT, S_KEY, S_SURFACE, S_PROGS };
 
@@ -67,6 +67,7 @@ struct fx_snow_state {
     GLuint untouched_tex, trampled_tex;   /* heights, same size as the map */
     float half;                           /* the ring half-size they were made for; 0: none yet */
     GLuint light_tex, light_fbo, tmp_tex, tmp_fbo; /* RES_SNOW_LIGHT, and the blur's half way */
+    int light_size;                       /* their side: r_quality.snow_light or SNOW_LIGHT */
     GLuint key_tex, key_fbo;              /* 1x1: the key light's colour (snow_key.frag) */
     GLuint color_tex, detail_tex;
     GLuint grid_vao, grid_vbo, grid_ibo;
@@ -193,15 +194,15 @@ static bool snow_create(r_game *r, rs_err *err)
         if (!(s->prog[d[i].id] = r_program(&(r_program_desc){.vs = d[i].vs, .fs = d[i].fs, .defines = d[i].defines}, err)))
             return false;
 
-    const int n = R_SNOW_MAP;
+    const int n = R_SNOW_MAP, nl = s->light_size = r_fx_quality(r)->snow_light > 0 ? r_fx_quality(r)->snow_light : SNOW_LIGHT;
     s->map_tex = r_tex2d(GL_R32F, n, n, GL_RED, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     s->map_fbo = r_fbo_for(s->map_tex, 0, 0);
     GLenum st_map = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
     s->untouched_tex = r_tex2d(GL_R32F, n, n, GL_RED, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     s->trampled_tex = r_tex2d(GL_R32F, n, n, GL_RED, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
-    s->tmp_tex = r_tex2d(GL_RGBA16F, SNOW_LIGHT, SNOW_LIGHT, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    s->tmp_tex = r_tex2d(GL_RGBA16F, nl, nl, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     s->tmp_fbo = r_fbo_for(s->tmp_tex, 0, 0);
-    s->light_tex = r_tex2d(GL_RGBA16F, SNOW_LIGHT, SNOW_LIGHT, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    s->light_tex = r_tex2d(GL_RGBA16F, nl, nl, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     s->light_fbo = r_fbo_for(s->light_tex, 0, 0);
     GLenum st_light = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
     s->key_tex = r_tex2d(GL_RGBA16F, 1, 1, GL_RGBA, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
@@ -357,7 +358,7 @@ static void run_light(void *u)
     struct fx_snow_state *s = SNOW(r);
     GLuint p = s->prog[S_LIGHT];
     gl.BindFramebuffer(GL_FRAMEBUFFER, s->light_fbo);
-    gl.Viewport(0, 0, SNOW_LIGHT, SNOW_LIGHT);
+    gl.Viewport(0, 0, s->light_size, s->light_size);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
     gl.Disable(GL_BLEND);
@@ -369,7 +370,7 @@ static void run_light(void *u)
     r_bind_ibl(r, p);
     gl.Uniform1f(r_loc(p, "u_half"), s->half);
     gl.Uniform1f(r_loc(p, "u_detail_tile"), DETAIL_TILE);
-    gl.Uniform2f(r_loc(p, "u_size"), SNOW_LIGHT, SNOW_LIGHT);
+    gl.Uniform2f(r_loc(p, "u_size"), (float)s->light_size, (float)s->light_size);
     const frame *f = r_fx_frame(r);
     gl.Uniform3f(r_loc(p, "u_eye"), f->eye.x, f->eye.y, f->eye.z);
     gl.Uniform3f(r_loc(p, "u_light_dir"), f->light_dir.x, f->light_dir.y, f->light_dir.z);
@@ -388,8 +389,11 @@ static void run_light_blur(void *u)
 {
     r_game *r = u;
     struct fx_snow_state *s = SNOW(r);
-    r_blur_into(r, s->tmp_fbo, s->light_tex, 0, SNOW_LIGHT, SNOW_LIGHT, 1, 0);
-    r_blur_into(r, s->light_fbo, s->tmp_tex, 0, SNOW_LIGHT, SNOW_LIGHT, 0, 1);
+    /* the same reach in metres at any size: steps of SNOW_LIGHT's texels */
+    int n = s->light_size;
+    float k = (float)n / SNOW_LIGHT;
+    r_blur_into(r, s->tmp_fbo, s->light_tex, 0, n, n, k, 0);
+    r_blur_into(r, s->light_fbo, s->tmp_tex, 0, n, n, 0, k);
 }
 
 /* ---- snow_surface ---- */
@@ -423,9 +427,10 @@ static void run_surface(void *u)
 
 /* ---- test hooks (fx_snow_tex.h) ---- */
 
-int fx_snow_light_size(void)
+int fx_snow_light_size(r_game *r)
 {
-    return SNOW_LIGHT;
+    struct fx_snow_state *s = SNOW(r);
+    return s ? s->light_size : 0;
 }
 
 bool fx_snow_read(r_game *r, const char *which, float *out)

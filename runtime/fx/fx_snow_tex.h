@@ -36,11 +36,11 @@ void fx_snow_tex_detail_normals(uint8_t *rgba, int n);
 
 /* Test hooks (fx_snow.c).  which: "map" (the displacement map),
  * "untouched", "trampled" (R_SNOW_MAP^2 floats) or "light" (the blurred
- * texture-space lighting, RGBA: fx_snow_light_size()^2 * 4).
+ * texture-space lighting, RGBA: fx_snow_light_size(r)^2 * 4).
  * False when the snow module has no such texture. */
 typedef struct r_game r_game;
 bool fx_snow_read(r_game *r, const char *which, float *out);
-int fx_snow_light_size(void);
+int fx_snow_light_size(r_game *r); /* 0: no snow module */
 /* Stamps n capsules into the map the way a tick's contacts are stamped
  * (the next frame's reset restarts it). */
 typedef struct r_fx_capsule r_fx_capsule;

@@ -398,8 +398,9 @@ static bool check_quality(const r_quality *q, rs_err *err)
         {"water_grid", "the water surface's quads a side", 16, 256},
         {"fog_size", "the mist's density map's side", 64, 1024},
         {"bloom_levels", "the bloom levels added", 1, 2},
+        {"snow_light", "the snow's light map's side", 64, 256},
     };
-    const int v[] = {q->shadow_size, q->sil_size, q->water_grid, q->fog_size, q->bloom_levels};
+    const int v[] = {q->shadow_size, q->sil_size, q->water_grid, q->fog_size, q->bloom_levels, q->snow_light};
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
         if (v[i] != 0 && (v[i] < k[i].lo || v[i] > k[i].hi))
             return rs_fail(err, R_ERR_QUALITY, "quality: %s %d out of range: %s is %d..%d (0 = default)", k[i].name, v[i],

@@ -49,6 +49,7 @@ typedef struct r_quality {
     int lspsm_size;   /* LSPSM shadow map, texels a side: 0 = the module's default; clamped to 256..4096 */
     int fog_size;     /* the mist's top-down density map, 64..1024: 0 = the module's default */
     int water_grid;   /* water surface quads a side, 16..256: 0 = the module's default */
+    int snow_light;   /* the snow's texture-space light map, texels a side, 64..256: 0 = 256 */
 } r_quality;
 
 /* Zero is the default for every field. */

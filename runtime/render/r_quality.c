@@ -7,11 +7,12 @@
 /* The table `ringside bench quality` chose (docs/accuracy.md has the
  * measurement).  Zero in a knob is its full-quality default. */
 const r_preset r_presets[R_PRESETS] = {
-    {"draft", 1.0, {.shadow_size = 512, .sil_size = 256, .mask_half = true, .lspsm_size = 1024, .water_grid = 32},
+    {"draft", 1.0, {.shadow_size = 512, .sil_size = 256, .mask_half = true, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128},
      34.0, "1:1, small light-space maps: previews"},
-    {"standard", 1.0, {.aa = R_AA_FXAA, .mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32}, 38.0,
-     "1:1, FXAA, the cheaper maps: the default"},
-    {"high", 3.0, {0}, 44.0, "3x3 pixels drawn per output pixel"},
+    {"standard", 1.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128}, 38.0,
+     "1:1, the cheaper maps: the default"},
+    {"high", 2.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128}, 44.0,
+     "2x2 pixels drawn per output pixel"},
     {"reference", 4.0, {0}, 0.0, "4x4, every knob at full: the measure"},
 };
 

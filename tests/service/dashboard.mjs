@@ -255,7 +255,7 @@ async function main() {
     const formats = await page.$$eval('#upload-format option', (os) => os.map((o) => o.value));
     if (!formats.includes('mkv')) fail(`the format menu offers ${formats.join(', ')}: no mkv`);
     const high = await page.$eval('#upload-quality option[value="high"]', (o) => o.textContent);
-    if (!/3×3/.test(high)) fail(`the high quality option says '${high}', not 3×3`);
+    if (!/2×2/.test(high)) fail(`the high quality option says '${high}', not 2×2`);
     if (opt.format === 'mp4') {
       const can = await page.evaluate(() => document.createElement('video').canPlayType('video/mp4; codecs="avc1.640028"'));
       if (!can) fail('this Chromium cannot play H.264 mp4; use --format webm');
