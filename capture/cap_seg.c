@@ -84,7 +84,8 @@ bool cap_seg_hashes_parse(const char *text, size_t len, const char *path, uint64
         char *q;
         errno = 0;
         unsigned long long n = strtoull(p, &q, 10);
-        ok = q > p && *p >= '0' && *p <= '9' && !errno && n == want && *q == ' ';
+        /* N as the render writes it (%llu): digits only, no leading zero */
+        ok = q > p && *p >= '0' && *p <= '9' && (*p != '0' || q == p + 1) && !errno && n == want && *q == ' ';
         for (int i = 1; ok && i <= 16; i++)
             ok = q + i < stop && ((q[i] >= '0' && q[i] <= '9') || (q[i] >= 'a' && q[i] <= 'f'));
         ok = ok && q + 17 < stop && q[17] == '\n';
