@@ -167,13 +167,14 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 # shared; no FFmpeg, GL or database code is built in (the libraries'
 # fallbacks stand in), libmicrohttpd is, for the HTTP layer.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := replay wire seg
+FUZZ_TARGETS := replay wire seg stage
 FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
                -DRS_HAVE_MHD=1 -MMD -MP
 FUZZ_UTIL := runtime/util/rs_err.c runtime/util/rs_file.c runtime/util/rs_hash.c
 FUZZ_SRC_replay := $(filter-out tests/simhash.c,$(SIM_SRC))
 FUZZ_SRC_wire := service/svc_wire.c
 FUZZ_SRC_seg := capture/cap_seg.c $(FUZZ_UTIL)
+FUZZ_SRC_stage := runtime/render/r_stage.c $(wildcard runtime/game/*.c) $(FUZZ_UTIL)
 FUZZ_LIBS := -lm -lpthread -ldl
 ifneq ($(SKIP_CONFIG),1)
 # objects depend on the flags, as the main build's do
@@ -192,6 +193,7 @@ $(foreach t,$(FUZZ_TARGETS),$(eval $(call FUZZ_RULE,$(t))))
 # in build/fuzz/corpus-NAME (fuzz-run: the replay reader)
 FUZZ_SEEDS_replay := demos/*.rsr tests/golden/dojo-format1.rsr
 FUZZ_MAXLEN_replay := 65536
+FUZZ_SEEDS_stage := stages/*.stage tests/fuzz/stage/*
 fuzz-run: fuzz-run-replay
 fuzz-run-%: build/fuzz/fuzz_%
 	@mkdir -p build/fuzz/corpus-$*
