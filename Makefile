@@ -167,13 +167,19 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 # shared; no FFmpeg, GL or database code is built in (the libraries'
 # fallbacks stand in), libmicrohttpd is, for the HTTP layer.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := replay wire seg stage
+FUZZ_TARGETS := replay wire seg stage config
 FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
                -DRS_HAVE_MHD=1 -MMD -MP
 FUZZ_UTIL := runtime/util/rs_err.c runtime/util/rs_file.c runtime/util/rs_hash.c
 FUZZ_SRC_replay := $(filter-out tests/simhash.c,$(SIM_SRC))
 FUZZ_SRC_wire := service/svc_wire.c
+# what capture/cap.c's size checks (svc_config_finish, uploads) bring along
+FUZZ_CAPTURE := capture/cap.c capture/cap_cpu.c capture/cap_scale.c capture/cap_sink.c capture/cap_writer.c \
+                capture/cap_out.c capture/cap_sink_images.c capture/cap_sink_y4m.c capture/cap_enc.c \
+                runtime/gl/rgl.c runtime/render/r_shader.c runtime/util/rs_progress.c runtime/util/rs_log.c \
+                runtime/util/rs_oiio_load.c runtime/util/rs_out.c
 FUZZ_SRC_seg := capture/cap_seg.c $(FUZZ_UTIL)
+FUZZ_SRC_config := service/svc_config.c $(FUZZ_CAPTURE) $(FUZZ_UTIL)
 FUZZ_SRC_stage := runtime/render/r_stage.c $(wildcard runtime/game/*.c) $(FUZZ_UTIL)
 FUZZ_LIBS := -lm -lpthread -ldl
 ifneq ($(SKIP_CONFIG),1)
