@@ -167,7 +167,7 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 # shared; no FFmpeg, GL or database code is built in (the libraries'
 # fallbacks stand in), libmicrohttpd is, for the HTTP layer.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := replay wire seg stage config
+FUZZ_TARGETS := replay wire seg stage config y4m
 FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
                -DRS_HAVE_MHD=1 -MMD -MP
 FUZZ_UTIL := runtime/util/rs_err.c runtime/util/rs_file.c runtime/util/rs_hash.c
@@ -180,6 +180,7 @@ FUZZ_CAPTURE := capture/cap.c capture/cap_cpu.c capture/cap_scale.c capture/cap_
                 runtime/util/rs_oiio_load.c runtime/util/rs_out.c
 FUZZ_SRC_seg := capture/cap_seg.c $(FUZZ_UTIL)
 FUZZ_SRC_config := service/svc_config.c $(FUZZ_CAPTURE) $(FUZZ_UTIL)
+FUZZ_SRC_y4m := player/mv_src.c player/mv_y4m.c player/mv_ffmpeg.c $(FUZZ_UTIL)
 FUZZ_SRC_stage := runtime/render/r_stage.c $(wildcard runtime/game/*.c) $(FUZZ_UTIL)
 FUZZ_LIBS := -lm -lpthread -ldl
 ifneq ($(SKIP_CONFIG),1)
