@@ -167,9 +167,9 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 # shared; no FFmpeg, GL or database code is built in (the libraries'
 # fallbacks stand in), libmicrohttpd is, for the HTTP layer.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := replay wire seg stage config y4m
+FUZZ_TARGETS := replay wire seg stage config y4m http
 FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
-               -DRS_HAVE_MHD=1 -MMD -MP
+               -DRS_HAVE_MHD=1 $(shell pkg-config --cflags libmicrohttpd 2>/dev/null) -MMD -MP
 FUZZ_UTIL := runtime/util/rs_err.c runtime/util/rs_file.c runtime/util/rs_hash.c
 FUZZ_SRC_replay := $(filter-out tests/simhash.c,$(SIM_SRC))
 FUZZ_SRC_wire := service/svc_wire.c
@@ -180,6 +180,15 @@ FUZZ_CAPTURE := capture/cap.c capture/cap_cpu.c capture/cap_scale.c capture/cap_
                 runtime/util/rs_oiio_load.c runtime/util/rs_out.c
 FUZZ_SRC_seg := capture/cap_seg.c $(FUZZ_UTIL)
 FUZZ_SRC_config := service/svc_config.c $(FUZZ_CAPTURE) $(FUZZ_UTIL)
+# the HTTP layer's files and what they call (the queue stores' fallbacks)
+FUZZ_SERVICE := service/svc_http_gate.c service/svc_http_routes.c service/svc_http_reply.c service/svc_http_guard.c \
+                service/svc_http_jobs.c service/svc_http_ops.c service/svc_http_recv.c service/svc_auth.c \
+                service/svc_upload.c service/svc_encode.c service/svc_json.c service/svc_log.c service/svc_store.c \
+                service/svc_store_pg.c service/svc_store_sqlite.c service/svc_files.c service/svc_queue_view.c \
+                service/svc_wire.c runtime/replay/rp.c $(wildcard runtime/game/*.c) runtime/render/r_quality.c \
+                $(FUZZ_CAPTURE) $(FUZZ_UTIL)
+FUZZ_SRC_http := $(FUZZ_SERVICE)
+FUZZ_LIBS_http := -lmicrohttpd
 FUZZ_SRC_y4m := player/mv_src.c player/mv_y4m.c player/mv_ffmpeg.c $(FUZZ_UTIL)
 FUZZ_SRC_stage := runtime/render/r_stage.c $(wildcard runtime/game/*.c) $(FUZZ_UTIL)
 FUZZ_LIBS := -lm -lpthread -ldl
