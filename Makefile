@@ -169,6 +169,7 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS := replay wire seg stage config y4m http
 FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
+               -fno-sanitize-recover=undefined \
                -DRS_HAVE_MHD=1 $(shell pkg-config --cflags libmicrohttpd 2>/dev/null) -MMD -MP
 FUZZ_UTIL := runtime/util/rs_err.c runtime/util/rs_file.c runtime/util/rs_hash.c
 FUZZ_SRC_replay := $(filter-out tests/simhash.c,$(SIM_SRC))
