@@ -167,7 +167,7 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 # shared; no FFmpeg, GL or database code is built in (the libraries'
 # fallbacks stand in), libmicrohttpd is, for the HTTP layer.
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS := replay wire seg stage config y4m http
+FUZZ_TARGETS := replay wire seg stage config y4m http upload
 FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
                -fno-sanitize-recover=undefined \
                -DRS_HAVE_MHD=1 $(shell pkg-config --cflags libmicrohttpd 2>/dev/null) -MMD -MP
@@ -190,6 +190,8 @@ FUZZ_SERVICE := service/svc_http_gate.c service/svc_http_routes.c service/svc_ht
                 $(FUZZ_CAPTURE) $(FUZZ_UTIL)
 FUZZ_SRC_http := $(FUZZ_SERVICE)
 FUZZ_LIBS_http := -lmicrohttpd
+FUZZ_SRC_upload := $(FUZZ_SERVICE) service/svc_config.c
+FUZZ_LIBS_upload := -lmicrohttpd
 FUZZ_SRC_y4m := player/mv_src.c player/mv_y4m.c player/mv_ffmpeg.c $(FUZZ_UTIL)
 FUZZ_SRC_stage := runtime/render/r_stage.c $(wildcard runtime/game/*.c) $(FUZZ_UTIL)
 FUZZ_LIBS := -lm -lpthread -ldl

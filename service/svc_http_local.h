@@ -216,6 +216,10 @@ enum MHD_Result http_retry(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_health(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_metrics(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_dashboard(svc_daemon *d, struct MHD_Connection *c, req *q);
+/* An upload's job parameters the form left to the query string, and its
+ * file name (the form's, else ?name=, else X-Filename); false
+ * (SVC_ERR_BAD_PARAM) for a value longer than its room. */
+bool http_upload_query(struct MHD_Connection *c, svc_upload *u, rs_err *err);
 /* An upload refused: counted for /metrics (ringside_uploads_rejected_total). */
 void http_count_rejected(svc_daemon *d);
 
