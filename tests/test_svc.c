@@ -1138,6 +1138,8 @@ static void t_tokens_and_bearer(void)
     T_ASSERT(!svc_listen_is_loopback("0.0.0.0:8080") && !svc_listen_is_loopback(":8080"));
     T_ASSERT(!svc_listen_is_loopback("[::]:80") && !svc_listen_is_loopback("127.0.0.1.evil:80"));
     T_ASSERT(!svc_listen_is_loopback("10.0.0.1:80") && !svc_listen_is_loopback("1270.0.0.1:80"));
+    /* getaddrinfo reads a leading zero as octal: 0127.0.0.1 is 87.0.0.1 (found by fuzz_http) */
+    T_ASSERT(!svc_listen_is_loopback("0127.0.0.1:8080") && !svc_listen_is_loopback("127.0.0.4294967296:80"));
 }
 
 /* The route table decides routing, 404 against 405, the open routes and
