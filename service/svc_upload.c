@@ -88,6 +88,8 @@ bool svc_upload_field(svc_upload *u, const char *key, const char *filename, cons
     if (dst && off + size < room) {
         memcpy(dst + off, data, size);
         dst[off + size] = 0;
+    } else if (dst) {
+        dst[0] = 0; /* too long: the pieces before this one go too, however the value was cut */
     }
     return true;
 }

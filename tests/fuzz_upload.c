@@ -60,8 +60,12 @@ static void feed(one *o, int k, const char *data, size_t n)
 
 static bool same_upload(const svc_upload *a, const svc_upload *b)
 {
-    return a->len == b->len && (!a->len || !memcmp(a->body, b->body, a->len)) && a->too_large == b->too_large &&
-           !a->bad == !b->bad && !strcmp(a->name, b->name) && !memcmp(&a->p, &b->p, sizeof a->p);
+    bool same = a->len == b->len && (!a->len || !memcmp(a->body, b->body, a->len)) && a->too_large == b->too_large &&
+                !a->bad == !b->bad && !strcmp(a->name, b->name);
+#define X(name, room) same = same && !strcmp(a->p.name, b->p.name);
+    SVC_JOB_PARAMS(X)
+#undef X
+    return same;
 }
 
 static void check_job(svc_upload *u)

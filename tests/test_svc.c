@@ -1200,6 +1200,9 @@ static void t_upload_params(void)
     T_ASSERT(svc_upload_field(&u, "codec", NULL, "h2", 0, 2) && svc_upload_field(&u, "codec", NULL, "64", 2, 2));
     T_ASSERT(!strcmp(u.p.codec, "h264"));
     T_ASSERT(svc_upload_field(&u, "crf", NULL, "123456789", 0, 9) && !u.p.crf[0]);
+    /* and in pieces, however it is cut: the pieces that fitted go too (found by fuzz_upload) */
+    T_ASSERT(svc_upload_field(&u, "crf", NULL, "1234", 0, 4) && svc_upload_field(&u, "crf", NULL, "56789", 4, 5));
+    T_ASSERT(!u.p.crf[0]);
     T_ASSERT(svc_upload_field(&u, "replay", "dir/a\x01" "b.rsr", "RS", 0, 2) && u.len == 2);
     T_ASSERT(!strcmp(u.name, "a_b.rsr"));
     T_ASSERT(svc_upload_field(&u, "other", NULL, "x", 0, 1) && svc_upload_field(&u, NULL, NULL, "x", 0, 1));
