@@ -147,13 +147,13 @@ static void request(one *o, const char *query, const char *type)
     int sv[2];
     if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sv) != 0)
         abort();
-    size_t cap = 1024 + strlen(query) + strlen(type) + o->len, n = 0;
-    char *req = malloc(cap);
-    n = (size_t)snprintf(req, cap,
-                         "POST /jobs%s%s HTTP/1.1\r\nHost: localhost\r\nContent-Type: %s\r\nContent-Length: %zu\r\n"
-                         "Connection: close\r\n\r\n",
-                         query[0] ? "?" : "", query, type, o->len);
-    memcpy(req + n, o->body, o->len);
+    size_t cap = 1024 + strlen(query) + strlen(type) + o->len;
+    char *text = malloc(cap);
+    size_t n = (size_t)snprintf(text, cap,
+                                "POST /jobs%s%s HTTP/1.1\r\nHost: localhost\r\nContent-Type: %s\r\n"
+                                "Content-Length: %zu\r\nConnection: close\r\n\r\n",
+                                query[0] ? "?" : "", query, type, o->len);
+    memcpy(text + n, o->body, o->len);
     n += o->len;
     struct sockaddr_in peer = {.sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
     if (MHD_add_connection(mhd, sv[1], (struct sockaddr *)&peer, sizeof peer) != MHD_YES)
@@ -164,7 +164,7 @@ static void request(one *o, const char *query, const char *type)
      * request as it is taken and drains the answer until then */
     for (int round = 0; round < 100000; round++) {
         if (sent < n) {
-            ssize_t w = send(sv[0], req + sent, n - sent, MSG_DONTWAIT | MSG_NOSIGNAL);
+            ssize_t w = send(sv[0], text + sent, n - sent, MSG_DONTWAIT | MSG_NOSIGNAL);
             sent += w > 0 ? (size_t)w : 0;
             if (sent == n)
                 shutdown(sv[0], SHUT_WR);
@@ -175,7 +175,7 @@ static void request(one *o, const char *query, const char *type)
             break; /* closed: the request is over */
     }
     close(sv[0]);
-    free(req);
+    free(text);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
