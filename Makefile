@@ -99,7 +99,7 @@ check-layers:
 	@tools/check-layers.sh
 	@tools/check-length.sh
 
-.PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run fuzz-run-wire man
+.PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -161,25 +161,64 @@ $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2: $(SIM_SRC) $(wildcard runti
 	@mkdir -p $(dir $@)
 	$(CC) $(filter-out -O% -MMD -MP,$(CFLAGS)) $(subst simhash-,-,$(notdir $@)) $(LDFLAGS) -o $@ $(SIM_SRC) -lm
 
-# libFuzzer on the replay reader and the raw request check (clang; not part of make test)
+# libFuzzer targets, one for each parser of outside input (docs/testing.md,
+# "Fuzzing"; tests/test_fuzz.sh runs each briefly in make test).  Objects
+# are built once under build/fuzz/obj (clang, ASan + UBSan + coverage) and
+# shared; no FFmpeg, GL or database code is built in (the libraries'
+# fallbacks stand in), libmicrohttpd is, for the HTTP layer.
 FUZZ_SECONDS ?= 600
-fuzz: build/fuzz/fuzz_replay build/fuzz/fuzz_wire
-build/fuzz/fuzz_wire: tests/fuzz_wire.c service/svc_wire.c service/svc_wire.h
-	@mkdir -p build/fuzz
-	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
-	    -o $@ tests/fuzz_wire.c service/svc_wire.c
-fuzz-run-wire: build/fuzz/fuzz_wire
-	@mkdir -p build/fuzz/corpus-wire
-	cp tests/fuzz/wire/* build/fuzz/corpus-wire/
-	build/fuzz/fuzz_wire -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -print_final_stats=1 build/fuzz/corpus-wire
-build/fuzz/fuzz_replay: tests/fuzz_replay.c $(SIM_SRC)
-	@mkdir -p build/fuzz
-	clang -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer,address,undefined \
-	    -o $@ tests/fuzz_replay.c $(filter-out tests/simhash.c,$(SIM_SRC)) -lm
-fuzz-run: build/fuzz/fuzz_replay
-	@mkdir -p build/fuzz/corpus
-	cp demos/*.rsr tests/golden/dojo-format1.rsr build/fuzz/corpus/
-	build/fuzz/fuzz_replay -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -print_final_stats=1 build/fuzz/corpus
+FUZZ_TARGETS := replay wire seg stage config y4m http upload
+FUZZ_CFLAGS := -std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -ffp-contract=off -fsanitize=fuzzer-no-link,address,undefined \
+               -fno-sanitize-recover=undefined \
+               -DRS_HAVE_MHD=1 $(shell pkg-config --cflags libmicrohttpd 2>/dev/null) -MMD -MP
+FUZZ_UTIL := runtime/util/rs_err.c runtime/util/rs_file.c runtime/util/rs_hash.c
+FUZZ_SRC_replay := $(filter-out tests/simhash.c,$(SIM_SRC))
+FUZZ_SRC_wire := service/svc_wire.c
+# what capture/cap.c's size checks (svc_config_finish, uploads) bring along
+FUZZ_CAPTURE := capture/cap.c capture/cap_cpu.c capture/cap_scale.c capture/cap_sink.c capture/cap_writer.c \
+                capture/cap_out.c capture/cap_sink_images.c capture/cap_sink_y4m.c capture/cap_enc.c \
+                runtime/gl/rgl.c runtime/render/r_shader.c runtime/util/rs_progress.c runtime/util/rs_log.c \
+                runtime/util/rs_oiio_load.c runtime/util/rs_out.c
+FUZZ_SRC_seg := capture/cap_seg.c $(FUZZ_UTIL)
+FUZZ_SRC_config := service/svc_config.c $(FUZZ_CAPTURE) $(FUZZ_UTIL)
+# the HTTP layer's files and what they call (the queue stores' fallbacks)
+FUZZ_SERVICE := service/svc_http_gate.c service/svc_http_routes.c service/svc_http_reply.c service/svc_http_guard.c \
+                service/svc_http_jobs.c service/svc_http_ops.c service/svc_http_recv.c service/svc_auth.c \
+                service/svc_upload.c service/svc_encode.c service/svc_json.c service/svc_log.c service/svc_store.c \
+                service/svc_store_pg.c service/svc_store_sqlite.c service/svc_files.c service/svc_queue_view.c \
+                service/svc_wire.c runtime/replay/rp.c $(wildcard runtime/game/*.c) runtime/render/r_quality.c \
+                $(FUZZ_CAPTURE) $(FUZZ_UTIL)
+FUZZ_SRC_http := $(FUZZ_SERVICE)
+FUZZ_LIBS_http := -lmicrohttpd
+FUZZ_SRC_upload := $(FUZZ_SERVICE) service/svc_config.c
+FUZZ_LIBS_upload := -lmicrohttpd
+FUZZ_SRC_y4m := player/mv_src.c player/mv_y4m.c player/mv_ffmpeg.c $(FUZZ_UTIL)
+FUZZ_SRC_stage := runtime/render/r_stage.c $(wildcard runtime/game/*.c) $(FUZZ_UTIL)
+FUZZ_LIBS := -lm -lpthread -ldl
+ifneq ($(SKIP_CONFIG),1)
+# objects depend on the flags, as the main build's do
+$(shell mkdir -p build/fuzz && (echo '$(FUZZ_CFLAGS)' | cmp -s - build/fuzz/flags || echo '$(FUZZ_CFLAGS)' > build/fuzz/flags))
+endif
+fuzz: $(patsubst %,build/fuzz/fuzz_%,$(FUZZ_TARGETS))
+build/fuzz/obj/%.o: %.c build/fuzz/flags
+	@mkdir -p $(dir $@)
+	clang $(FUZZ_CFLAGS) -c $< -o $@
+define FUZZ_RULE
+build/fuzz/fuzz_$(1): build/fuzz/obj/tests/fuzz_$(1).o $(patsubst %.c,build/fuzz/obj/%.o,$(FUZZ_SRC_$(1)))
+	clang -fsanitize=fuzzer,address,undefined -o $$@ $$^ $(FUZZ_LIBS_$(1)) $(FUZZ_LIBS)
+endef
+$(foreach t,$(FUZZ_TARGETS),$(eval $(call FUZZ_RULE,$(t))))
+# make fuzz-run-NAME FUZZ_SECONDS=3600: one target on its seeds, new inputs
+# in build/fuzz/corpus-NAME (fuzz-run: the replay reader)
+FUZZ_SEEDS_replay := demos/*.rsr tests/golden/dojo-format1.rsr
+FUZZ_MAXLEN_replay := 65536
+FUZZ_SEEDS_stage := stages/*.stage tests/fuzz/stage/*
+fuzz-run: fuzz-run-replay
+fuzz-run-%: build/fuzz/fuzz_%
+	@mkdir -p build/fuzz/corpus-$*
+	cp $(or $(FUZZ_SEEDS_$*),tests/fuzz/$*/*) build/fuzz/corpus-$*/
+	build/fuzz/fuzz_$* -max_total_time=$(FUZZ_SECONDS) -max_len=$(or $(FUZZ_MAXLEN_$*),4096) -print_final_stats=1 \
+	    build/fuzz/corpus-$*
 
 # the same with clang (tools/deps.sh test installs it, before this is built):
 # a second compiler must agree too
@@ -303,4 +342,4 @@ clean:
 help:
 	@sed -n '1,/^$$/p' Makefile | sed 's/^# \{0,1\}//'
 
--include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)
+-include $(shell find $(BUILD)/obj build/fuzz/obj -name '*.d' 2>/dev/null)

@@ -74,14 +74,9 @@ const char *cap_seg_format_of(const char *path)
 
 /* --- the hash list ------------------------------------------------------ */
 
-/* "N HHHHHHHHHHHHHHHH\n" for N = first..end-1, nothing else; its FNV. */
-static bool hashes_check(const char *path, uint64_t first, uint64_t end, uint64_t *fnv, rs_err *err)
+bool cap_seg_hashes_parse(const char *text, size_t len, const char *path, uint64_t first, uint64_t end, uint64_t *fnv,
+                          rs_err *err)
 {
-    size_t len;
-    rs_err e = {0};
-    char *text = rs_read_file(path, HASHES_MAX, &len, &e);
-    if (!text)
-        return rs_fail(err, CAP_ERR_SEG_HASHES, "%s", e.msg);
     const char *p = text, *stop = text + len;
     uint64_t want = first;
     bool ok = true;
@@ -89,7 +84,8 @@ static bool hashes_check(const char *path, uint64_t first, uint64_t end, uint64_
         char *q;
         errno = 0;
         unsigned long long n = strtoull(p, &q, 10);
-        ok = q > p && *p >= '0' && *p <= '9' && !errno && n == want && *q == ' ';
+        /* N as the render writes it (%llu): digits only, no leading zero */
+        ok = q > p && *p >= '0' && *p <= '9' && (*p != '0' || q == p + 1) && !errno && n == want && *q == ' ';
         for (int i = 1; ok && i <= 16; i++)
             ok = q + i < stop && ((q[i] >= '0' && q[i] <= '9') || (q[i] >= 'a' && q[i] <= 'f'));
         ok = ok && q + 17 < stop && q[17] == '\n';
@@ -97,31 +93,48 @@ static bool hashes_check(const char *path, uint64_t first, uint64_t end, uint64_
             p = q + 18;
     }
     if (!ok)
-        rs_fail(err, CAP_ERR_SEG_HASHES, "%s: line %" PRIu64 " is not \"%" PRIu64 " <16 hex digits>\"", path,
-                want - first, want - 1);
-    else if (want != end)
-        ok = rs_fail(err, CAP_ERR_SEG_HASHES, "%s: %" PRIu64 " lines, expected %" PRIu64 " (ticks %" PRIu64 "..%" PRIu64 ")",
-                     path, want - first, end - first, first, end - 1);
-    else
-        *fnv = rs_fnv1a64(text, len);
+        return rs_fail(err, CAP_ERR_SEG_HASHES, "%s: line %" PRIu64 " is not \"%" PRIu64 " <16 hex digits>\"", path,
+                       want - first, want - 1);
+    if (want != end)
+        return rs_fail(err, CAP_ERR_SEG_HASHES, "%s: %" PRIu64 " lines, expected %" PRIu64 " (ticks %" PRIu64 "..%" PRIu64 ")",
+                       path, want - first, end - first, first, end - 1);
+    *fnv = rs_fnv1a64(text, len);
+    return true;
+}
+
+/* The hash list at path: its text checked by cap_seg_hashes_parse. */
+static bool hashes_check(const char *path, uint64_t first, uint64_t end, uint64_t *fnv, rs_err *err)
+{
+    size_t len;
+    rs_err e = {0};
+    char *text = rs_read_file(path, HASHES_MAX, &len, &e);
+    if (!text)
+        return rs_fail(err, CAP_ERR_SEG_HASHES, "%s", e.msg);
+    bool ok = cap_seg_hashes_parse(text, len, path, first, end, fnv, err);
     free(text);
     return ok;
 }
 
 /* --- the manifest ------------------------------------------------------- */
 
-static bool manifest_write(const char *seg, const cap_seg_info *m, rs_err *err)
+int cap_seg_manifest_format(const cap_seg_info *m, char *out, size_t n)
 {
-    char path[1100], text[MANIFEST_MAX], hashes[24] = "none", replay[32] = "";
-    cap_seg_manifest_path(seg, path, sizeof path);
+    char hashes[24] = "none", replay[32] = "";
     if (m->has_hashes)
         snprintf(hashes, sizeof hashes, "%016" PRIx64, m->hashes_fnv);
     if (m->has_replay)
         snprintf(replay, sizeof replay, "replay %016" PRIx64 "\n", m->replay_fnv);
-    int n = snprintf(text, sizeof text,
-                     MANIFEST_MAGIC "\nkey %s\nformat %s\nsize %dx%d\nticks %" PRIu64 " %" PRIu64 "\nframes %" PRIu64
-                                    "\nbytes %" PRIu64 "\ncrc32 %08" PRIx32 "\nhashes %s\n%s",
-                     m->key, m->format, m->w, m->h, m->first, m->end, m->frames, m->bytes, m->crc, hashes, replay);
+    return snprintf(out, n,
+                    MANIFEST_MAGIC "\nkey %s\nformat %s\nsize %dx%d\nticks %" PRIu64 " %" PRIu64 "\nframes %" PRIu64
+                                   "\nbytes %" PRIu64 "\ncrc32 %08" PRIx32 "\nhashes %s\n%s",
+                    m->key, m->format, m->w, m->h, m->first, m->end, m->frames, m->bytes, m->crc, hashes, replay);
+}
+
+static bool manifest_write(const char *seg, const cap_seg_info *m, rs_err *err)
+{
+    char path[1100], text[MANIFEST_MAX];
+    cap_seg_manifest_path(seg, path, sizeof path);
+    int n = cap_seg_manifest_format(m, text, sizeof text);
     rs_err e = {0};
     if (!rs_write_part(path, text, (size_t)n, &e) || !rs_commit_file(path, &e))
         return rs_fail(err, CAP_ERR_WRITE, "%s", e.msg); /* rs_file's failure, as one of ours */
@@ -129,10 +142,10 @@ static bool manifest_write(const char *seg, const cap_seg_info *m, rs_err *err)
 }
 
 /* One "name value" line; value points into the line. */
-static bool manifest_line(char **p, const char *name, char *value, size_t n)
+static bool manifest_line(const char **p, const char *name, char *value, size_t n)
 {
     size_t len = strlen(name);
-    char *nl = strchr(*p, '\n');
+    const char *nl = strchr(*p, '\n');
     if (!nl || strncmp(*p, name, len) != 0 || (*p)[len] != ' ' || (size_t)(nl - *p - (ptrdiff_t)len - 1) >= n)
         return false;
     memcpy(value, *p + len + 1, (size_t)(nl - *p) - len - 1);
@@ -141,21 +154,11 @@ static bool manifest_line(char **p, const char *name, char *value, size_t n)
     return true;
 }
 
-static bool manifest_read(const char *seg, cap_seg_info *out, rs_err *err)
+bool cap_seg_manifest_parse(const char *text, const char *path, cap_seg_info *out, rs_err *err)
 {
-    char path[1100];
-    cap_seg_manifest_path(seg, path, sizeof path);
-    struct stat st;
-    if (stat(path, &st) != 0)
-        return rs_fail(err, CAP_ERR_SEG_MISSING, "%s: no manifest %s (the segment is unfinished or was never rendered)",
-                       seg, path);
-    size_t len;
-    rs_err e = {0};
-    char *text = rs_read_file(path, MANIFEST_MAX, &len, &e);
-    if (!text)
-        return rs_fail(err, CAP_ERR_SEG_MANIFEST, "%s", e.msg);
     cap_seg_info got = {0}, *m = &got; /* the caller's is filled only when all of it is good */
-    char *p = text, v[5][128];
+    const char *p = text;
+    char v[5][128];
     const char *bad = NULL;
     char tail;
     if (strncmp(p, MANIFEST_MAGIC "\n", sizeof MANIFEST_MAGIC) != 0)
@@ -188,11 +191,28 @@ static bool manifest_read(const char *seg, cap_seg_info *out, rs_err *err)
     else if (*p)
         bad = "has text after the 'replay' line";
     m->has_hashes = !bad && strcmp(v[0], "none") != 0;
-    free(text);
     if (bad)
         return rs_fail(err, CAP_ERR_SEG_MANIFEST, "%s: %s (not a ringside segment manifest, or a damaged one)", path, bad);
     *out = got;
     return true;
+}
+
+static bool manifest_read(const char *seg, cap_seg_info *out, rs_err *err)
+{
+    char path[1100];
+    cap_seg_manifest_path(seg, path, sizeof path);
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return rs_fail(err, CAP_ERR_SEG_MISSING, "%s: no manifest %s (the segment is unfinished or was never rendered)",
+                       seg, path);
+    size_t len;
+    rs_err e = {0};
+    char *text = rs_read_file(path, MANIFEST_MAX, &len, &e);
+    if (!text)
+        return rs_fail(err, CAP_ERR_SEG_MANIFEST, "%s", e.msg);
+    bool ok = cap_seg_manifest_parse(text, path, out, err);
+    free(text);
+    return ok;
 }
 
 /* --- reading a segment back --------------------------------------------- */

@@ -63,6 +63,19 @@ typedef struct cap_seg_info {
     uint64_t replay_fnv;   /* FNV-1a 64 of the replay file */
 } cap_seg_info;
 
+/* The manifest's text (snprintf rules: returns the length it needs). */
+int cap_seg_manifest_format(const cap_seg_info *m, char *out, size_t n);
+/* A manifest's text, NUL-terminated (path names it in messages): false
+ * (CAP_ERR_SEG_MANIFEST) saying which line is wrong; *out is filled only
+ * when all of it is good, and formats back to a text that parses to it. */
+bool cap_seg_manifest_parse(const char *text, const char *path, cap_seg_info *out, rs_err *err);
+/* A hash list's len bytes, with text[len] == 0 (as rs_read_file gives
+ * it): "N HHHHHHHHHHHHHHHH\n" for N = first..end-1 and nothing else.
+ * *fnv gets the FNV-1a 64 of the text; false (CAP_ERR_SEG_HASHES) names
+ * the first bad line or the count. */
+bool cap_seg_hashes_parse(const char *text, size_t len, const char *path, uint64_t first, uint64_t end, uint64_t *fnv,
+                          rs_err *err);
+
 /* One segment as join sees it. */
 typedef struct cap_seg {
     const char *path;      /* the segment file */

@@ -8,6 +8,7 @@
  * binary links no crypto library, and one is not worth adding for 80
  * lines. */
 #define _DEFAULT_SOURCE /* getrandom */
+#include <arpa/inet.h>
 #include <ctype.h>
 #include <errno.h>
 #include <stdio.h>
@@ -148,11 +149,11 @@ bool svc_listen_is_loopback(const char *listen)
         *colon = 0;
     if (!strcmp(host, "[::1]") || !strcmp(host, "::1") || !strcasecmp(host, "localhost"))
         return true;
-    /* 127.0.0.0/8: four dotted numbers, the first 127 */
-    int a, b, c, d;
-    char extra;
-    return sscanf(host, "%d.%d.%d.%d%c", &a, &b, &c, &d, &extra) == 4 && a == 127 && b >= 0 && b < 256 && c >= 0 &&
-           c < 256 && d >= 0 && d < 256;
+    /* 127.0.0.0/8, as four plain decimal numbers (inet_pton's form): the
+     * daemon binds with getaddrinfo, which reads "0127.0.0.1" as octal, so
+     * 87.0.0.1; anything but the plain form is not taken for loopback */
+    struct in_addr a;
+    return inet_pton(AF_INET, host, &a) == 1 && (ntohl(a.s_addr) >> 24) == 127;
 }
 
 /* --- `ringside serve token` --- */

@@ -27,8 +27,8 @@ void svc_token_hash(const char *token, char hex[SVC_TOKEN_HASH_LEN]);
  * in any case, spaces around): a pointer into it and its length, or NULL
  * when the header is missing or names another scheme. */
 const char *svc_bearer(const char *authorization, size_t *len);
-/* true for 127.0.0.0/8, ::1, [::1] and localhost (any port): the only
- * addresses a daemon may listen on without a token. */
+/* true for 127.0.0.0/8 in plain dotted decimal, ::1, [::1] and localhost
+ * (any port): the only addresses a daemon may listen on without a token. */
 bool svc_listen_is_loopback(const char *listen);
 
 #endif

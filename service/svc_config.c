@@ -262,20 +262,19 @@ static char *trim(char *s)
     return s;
 }
 
-bool svc_config_load(svc_config *c, const char *path, rs_err *err)
+bool svc_config_parse(svc_config *c, const char *path, const char *text, size_t len, rs_err *err)
 {
-    size_t len;
-    char *text = rs_read_file(path, 1 << 20, &len, err);
-    if (!text)
-        return false;
+    if (memchr(text, 0, len))
+        return rs_fail(err, SVC_CONFIG_ERR_FILE, "%s: contains a NUL byte (not a text file)", path);
+    char *copy = malloc(len + 1); /* lines are cut and trimmed in place */
+    if (!copy)
+        return rs_fail(err, RS_FILE_ERR_READ, "%s: out of memory", path); /* as rs_read_file says it */
+    memcpy(copy, text, len);
+    copy[len] = 0;
     bool ok = true;
     int line = 0;
-    if (strlen(text) != len) {
-        ok = rs_fail(err, SVC_CONFIG_ERR_FILE, "%s: contains a NUL byte (not a text file)", path);
-        goto out;
-    }
     /* strtok_r would skip empty lines and so miscount; walk by hand */
-    for (char *p = text; p && ok;) {
+    for (char *p = copy; p && ok;) {
         char *nl = strchr(p, '\n');
         if (nl)
             *nl = 0;
@@ -300,7 +299,17 @@ bool svc_config_load(svc_config *c, const char *path, rs_err *err)
             ok = false;
         }
     }
-out:
+    free(copy);
+    return ok;
+}
+
+bool svc_config_load(svc_config *c, const char *path, rs_err *err)
+{
+    size_t len;
+    char *text = rs_read_file(path, 1 << 20, &len, err);
+    if (!text)
+        return false;
+    bool ok = svc_config_parse(c, path, text, len, err);
     free(text);
     return ok;
 }

@@ -87,6 +87,9 @@ void svc_config_defaults(svc_config *c);
 bool svc_config_set(svc_config *c, const char *name, const char *value, rs_err *err);
 /* A config file; errors read "path:line: ...". */
 bool svc_config_load(svc_config *c, const char *path, rs_err *err);
+/* A config file's len bytes (need not be NUL-terminated), path for the
+ * messages: what svc_config_load does once the file is read. */
+bool svc_config_parse(svc_config *c, const char *path, const char *text, size_t len, rs_err *err);
 /* Fills the derived defaults (queue, output from data) and checks the
  * settings against each other. */
 bool svc_config_finish(svc_config *c, rs_err *err);

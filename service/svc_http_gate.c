@@ -16,9 +16,7 @@
 
 #define REFUSED "request refused" /* the log's word for a refusal here */
 
-/* The host of a Host header or an allowed_hosts entry, lower case, without
- * its port or IPv6 brackets ("[::1]:8080" -> "::1"); false if empty or too long. */
-static bool host_part(const char *in, size_t in_len, char *out, size_t n)
+bool http_host_part(const char *in, size_t in_len, char *out, size_t n)
 {
     const char *s = in;
     size_t len = in_len;
@@ -42,9 +40,7 @@ static bool host_part(const char *in, size_t in_len, char *out, size_t n)
     return true;
 }
 
-/* Whether NAME is one of the comma-separated items of LIST (spaces around
- * items ignored, case-insensitive). */
-static bool in_list(const char *list, const char *name)
+bool http_in_list(const char *list, const char *name)
 {
     size_t n = strlen(name);
     for (const char *p = list; *p;) {
@@ -69,7 +65,7 @@ void http_gate_default_hosts(svc_net *n)
 {
     char lh[128] = "";
     const char *listen = n->d->cfg.listen, *colon = strrchr(listen, ':');
-    host_part(listen, colon ? (size_t)(colon - listen) : strlen(listen), lh, sizeof lh);
+    http_host_part(listen, colon ? (size_t)(colon - listen) : strlen(listen), lh, sizeof lh);
     bool any = !lh[0] || !strcmp(lh, "0.0.0.0") || !strcmp(lh, "::");
     char me[256] = "";
     if (any && gethostname(me, sizeof me - 1) != 0)
@@ -83,14 +79,14 @@ static bool host_allowed(svc_net *n, const char *host)
     if (!strcmp(n->hosts, "*"))
         return true;
     char h[256];
-    if (!host_part(host, strlen(host), h, sizeof h))
+    if (!http_host_part(host, strlen(host), h, sizeof h))
         return false;
     for (const char *p = n->hosts; *p;) { /* entries may carry ports or brackets too */
         while (*p == ' ' || *p == ',')
             p++;
         const char *e = p + strcspn(p, ",");
         char item[256];
-        if (host_part(p, (size_t)(e - p), item, sizeof item) && !strcmp(item, h))
+        if (http_host_part(p, (size_t)(e - p), item, sizeof item) && !strcmp(item, h))
             return true;
         p = e;
     }
@@ -112,7 +108,7 @@ static enum MHD_Result note_param(void *cls, enum MHD_ValueKind kind, const char
 {
     (void)kind, (void)value;
     unknown_params *u = cls;
-    if (in_list(u->allowed, key))
+    if (http_in_list(u->allowed, key))
         return MHD_YES;
     size_t k = strlen(u->names);
     snprintf(u->names + k, sizeof u->names - k, "%s%s", k ? ", " : "", key);
@@ -140,7 +136,7 @@ static bool gate_origin(svc_daemon *d, struct MHD_Connection *c, const char *met
     const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
     if (!origin)
         return true;
-    bool listed = in_list(d->cfg.cors_origins, origin);
+    bool listed = http_in_list(d->cfg.cors_origins, origin);
     if (listed && nc)
         snprintf(nc->cors, sizeof nc->cors, "%s", origin);
     const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Host");
@@ -209,15 +205,22 @@ void *http_gate_uri(void *cls, const char *uri, struct MHD_Connection *c)
         return NULL;
     q->d = cls;
     q->up.limit = q->d->cfg.max_upload;
+    q->bad_uri = http_uri_bad(uri);
+    return q;
+}
+
+bool http_uri_bad(const char *uri)
+{
+    bool bad = false;
     for (const unsigned char *p = (const unsigned char *)uri; *p; p++) {
         if (*p < 0x20 || *p == 0x7f)
-            q->bad_uri = true;
+            bad = true;
         if (*p == '%' && isxdigit(p[1]) && isxdigit(p[2])) {
             unsigned v = (unsigned)strtoul((char[]){(char)p[1], (char)p[2], 0}, NULL, 16);
-            q->bad_uri |= v < 0x20 || v == 0x7f;
+            bad |= v < 0x20 || v == 0x7f;
         }
     }
-    return q;
+    return bad;
 }
 
 #endif

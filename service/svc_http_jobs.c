@@ -50,8 +50,7 @@ static enum MHD_Result created(struct MHD_Connection *c, const svc_job *j)
     return ret;
 }
 
-/* The parameters the form left to the query string, and the file name. */
-static bool query_params(struct MHD_Connection *c, svc_upload *u, rs_err *err)
+bool http_upload_query(struct MHD_Connection *c, svc_upload *u, rs_err *err)
 {
     static const char *const keys[] = {
 #define X(name, room) #name,
@@ -79,7 +78,7 @@ enum MHD_Result http_submit(svc_daemon *d, struct MHD_Connection *c, req *q)
         rs_fail(&err, SVC_ERR_BAD_BODY, "%s", u->bad);
     else if (u->too_large)
         rs_fail(&err, SVC_ERR_TOO_LARGE, "the upload is over the limit of %ld bytes (max_upload)", d->cfg.max_upload);
-    if (err.code || !query_params(c, u, &err) || !svc_upload_job(&d->cfg, u, &j, &err)) {
+    if (err.code || !http_upload_query(c, u, &err) || !svc_upload_job(&d->cfg, u, &j, &err)) {
         http_count_rejected(d);
         return http_error(c, err.code, NULL, REFUSED, "%s", err.msg);
     }

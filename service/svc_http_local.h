@@ -188,6 +188,15 @@ void *http_gate_uri(void *cls, const char *uri, struct MHD_Connection *c);
 /* The request's form: false with *ret the answer when it is refused. */
 bool http_gate(svc_daemon *d, struct MHD_Connection *c, req *q, const char *url, const char *method,
                enum MHD_Result *ret);
+/* The gate's parsers of request text (exposed for tests and fuzzing):
+ * the host of a Host header or an allowed_hosts entry, lower case, without
+ * its port or IPv6 brackets ("[::1]:8080" -> "::1"), false if empty or too
+ * long; whether NAME is one of the comma-separated items of LIST (spaces
+ * around items ignored, case-insensitive); whether a raw URI holds a
+ * control character, raw or %-encoded. */
+bool http_host_part(const char *in, size_t in_len, char *out, size_t n);
+bool http_in_list(const char *list, const char *name);
+bool http_uri_bad(const char *uri);
 /* The Host names accepted when allowed_hosts is empty. */
 void http_gate_default_hosts(svc_net *n);
 /* Who asks: true to go on (q->tok, q->all say who); false answered (401, 503). */
@@ -207,6 +216,10 @@ enum MHD_Result http_retry(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_health(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_metrics(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_dashboard(svc_daemon *d, struct MHD_Connection *c, req *q);
+/* An upload's job parameters the form left to the query string, and its
+ * file name (the form's, else ?name=, else X-Filename); false
+ * (SVC_ERR_BAD_PARAM) for a value longer than its room. */
+bool http_upload_query(struct MHD_Connection *c, svc_upload *u, rs_err *err);
 /* An upload refused: counted for /metrics (ringside_uploads_rejected_total). */
 void http_count_rejected(svc_daemon *d);
 

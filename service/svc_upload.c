@@ -14,7 +14,9 @@
 
 bool svc_upload_append(svc_upload *u, const void *data, size_t n)
 {
-    if (u->too_large || u->oom)
+    /* libmicrohttpd can open a file part with an empty piece: with
+     * no body yet, body + len would be arithmetic on NULL */
+    if (u->too_large || u->oom || n == 0)
         return true;
     if (u->len + n > (size_t)u->limit) {
         u->too_large = true;
@@ -86,6 +88,8 @@ bool svc_upload_field(svc_upload *u, const char *key, const char *filename, cons
     if (dst && off + size < room) {
         memcpy(dst + off, data, size);
         dst[off + size] = 0;
+    } else if (dst) {
+        dst[0] = 0; /* too long: the pieces before this one go too, however the value was cut */
     }
     return true;
 }

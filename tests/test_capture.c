@@ -271,6 +271,32 @@ static void t_segment_names(void)
              !cap_seg_key_ok("aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"));
 }
 
+/* A segment's hash list is exactly what the render writes ("%llu %016llx"):
+ * tick numbers with a leading zero once passed (found by fuzz_seg). */
+static void t_segment_hash_list(void)
+{
+    static const char good[] = "128 0123456789abcdef\n129 fedcba9876543210\n";
+    uint64_t fnv = 0;
+    rs_err e = {0};
+    T_ASSERTF(cap_seg_hashes_parse(good, strlen(good), "s.hashes", 128, 130, &fnv, &e), "%s", e.msg);
+    T_EQ(fnv, rs_fnv1a64(good, strlen(good)));
+    static const char *const bad[] = {
+        "0128 0123456789abcdef\n129 fedcba9876543210\n", /* a leading zero */
+        "128 0123456789ABCDEF\n129 fedcba9876543210\n", /* upper-case hex */
+        "+128 0123456789abcdef\n129 fedcba9876543210\n",
+        "128 0123456789abcdef\n129 fedcba9876543210",     /* no last newline */
+        "128 0123456789abcdef\n",                         /* a line short */
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        rs_err_clear(&e);
+        T_ASSERTF(!cap_seg_hashes_parse(bad[i], strlen(bad[i]), "s.hashes", 128, 130, &fnv, &e), "accepted: %s",
+                  bad[i]);
+        T_EQ(e.code, CAP_ERR_SEG_HASHES);
+        T_ASSERTF(!strncmp(e.msg, "s.hashes: ", 10), "%s", e.msg);
+    }
+    T_ASSERT(cap_seg_hashes_parse("0 0123456789abcdef\n", 19, "s.hashes", 0, 1, &fnv, &e)); /* "0" is no leading zero */
+}
+
 /* A test picture in a texture: gradients and hard edges; `shift` moves
  * the checkerboard so every frame differs. */
 static GLuint test_texture(int w, int h, uint8_t *px, int shift)
@@ -468,5 +494,6 @@ T_MAIN({"queue_cap_holds", t_queue_cap_holds}, {"inline_queue", t_inline_queue},
        {"cpu_downscale_averages_and_flips", t_cpu_downscale_averages_and_flips}, {"sizes", t_sizes},
        {"sink_errors", t_sink_errors}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"segment_names", t_segment_names},
+       {"segment_hash_list", t_segment_hash_list},
        {"gpu_matches_cpu_egl", t_gpu_matches_cpu_egl}, {"gpu_matches_cpu_osmesa", t_gpu_matches_cpu_osmesa},
        {"gpu_matches_cpu_same_size", t_gpu_matches_cpu_same_size})

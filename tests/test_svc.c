@@ -1138,6 +1138,8 @@ static void t_tokens_and_bearer(void)
     T_ASSERT(!svc_listen_is_loopback("0.0.0.0:8080") && !svc_listen_is_loopback(":8080"));
     T_ASSERT(!svc_listen_is_loopback("[::]:80") && !svc_listen_is_loopback("127.0.0.1.evil:80"));
     T_ASSERT(!svc_listen_is_loopback("10.0.0.1:80") && !svc_listen_is_loopback("1270.0.0.1:80"));
+    /* getaddrinfo reads a leading zero as octal: 0127.0.0.1 is 87.0.0.1 (found by fuzz_http) */
+    T_ASSERT(!svc_listen_is_loopback("0127.0.0.1:8080") && !svc_listen_is_loopback("127.0.0.4294967296:80"));
 }
 
 /* The route table decides routing, 404 against 405, the open routes and
@@ -1190,10 +1192,17 @@ static void t_upload_params(void)
     T_ASSERT(svc_upload_append(&u, "56789", 5) && u.too_large && !u.body && u.len == 0);
     svc_upload_free(&u);
     u = (svc_upload){.limit = 1 << 20};
+    /* the empty first piece of a file part, as libmicrohttpd may send it
+     * (fuzz_upload: pointer arithmetic on the NULL body, UBSan's report) */
+    T_ASSERT(svc_upload_field(&u, "replay", "a.rsr", "", 0, 0) && u.len == 0 && !u.body && !strcmp(u.name, "a.rsr"));
+    u.name[0] = 0;
     /* a form field in two pieces; one too long for its room is dropped */
     T_ASSERT(svc_upload_field(&u, "codec", NULL, "h2", 0, 2) && svc_upload_field(&u, "codec", NULL, "64", 2, 2));
     T_ASSERT(!strcmp(u.p.codec, "h264"));
     T_ASSERT(svc_upload_field(&u, "crf", NULL, "123456789", 0, 9) && !u.p.crf[0]);
+    /* and in pieces, however it is cut: the pieces that fitted go too (found by fuzz_upload) */
+    T_ASSERT(svc_upload_field(&u, "crf", NULL, "1234", 0, 4) && svc_upload_field(&u, "crf", NULL, "56789", 4, 5));
+    T_ASSERT(!u.p.crf[0]);
     T_ASSERT(svc_upload_field(&u, "replay", "dir/a\x01" "b.rsr", "RS", 0, 2) && u.len == 2);
     T_ASSERT(!strcmp(u.name, "a_b.rsr"));
     T_ASSERT(svc_upload_field(&u, "other", NULL, "x", 0, 1) && svc_upload_field(&u, NULL, NULL, "x", 0, 1));
