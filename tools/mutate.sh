@@ -25,6 +25,11 @@
 # Exit status: 0 every mutation killed; 1 one survived or did not build;
 # 2 bad usage, a stale list, a covering test failing or running nothing
 # unmutated, or the unmutated tree not building.
+#
+# The whole script is one { } block, read before it runs: a run takes
+# minutes, and a checkout switched or an edit made meanwhile must not
+# change it midway (bash reads a script as it goes).
+{
 set -u
 export LC_ALL=C
 
@@ -367,3 +372,5 @@ extra=""
 say "mutate: $total mutations in $(($(date +%s) - start)) s${survivors[0]+; survived: ${survivors[*]}}"
 echo "$killed killed, $survived survived of $total${extra:+ ($extra)}" | sed 's/(, /(/'
 [ "$survived" = 0 ] && [ "$unbuilt" = 0 ] && [ "$skipped" = 0 ]
+exit
+}
