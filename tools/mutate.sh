@@ -185,7 +185,7 @@ cleanup() {
     fi
 }
 trap cleanup EXIT
-trap 'say "mutate: interrupted"; exit 130' INT TERM
+trap 'say "mutate: interrupted"; [ -z "${cur_sid:-}" ] || end_session "$cur_sid"; exit 130' INT TERM
 
 if [ "$worktree" = 1 ]; then
     what="the working tree of $root"
@@ -266,11 +266,29 @@ build "$logs/build.log" all "${all_targets[@]}" || { tail -30 "$logs/build.log" 
 say "mutate: built in $(($(date +%s) - t0)) s"
 
 # --- running a covering command ----------------------------------------------
-export RS_BIN=$src/build/ringside RINGSIDE_CACHE=$scratch/cache RS_TEST_OUT=$src/build/test-output
-mkdir -p "$RS_TEST_OUT"
+# the tests' temporary files go in the scratch folder too, so a test ended
+# early leaves nothing behind once it is removed
+export RS_BIN=$src/build/ringside RINGSIDE_CACHE=$scratch/cache RS_TEST_OUT=$src/build/test-output TMPDIR=$scratch/tmp
+mkdir -p "$RS_TEST_OUT" "$TMPDIR"
 
+# Each command runs in a session of its own: what it leaves behind (a
+# daemon, or a nested timeout's process group, which the outer timeout
+# cannot reach) is ended with it, by session, when it ends or runs out.
+cur_sid=""
 run_test() { # CMD LOG: the command's exit status (124/137: ran out of time)
-    (cd "$src" && nice -n 10 timeout -k 10 "$timeout_s" sh -c "$1") >"$2" 2>&1
+    (cd "$src" && exec setsid nice -n 10 timeout -k 10 "$timeout_s" sh -c "$1") >"$2" 2>&1 &
+    cur_sid=$! # not a group leader (no job control here), so setsid keeps the pid
+    wait "$cur_sid"
+    local rc=$?
+    end_session "$cur_sid"
+    cur_sid=""
+    return "$rc"
+}
+end_session() { # SID: TERM first, so traps can tidy up, then KILL
+    pgrep -s "$1" >/dev/null 2>&1 || return 0
+    pkill -TERM -s "$1" 2>/dev/null
+    sleep 1
+    pkill -KILL -s "$1" 2>/dev/null
 }
 
 # cases the summary lines of a log say passed
@@ -280,7 +298,7 @@ skipped_in() { awk '/^[0-9]+ passed, [0-9]+ failed, [0-9]+ skipped/ { n += $5 } 
 broken=() # covering commands that fail (or run nothing) unmutated
 if [ "$baseline" = 1 ]; then
     mapfile -t cmds < <(printf '%s\n' "${all_tests[@]}" | awk 'NF && !seen[$0]++')
-    say "mutate: baseline: ${#cmds[@]} covering commands on the unmutated build"
+    say "mutate: baseline: each of the ${#cmds[@]} covering commands on the unmutated build"
     k=0
     for c in "${cmds[@]}"; do
         k=$((k + 1))
