@@ -117,6 +117,7 @@ parse_list() { # FILE
         [ "$has_from" = 1 ] || miss="$miss from"
         [ "$has_to" = 1 ] || miss="$miss to"
         [ -n "$test" ] || miss="$miss test"
+        # shellcheck disable=SC2016 # the quotes are text, inside double quotes
         [ -z "$miss" ] || die "$f:$at: the mutation${id:+ '$id'} lacks:$miss"
         case $id in *[!A-Za-z0-9_.-]*) die "$f:$at: id '$id': use letters, digits, '.', '_' and '-'" ;; esac
         [ -n "$from" ] || die "$f:$at: '$id': from is empty"
@@ -177,6 +178,7 @@ fi
 scratch=$(mktemp -d "${TMPDIR:-/tmp}/ringside-mutate-XXXXXX") || die "cannot make a scratch folder"
 src=$scratch/tree logs=$scratch/logs orig=$scratch/orig
 mkdir -p "$src" "$logs" "$orig" "$scratch/cache"
+# shellcheck disable=SC2317 # called by the EXIT trap
 cleanup() {
     if [ "$keep" = 1 ]; then
         say "mutate: the scratch copy, its build and the logs stay in $scratch"
