@@ -113,6 +113,29 @@ t_queue_cap_in_report() {
     hw=$(sed -n 's/.*high-water \([0-9]*\).*/\1/p' r.txt)
     [ -n "$hw" ] && [ "$hw" -le 4 ] || { cat r.txt; return 1; }
     grep -q "120 frames 160x90" r.txt || { cat r.txt; return 1; }
+    # the default cap is 120 frames (about 2 s of video; capture/cap.h): behind
+    # a reader that waits until the render stands still (the writer blocked on
+    # the full pipe, the game thread on a full queue), the queue fills to it;
+    # the writer holds one frame, so the high-water is 119 or 120
+    "$RS_BIN" record --ai --quiet --seconds 4 --seed 21 -o long.rsr 2>/dev/null || return 1
+    sh -c 'echo $$ >render.pid; exec "$0" render long.rsr -o - --size 64x36 --render-size 64x36 --quality draft \
+        --progress off 2>d.txt' "$RS_BIN" | { wait_still render.pid; cat >/dev/null; }
+    hw=$(sed -n 's/.*high-water \([0-9]*\).*/\1/p' d.txt)
+    grep -q ", queue 120, " d.txt && [ -n "$hw" ] && [ "$hw" -ge 119 ] && [ "$hw" -le 120 ] ||
+        { echo "the default queue: high-water '$hw', want 119 or 120 of 120"; cat d.txt; return 1; }
+}
+
+# wait_still PIDFILE: until the process it names uses no CPU for half a
+# second (at most 30 s)
+wait_still() {
+    i=0 last=-1
+    while [ $i -lt 60 ]; do
+        cpu=$(awk '{ print $14 + $15 }' "/proc/$(cat "$1" 2>/dev/null)/stat" 2>/dev/null)
+        [ -n "$cpu" ] && [ "$cpu" = "$last" ] && return 0
+        last=${cpu:--1}
+        i=$((i + 1))
+        sleep 0.5
+    done
 }
 
 t_bench_capture_small() {

@@ -127,6 +127,29 @@ static void t_punch_hits_and_guard_blocks(void)
     T_EQ(st.f[0].hits, 0);
 }
 
+/* An attack hits on exactly its active frames [active_start, active_end)
+ * (g_moves.c): the move is put at each of its frames in turn with the
+ * other fighter well within reach, and one tick run.  (The demos alone do
+ * not pin this: their hits all land early in the window.) */
+static void t_attack_active_frames(void)
+{
+    const int moves[] = {G_MV_PUNCH, G_MV_KICK, G_MV_LOW_KICK, G_MV_CROUCH_PUNCH};
+    for (size_t i = 0; i < sizeof moves / sizeof moves[0]; i++) {
+        const g_move *m = &g_moves[moves[i]];
+        for (int k = 0; k < m->frames; k++) {
+            g_state st;
+            fight_at(&st, FX(0.75));
+            st.f[0].move = moves[i];
+            st.f[0].frame = k;
+            st.f[0].hit_done = 0;
+            run(&st, 0, 0, 1, NULL);
+            bool hit = st.f[1].health < G_MAX_HEALTH, active = k >= m->active_start && k < m->active_end;
+            T_ASSERTF(hit == active, "%s at frame %d: %s (active %d..%d)", m->name, k, hit ? "hit" : "missed",
+                      m->active_start, m->active_end - 1);
+        }
+    }
+}
+
 static void t_guard_levels(void)
 {
     /* a low kick beats a standing guard, a crouching guard stops it */
@@ -428,7 +451,8 @@ static void t_long_run_stays_bounded(void)
 
 T_MAIN({"trig", t_trig}, {"isqrt", t_isqrt}, {"segment_distance", t_segment_distance},
        {"skeleton_stands", t_skeleton_stands}, {"inputs", t_inputs},
-       {"punch_hits_and_guard_blocks", t_punch_hits_and_guard_blocks}, {"guard_levels", t_guard_levels},
+       {"punch_hits_and_guard_blocks", t_punch_hits_and_guard_blocks},
+       {"attack_active_frames", t_attack_active_frames}, {"guard_levels", t_guard_levels},
        {"trades_hit_both", t_trades_hit_both}, {"double_ko_is_a_draw", t_double_ko_is_a_draw},
        {"crouch_ducks_highs", t_crouch_ducks_highs}, {"special_motion", t_special_motion}, {"special_knocks_down_and_out", t_special_knocks_down_and_out},
        {"walking_cannot_push_out", t_walking_cannot_push_out},

@@ -66,6 +66,20 @@ t_ticks_errors() {
     [ "$(wc -l <a.txt)" = 10 ] && cmp a.txt b.txt || { echo "290:999999 and 290: differ"; cat a.txt b.txt; return 1; }
 }
 
+# --size and --render-size hold each side to its bounds on its own: the
+# first value past either end of either side is refused before any work
+t_size_sides_bounded() {
+    for s in 15x90 160x15 8193x90 160x8193 160x 160x90x2; do
+        expect_fail 2 "^ringside render: --size '$s': expected WIDTHxHEIGHT, each from 16 to 8192" \
+            "$RS_BIN" render short.rsr --size "$s" -o x.y4m || return 1
+    done
+    for s in 0x90 160x0 8193x90 160x8193; do
+        expect_fail 2 "^ringside render: --render-size '$s': expected WIDTHxHEIGHT, each from 1 to 8192" \
+            "$RS_BIN" render short.rsr --render-size "$s" -o x.y4m || return 1
+    done
+    [ ! -e x.y4m ] || { echo "output written on error"; return 1; }
+}
+
 t_bad_stage_files() {
     short_replay || return 1
     printf 'name = bad\ngame = dojo\nsunn = yes\n' >bad.stage
@@ -223,5 +237,5 @@ t_outputs_on_a_full_disk() {
     umount ro
 }
 
-t_run outputs_on_a_full_disk passes_summary_and_frames quality_and_sizes ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
+t_run outputs_on_a_full_disk passes_summary_and_frames quality_and_sizes size_sides_bounded ticks_match_a_full_render ticks_errors bad_stage_files mask_cutouts help_lists_the_options
 t_done

@@ -123,6 +123,7 @@ static void t_corruption_cases(void)
     expect_bad(g, n, 28, iv0, 2, true, RP_ERR_FIELD, "checkpoint interval 0 at byte 28", NULL);
     expect_bad(g, n, 30, &k3, 1, true, RP_ERR_FIELD, "player 1 kind 3 at byte 30", NULL);
     expect_bad(g, n, 32, &w7, 1, true, RP_ERR_FIELD, "winner 7 at byte 32", NULL);
+    expect_bad(g, n, 32, &k3, 1, true, RP_ERR_FIELD, "winner 3 at byte 32", NULL); /* the first past 0..2 */
     expect_bad(g, n, 33, &r9, 1, true, RP_ERR_FIELD, "rounds won 9 at byte 33", NULL);
     expect_bad(g, n, 35, &k3, 1, true, RP_ERR_FIELD, "reserved byte 35 is 3", NULL);
     expect_bad(g, n, 36, zero4, 4, true, RP_ERR_FIELD, "game version 0 at byte 36", NULL);
@@ -154,6 +155,22 @@ static void t_corruption_cases(void)
     T_EQ(e.code, RP_ERR_FIELD);
     T_CONTAINS(e.msg, "unexpected bytes");
     free(longer);
+    /* one checkpoint short, the file otherwise whole (count, hashes and CRC
+     * agree): readers index checkpoints up to ticks / interval */
+    T_ASSERT(rp.ncheck >= 2);
+    rp.ncheck--;
+    uint8_t *shorter;
+    size_t ns;
+    encode(&rp, &shorter, &ns);
+    rp.ncheck++;
+    T_ASSERT(!rp_decode(shorter, ns, "x.rsr", &out, &e));
+    T_EQ(e.code, RP_ERR_FIELD);
+    char want[64];
+    snprintf(want, sizeof want, "%zu checkpoints at byte", rp.ncheck - 1);
+    T_CONTAINS(e.msg, want);
+    snprintf(want, sizeof want, "expected %zu (ticks / interval)", rp.ncheck);
+    T_CONTAINS(e.msg, want);
+    free(shorter);
     free(g);
     rp_free(&rp);
 }

@@ -143,6 +143,8 @@ t_bad_segments_exit_3() {
     mv keep.seg s0.mp4.seg
     # a gap in the ticks
     bad_join 1 ticks "s160.mp4: ticks 160..239, expected to start at 70" s0.mp4 s160.mp4 || return 1
+    # and an overlap: a segment given twice starts before the one before it ends
+    bad_join 2 ticks "s70.mp4: ticks 70..159, expected to start at 160" s0.mp4 s70.mp4 s70.mp4 || return 1
     # the first does not start at --first
     "$RS_BIN" join --segment job7 -o jx.mp4 --first 70 -q s70.mp4 s160.mp4 || { echo "--first 70 refused"; return 1; }
     [ "$(pts_ticks jx.mp4 | head -1)" = 0 ] && [ "$(pts_ticks jx.mp4 | wc -l)" = 170 ] || { echo "--first 70: wrong timestamps"; return 1; }

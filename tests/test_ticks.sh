@@ -90,6 +90,11 @@ t_seconds_are_ticks() {
             { echo "$bad: exit $st (want 2), said:"; cat err.txt; return 1; }
     done
     grep -q "starts past the replay's end (42.283 s, 2537 ticks)" err.txt || { cat err.txt; return 1; }
+    # minutes and seconds after a colon are under 60: the first past it is no time
+    for bad in 0:60 0:59:60 0:60:00; do
+        expect_fail 2 "^ringside render: --from '$bad': expected seconds \(12.5\), MM:SS" \
+            "$RS_BIN" render "$rp" $small --from "$bad" || return 1
+    done
 }
 
 # REPLAY '-': the replay from standard input, also for --jobs (the
