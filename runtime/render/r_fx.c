@@ -66,14 +66,14 @@ r_fx_gl r_fx_core_gl(const r_game *r)
         .sky_tex = r->sky_tex,
         .diffuse_on = r->ibl_tex[R_IBL_DIFFUSE][R_IBL_KEY_ON],
         .empty_vao = r->empty_vao,
-        .fighter_vao = r->fighter_vao,
+        .fighter_vao = r->fighter->vao,
         .ring_vao = r->ring_vao,
-        .fighter_count = r->fighter_count,
+        .fighter_count = r->fighter->count,
         .ring_count = r->ring_count,
         .prog_depth = r->prog[P_DEPTH],
         .prog_sky = r->prog[P_SKY],
     };
-    memcpy(g.fighter_bone_first, r->fighter_bone_first, sizeof g.fighter_bone_first);
+    memcpy(g.fighter_bone_first, r->fighter->bone_first, sizeof g.fighter_bone_first);
     g.whole_meshes = r->opts.whole_meshes;
     return g;
 }

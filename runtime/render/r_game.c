@@ -454,6 +454,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     r->sil_size = r->opts.q.sil_size > 0 ? r->opts.q.sil_size : SIL_SIZE;
     r->stage_game = -2;
     r->ring_stage = -1;
+    r->fighter = &r->fighter_lod[R_FIGHTER_FINE]; /* until a frame chooses (select_fighter_mesh) */
     r->lut_size = r->opts.lut_size > 0 ? r->opts.lut_size : R_TONE_LUT_DEFAULT;
     r->lut_size = r->lut_size < R_TONE_LUT_MIN ? R_TONE_LUT_MIN : r->lut_size > R_TONE_LUT_MAX ? R_TONE_LUT_MAX : r->lut_size;
     if (!build_programs(r, err) || !build_graph(r, err)) {
@@ -680,11 +681,7 @@ bool r_game_draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
  * "HDR, materials, mask"), unless the options ask for the fine one. */
 static void select_fighter_mesh(r_game *r, int h)
 {
-    const struct fighter_mesh *fm =
-        &r->fighter_lod[h < R_FIGHTER_COARSE_ROWS && !r->opts.fine_mesh ? R_FIGHTER_COARSE : R_FIGHTER_FINE];
-    r->fighter_vao = fm->vao;
-    r->fighter_count = fm->count;
-    memcpy(r->fighter_bone_first, fm->bone_first, sizeof r->fighter_bone_first);
+    r->fighter = &r->fighter_lod[h < R_FIGHTER_COARSE_ROWS && !r->opts.fine_mesh ? R_FIGHTER_COARSE : R_FIGHTER_FINE];
 }
 
 static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha, int w, int h, r_graph_mask skip,

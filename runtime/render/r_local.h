@@ -61,9 +61,7 @@ struct r_game {
         GLuint vao, vbo, ibo;
         GLsizei count, bone_first[G_BONES + 1];
     } fighter_lod[R_FIGHTER_LODS];
-    GLuint fighter_vao;
-    GLsizei fighter_count;
-    GLsizei fighter_bone_first[G_BONES + 1]; /* r_fx_gl's */
+    const struct fighter_mesh *fighter; /* points into fighter_lod */
     GLuint lens_vao, lens_vbo, lens_ibo;
     GLsizei lens_count;
     GLuint ring_vao, ring_vbo, ring_ibo;

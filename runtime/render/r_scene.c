@@ -16,12 +16,12 @@ static bool need_always(void *u)
 
 void r_draw_fighters(r_game *r, GLuint p)
 {
-    gl.BindVertexArray(r->fighter_vao);
+    gl.BindVertexArray(r->fighter->vao);
     for (int i = 0; i < 2; i++) {
         gl.UniformMatrix4fv(r_loc(p, "u_bones"), G_BONES, GL_FALSE, &r->f.bones[i][0][0]);
         gl.Uniform4fv(r_loc(p, "u_bone_color"), G_BONES, &r->f.colors[i][0][0]);
         gl.Uniform1i(r_loc(p, "u_fighter"), i);
-        gl.DrawElements(GL_TRIANGLES, r->fighter_count, GL_UNSIGNED_INT, NULL);
+        gl.DrawElements(GL_TRIANGLES, r->fighter->count, GL_UNSIGNED_INT, NULL);
     }
 }
 
