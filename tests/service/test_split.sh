@@ -12,15 +12,15 @@ dojo() { # SECONDS SEED FILE
 }
 
 # the single-process render the service's video must equal
-direct_hashes() { # REPLAY OUT
-    "$RS_BIN" render "$1" -o direct.mp4 --render-size 160x90 --size 160x90 --hashes "$2" --quiet
+direct_hashes() { # REPLAY OUT [DRAWN SIZE]
+    "$RS_BIN" render "$1" -o direct.mp4 --render-size "${3:-160x90}" --size 160x90 --hashes "$2" --quiet
 }
 
 # the job's video and hash list are those of a single render, and nothing
 # but N.fmt and N.hashes is left in the output directory
-check_video() { # ID REPLAY FRAMES
+check_video() { # ID REPLAY FRAMES [DRAWN SIZE]
     curl -sf -o "v$1.hashes" "$SVC_URL/jobs/$1/hashes" || { echo "job $1: no hashes"; return 1; }
-    direct_hashes "$2" "d$1.hashes" || return 1
+    direct_hashes "$2" "d$1.hashes" "${4:-}" || return 1
     cmp "v$1.hashes" "d$1.hashes" || { echo "job $1: the joined video's frames differ from render's"; return 1; }
     curl -sf -o "v$1.mp4" "$SVC_URL/jobs/$1/video" || return 1
     [ "$(frames_of "v$1.mp4")" = "$3" ] || { echo "job $1: ffprobe counts $(frames_of "v$1.mp4") frames"; return 1; }
@@ -29,8 +29,10 @@ check_video() { # ID REPLAY FRAMES
 
 t_two_workers_one_video() {
     # the done-when case: 4 s in 1 s segments on 2 workers
+    # (drawn at 640x360: at 160x90 a second of frames renders faster than
+    # the loop below can see two segments running)
     dojo 4 5 four.rsr || return 1
-    svc_start d $SVC_FAST --workers 2 --segment-seconds 1 || return 1
+    svc_start d $SVC_FAST --render-size 640x360 --workers 2 --segment-seconds 1 || return 1
     id=$(svc_submit four.rsr) || return 1
     [ "$(svc_field "$id" segment_count)" = 4 ] || { curl -s "$SVC_URL/jobs/$id"; return 1; }
     # progress counts every segment while they run
@@ -49,7 +51,7 @@ EOF
         sleep 0.3
     done
     [ "$seen" = 1 ] || { echo "never saw two segments running with progress, fps and an ETA"; return 1; }
-    check_video "$id" four.rsr 240 || return 1
+    check_video "$id" four.rsr 240 640x360 || return 1
     svc_units "$id" >units.txt
     cat units.txt
     # every segment rendered once, by both workers between them
