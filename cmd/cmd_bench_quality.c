@@ -78,12 +78,19 @@ static const config fixed_configs[] = {
     {"1x fog 64", 1, {.fog_size = 64}, 0},
     {"1x water 32", 1, {.water_grid = 32}, 0},
     {"1x snow light 128", 1, {.snow_light = 128}, 0},
+    {"1x scene 75%", 1, {.scene_pct = 75}, 0},
     /* combinations the presets choose among */
     {"1x cheap", 1, {CHEAP_Q}, 1},
     {"1x cheap fxaa", 1, {CHEAP_Q, .aa = R_AA_FXAA}, 1},
     {"1x fxaa mask half", 1, {.aa = R_AA_FXAA, .mask_half = true}, 1},
     {"1x lean", 1, {LEAN_Q}, 1},
     {"1x fxaa lean", 1, {LEAN_Q, .aa = R_AA_FXAA}, 1},
+    {"1x lean scene 75%", 1, {LEAN_Q, .scene_pct = 75}, 1},
+    {"1x cheap scene 75%", 1, {CHEAP_Q, .scene_pct = 75}, 1},
+    {"1x lean scene 60%", 1, {LEAN_Q, .scene_pct = 60}, 1},
+    {"1x lean scene 90%", 1, {LEAN_Q, .scene_pct = 90}, 1},
+    {"1x fxaa lean scene 75%", 1, {LEAN_Q, .aa = R_AA_FXAA, .scene_pct = 75}, 1},
+    {"1x fxaa lean scene 85%", 1, {LEAN_Q, .aa = R_AA_FXAA, .scene_pct = 85}, 1},
     {"1.5x fxaa", 1.5, {.aa = R_AA_FXAA}, 1},
     {"1.5x cheap", 1.5, {CHEAP_Q}, 1},
     {"2x fxaa", 2, {.aa = R_AA_FXAA}, 1},
@@ -111,7 +118,8 @@ static void help(void)
            "                              [--chart FILE.png] [-y|-n] [-q|-v]\n\n"
            "Draws the same frames of every shipped demo under each knob of the renderer\n"
            "(render scale, FXAA, shadow and silhouette map sizes, the shadow mask at half\n"
-           "size, bloom levels, LSPSM and fog map sizes, the water grid) and under\n"
+           "size, bloom levels, LSPSM and fog map sizes, the water grid, the snow's light\n"
+           "map, the scene's size under the output's) and under\n"
            "combinations of them, brings each to the output size with the box filter, and\n"
            "compares it with a reference drawn at 4x4 pixels per output pixel with every\n"
            "knob at full: PSNR (RGB) and SSIM (luma), and the milliseconds a frame takes\n"
@@ -296,7 +304,8 @@ static bool q_equal(const r_quality *a, const r_quality *b)
 {
     return a->shadow_size == b->shadow_size && a->sil_size == b->sil_size && a->mask_half == b->mask_half &&
            a->bloom_levels == b->bloom_levels && a->aa == b->aa && a->lspsm_size == b->lspsm_size &&
-           a->fog_size == b->fog_size && a->water_grid == b->water_grid && a->snow_light == b->snow_light;
+           a->fog_size == b->fog_size && a->water_grid == b->water_grid && a->snow_light == b->snow_light &&
+           a->scene_pct == b->scene_pct;
 }
 
 /* The config whose scale and knobs are these, or -1. */
@@ -521,14 +530,14 @@ static bool write_outputs(const quality_opts *o, const quality_res *q, rs_err *e
         if (!f)
             return rs_fail(err, JOB_ERR_WRITE, "%s: not written", csv);
         fprintf(f, "stage,configuration,scale,aa,shadow_size,sil_size,mask_half,bloom_levels,lspsm_size,fog_size,water_grid,"
-                   "snow_light,ms_per_frame,psnr_db,ssim,frames,w,h\n");
+                   "snow_light,scene_pct,ms_per_frame,psnr_db,ssim,frames,w,h\n");
         for (int d = 0; d < NDEMOS; d++)
             for (int ci = 0; o->use[d] && ci < NCONFIGS; ci++) {
                 const config *cf = &configs[ci];
                 const result *rr = &q->res[d][ci];
-                fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
+                fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
                         cf->q.aa == R_AA_FXAA ? "fxaa" : "off", cf->q.shadow_size, cf->q.sil_size, cf->q.mask_half,
-                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, cf->q.snow_light, rr->ms, rr->psnr, rr->ssim,
+                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, cf->q.snow_light, cf->q.scene_pct, rr->ms, rr->psnr, rr->ssim,
                         o->frames, o->w, o->h);
             }
         if (cli_fclose(f) != 0)

@@ -610,6 +610,19 @@ static int prepare(render_run *run)
 /* The replay read from standard input, written (rp_write: checked, read
  * back) into a temporary folder the segments' processes can read ($TMPDIR,
  * else /tmp); path gets the file's name, stdin_copy_free removes both. */
+/* "640x360", or "640x360, the scene at 480x270" when the quality draws
+ * the scene smaller (r_quality.scene_pct) */
+static void drawn_at(const render_opts *o, char *out, size_t n)
+{
+    const cap_desc *cd = &o->cd;
+    int sw, sh;
+    r_scene_size(&o->quality->q, cd->src_w, cd->src_h, &sw, &sh);
+    if (sw == cd->src_w && sh == cd->src_h)
+        snprintf(out, n, "%dx%d", cd->src_w, cd->src_h);
+    else
+        snprintf(out, n, "%dx%d, the scene at %dx%d", cd->src_w, cd->src_h, sw, sh);
+}
+
 static bool stdin_copy(const rp_replay *rp, char *path, size_t n, rs_err *err)
 {
     const char *dir = getenv("TMPDIR");
@@ -677,7 +690,9 @@ static int render_split(render_run *run, int argc, char **argv)
         return rs_fail(&run->err, JOB_ERR_PROCESS, "cannot find this program (/proc/self/exe): %s", strerror(errno)), RS_EXIT_FAIL;
     exe[ne] = 0;
     const cap_desc *cd = &o->cd;
-    snprintf(what, sizeof what, "%dx%d (drawn at %dx%d, quality %s)", cd->w, cd->h, cd->src_w, cd->src_h, o->quality->name);
+    char drawn[64];
+    drawn_at(o, drawn, sizeof drawn);
+    snprintf(what, sizeof what, "%dx%d (drawn at %s, quality %s)", cd->w, cd->h, drawn, o->quality->name);
     /* a replay from standard input: the segments read a copy of it */
     char copy[PATH_MAX] = "";
     if (!strcmp(o->replay, "-") && !stdin_copy(&run->rp, copy, sizeof copy, &run->err))
@@ -737,12 +752,13 @@ static void summary(const render_run *run, const cap_stats *st, const job_render
 {
     const render_opts *o = run->o;
     const cap_desc *cd = &o->cd;
-    char said[300];
+    char said[300], drawn[64];
+    drawn_at(o, drawn, sizeof drawn);
     job_audio_describe(&o->audio, &run->sink, said, sizeof said);
     fprintf(stderr,
-            "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %dx%d, quality %s) in %.1f s, %.1f fps; %s capture, "
+            "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %s, quality %s) in %.1f s, %.1f fps; %s capture, "
             "%s downscale, pbo %d, queue %d, high-water %d, %" PRIu64 " fence waits%s%s%s\n", /* the encoder last */
-            o->out, st->frames, cd->w, cd->h, cd->src_w, cd->src_h, o->quality->name, secs, secs > 0 ? st->frames / secs : 0.0,
+            o->out, st->frames, cd->w, cd->h, drawn, o->quality->name, secs, secs > 0 ? st->frames / secs : 0.0,
             cd->mode == CAP_SEQUENTIAL ? "sequential" : "async",
             (cd->downscale ? cd->downscale : (cd->mode == CAP_SEQUENTIAL ? CAP_DS_CPU : CAP_DS_GPU)) == CAP_DS_GPU ? "gpu" : "cpu",
             cd->pbo ? cd->pbo : CAP_DEFAULT_PBO, cd->no_writer || cd->mode == CAP_SEQUENTIAL ? 0 : cd->queue ? cd->queue : CAP_DEFAULT_QUEUE,

@@ -1,5 +1,5 @@
 #version 330 core
-// variants: - GLOW AA GLOW+AA
+// variants: - GLOW AA GLOW+AA SCALED GLOW+SCALED SCALED+AA GLOW+SCALED+AA
 // Tone map (docs/renderer.md, "Tone map, bloom, flare"), one full-screen pass:
 //   1. RGB -> Y, Cb, Cr (CbCr unnormalised: B - Y and R - Y)
 //   2. Y' from the curve ((1 - exp(-x^2))^1.5)^(1/gamma) in a float table
@@ -10,7 +10,10 @@
 // flare, blur.frag), or the flare pass's own when bloom did not run; the
 // variant exists only when one of them ran this frame.  With the
 // AA pass after it (AA), it writes the image's luma beside it, as the AA
-// pass's early out reads it (fxaa.frag).
+// pass's early out reads it (fxaa.frag).  SCALED: the scene was drawn
+// smaller than the output (r_quality.scene_pct); this pass runs at the
+// output's size and reads it bilinearly, so everything after it (the AA
+// pass, the HUD) is at the output's size.
 uniform sampler2D u_hdr;
 uniform sampler1D u_lut;
 uniform int u_lut_size;
@@ -20,6 +23,9 @@ uniform float u_saturation;
 uniform int u_write_mask; // alpha = the fighters' mask, else 1
 #ifdef GLOW
 uniform sampler2D u_glow; // bloom and flare, already scaled (HDR)
+#endif
+#ifdef SCALED
+uniform vec2 u_out; // the output's size, pixels
 #endif
 layout(location = 0) out vec4 o_color;
 #ifdef AA
@@ -41,10 +47,15 @@ float curve(float x)
 
 void main()
 {
+#ifdef SCALED
+    vec2 uv = gl_FragCoord.xy / u_out;
+    vec4 hdr = textureLod(u_hdr, uv, 0.0);
+#else
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec4 hdr = texelFetch(u_hdr, p, 0);
-    vec3 c = hdr.rgb * u_exposure;
     vec2 uv = (gl_FragCoord.xy) / vec2(textureSize(u_hdr, 0));
+#endif
+    vec3 c = hdr.rgb * u_exposure;
 #ifdef GLOW
     c += texture(u_glow, uv).rgb;
 #endif

@@ -78,7 +78,7 @@ static void t_defaults_spelled_out_are_zero(void)
     plat *p = t_context("egl");
     enum { W = 320, H = 180 };
     uint8_t *a = frame_of("dojo", 1200, 0, NULL, W, H);
-    r_game_opts o = {.q = {.shadow_size = 1024, .sil_size = 512, .aa = R_AA_OFF, .water_grid = 64}};
+    r_game_opts o = {.q = {.shadow_size = 1024, .sil_size = 512, .aa = R_AA_OFF, .water_grid = 64, .scene_pct = 100}};
     uint8_t *b = frame_of("dojo", 1200, 0, &o, W, H);
     T_ASSERTF(!memcmp(a, b, (size_t)W * H * 4), "dojo: the knobs at their defaults drew other bytes than zero");
     free(a), free(b);
@@ -422,6 +422,50 @@ static void t_snow_light(void)
     plat_destroy(p);
 }
 
+/* scene_pct: the scene and its passes drawn at that share of the output
+ * (the HDR image 240x135 for 320x180 at 75%), the tone map scaling it up:
+ * the picture moves a little, not a lot, and the HUD stays at the output's
+ * size, where it was (the pixels it touches are the same set). */
+static void t_scene_pct(void)
+{
+    plat *p = t_context("egl");
+    enum { W = 320, H = 180 };
+    knob_moves_a_little("temple", 900, (r_quality){.scene_pct = 75}, "scene 75%", 30);
+    uint8_t *px[2][2];
+    for (int k = 0; k < 2; k++)
+        for (int hud = 0; hud < 2; hud++)
+            px[k][hud] = frame_of("dojo", 1200, 0, &(r_game_opts){.no_hud = !hud, .q = {.scene_pct = k ? 75 : 0}}, W, H);
+    long both = 0, either = 0;
+    for (int i = 0; i < W * H; i++) {
+        bool a = memcmp(px[0][0] + 4 * i, px[0][1] + 4 * i, 3) != 0, b = memcmp(px[1][0] + 4 * i, px[1][1] + 4 * i, 3) != 0;
+        both += a && b, either += a || b;
+    }
+    fprintf(stderr, "    the HUD's pixels at 100%% and at 75%%: %ld in both of %ld in either\n", both, either);
+    T_ASSERTF(either > 500 && both * 10 > either * 9, "the HUD touched other pixels at 75%%: %ld in both of %ld", both, either);
+    for (int k = 0; k < 2; k++)
+        free(px[k][0]), free(px[k][1]);
+    static const struct {
+        int pct, w, h, want_w, want_h;
+    } c[] = {{0, 320, 180, 320, 180}, {75, 320, 180, 240, 135}, {50, 64, 36, 32, 18}, {60, 101, 57, 61, 34}};
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.scene_pct = c[i].pct}});
+        t_fb f;
+        t_fb_make(&f, c[i].w, c[i].h);
+        g_state prev, cur;
+        t_state_at("dojo", 1200, &prev, &cur);
+        t_draw(r, &f, &prev, &cur, c[i].w, c[i].h);
+        float *hdr = malloc((size_t)c[i].w * c[i].h * 4 * sizeof *hdr);
+        int hw = 0, hh = 0;
+        T_ASSERT(hdr && r_game_read_buffer(r, "hdr", hdr, &hw, &hh));
+        T_ASSERTF(hw == c[i].want_w && hh == c[i].want_h, "scene_pct %d at %dx%d: the scene is %dx%d, want %dx%d", c[i].pct,
+                  c[i].w, c[i].h, hw, hh, c[i].want_w, c[i].want_h);
+        free(hdr);
+        t_fb_free(&f);
+        r_game_destroy(r);
+    }
+    plat_destroy(p);
+}
+
 static void t_water_grid(void)
 {
     plat *p = t_context("egl");
@@ -582,9 +626,11 @@ static void t_out_of_range_refused(void)
     refused((r_quality){.bloom_levels = 3}, "bloom_levels 3 out of range");
     refused((r_quality){.snow_light = 32}, "snow_light 32 out of range");
     refused((r_quality){.snow_light = 512}, "64..256");
+    refused((r_quality){.scene_pct = 49}, "scene_pct 49 out of range");
+    refused((r_quality){.scene_pct = 101}, "50..100");
     /* the ends of the ranges are taken */
     r_game_destroy(t_game_opts(&(r_game_opts){.q = {.shadow_size = 128, .sil_size = 64, .water_grid = 256,
-                                                     .fog_size = 1024, .bloom_levels = 1}}));
+                                                     .fog_size = 1024, .bloom_levels = 1, .scene_pct = 50}}));
     plat_destroy(p);
 }
 
@@ -631,7 +677,7 @@ static void t_presets_are_the_documented_table(void)
         for (char *tok = strtok(what, ",("); tok; tok = strtok(NULL, ",(")) {
             while (*tok == ' ')
                 tok++;
-            int v, a, b;
+            int v, a, b, used = 0;
             if (sscanf(tok, "%dx%d", &a, &b) == 2 && a == b)
                 scale = a;
             else if (sscanf(tok, "%dx", &a) == 1)
@@ -650,6 +696,8 @@ static void t_presets_are_the_documented_table(void)
                 q.water_grid = v;
             else if (sscanf(tok, "snow light %d", &v) == 1)
                 q.snow_light = v;
+            else if (sscanf(tok, "scene %d%%%n", &v, &used) == 1 && used > 0)
+                q.scene_pct = v;
             else if (sscanf(tok, "fog %d", &v) == 1)
                 q.fog_size = v;
             else if (sscanf(tok, "bloom %d", &v) == 1)
@@ -658,11 +706,11 @@ static void t_presets_are_the_documented_table(void)
         T_ASSERTF(scale == p->scale, "%s: scale %g in the doc, %g in r_presets", p->name, scale, p->scale);
         T_ASSERTF(!memcmp(&q, &p->q, sizeof q),
                   "%s: the doc's knobs (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, fog %d, bloom %d, "
-                  "snow light %d) are not r_presets' (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, water %d, "
-                  "fog %d, bloom %d, snow light %d)",
+                  "snow light %d, scene %d%%) are not r_presets' (aa %d, mask_half %d, shadow %d, silhouette %d, lspsm %d, "
+                  "water %d, fog %d, bloom %d, snow light %d, scene %d%%)",
                   p->name, q.aa, q.mask_half, q.shadow_size, q.sil_size, q.lspsm_size, q.water_grid, q.fog_size,
-                  q.bloom_levels, q.snow_light, p->q.aa, p->q.mask_half, p->q.shadow_size, p->q.sil_size, p->q.lspsm_size,
-                  p->q.water_grid, p->q.fog_size, p->q.bloom_levels, p->q.snow_light);
+                  q.bloom_levels, q.snow_light, q.scene_pct, p->q.aa, p->q.mask_half, p->q.shadow_size, p->q.sil_size,
+                  p->q.lspsm_size, p->q.water_grid, p->q.fog_size, p->q.bloom_levels, p->q.snow_light, p->q.scene_pct);
     }
     free(doc);
 }
@@ -672,4 +720,4 @@ T_MAIN({"presets_are_the_documented_table", t_presets_are_the_documented_table},
        {"fxaa_pass_in_graph", t_fxaa_pass_in_graph}, {"fxaa_cost", t_fxaa_cost}, {"light_maps_at_the_asked_size", t_light_maps_at_the_asked_size},
        {"shadow_and_silhouette_in_one_draw", t_shadow_and_silhouette_in_one_draw},
        {"silhouette_mips_whole", t_silhouette_mips_whole},
-       {"water_grid", t_water_grid}, {"snow_light", t_snow_light}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})
+       {"water_grid", t_water_grid}, {"snow_light", t_snow_light}, {"scene_pct", t_scene_pct}, {"fog_size", t_fog_size}, {"out_of_range_refused", t_out_of_range_refused})

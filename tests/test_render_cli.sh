@@ -129,7 +129,7 @@ t_help_lists_the_options() {
 # and the renderer's knobs; --size alone works from 16x16 to 3840x2160
 t_quality_and_sizes() {
     short_replay || return 1
-    for qs in "draft:160x90:160x90" "standard:160x90:160x90" "high:160x90:320x180" "reference:160x90:640x360" \
+    for qs in "draft:160x90:160x90, the scene at 96x54" "standard:160x90:160x90" "high:160x90:320x180" "reference:160x90:640x360" \
         "standard:1920x1080:1920x1080" "standard:16x16:16x16" "standard:3840x2160:3840x2160"; do
         q=${qs%%:*} rest=${qs#*:}
         size=${rest%%:*} drawn=${rest#*:}
@@ -138,11 +138,13 @@ t_quality_and_sizes() {
         grep -q "frames $size (drawn at $drawn, quality $q)" q.txt || { echo "$qs:"; cat q.txt; return 1; }
     done
     # --render-size wins over the quality's scale; the knobs still apply
-    # (draft's silhouette at 256, standard's at 512: other bytes)
+    # (draft's scene at 60% of the render size: other bytes)
     for q in draft standard; do
         "$RS_BIN" render short.rsr --ticks 100:102 --size 160x90 --render-size 320x180 --quality $q --passes \
             -o r_$q.y4m -y 2>r_$q.txt || { cat r_$q.txt; return 1; }
-        grep -q "(drawn at 320x180, quality $q)" r_$q.txt || { cat r_$q.txt; return 1; }
+        drawn=320x180
+        [ $q = standard ] || drawn="320x180, the scene at 192x108"
+        grep -q "(drawn at $drawn, quality $q)" r_$q.txt || { cat r_$q.txt; return 1; }
     done
     ! cmp -s r_draft.y4m r_standard.y4m || { echo "--render-size: draft drew what standard drew"; return 1; }
     grep -q "^fxaa  *0  *2 " r_standard.txt || { echo "standard runs FXAA"; cat r_standard.txt; return 1; }

@@ -46,10 +46,10 @@ static void run_fxaa(void *u)
     if (marked) {
         gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r->ldr_fbo);
         gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-        gl.BlitFramebuffer(0, 0, f->w, f->h, 0, 0, f->w, f->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        gl.BlitFramebuffer(0, 0, f->out_w, f->out_h, 0, 0, f->out_w, f->out_h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
         gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)f->out_fbo);
     }
-    gl.Viewport(0, 0, f->w, f->h);
+    gl.Viewport(0, 0, f->out_w, f->out_h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     if (marked) {

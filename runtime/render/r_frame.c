@@ -143,8 +143,8 @@ static void fx_setup(r_game *r, frame *f)
         bone_matrices(NULL, cur, i, 1.0f, f->bones_tick[i]);
     }
     r_mat4 proj;
-    r_game_camera_parts(prev, f->w, f->h, &f->view_prev, &proj, NULL);
-    r_game_camera_parts(cur, f->w, f->h, &f->view, &f->proj, NULL);
+    r_game_camera_parts(prev, f->out_w, f->out_h, &f->view_prev, &proj, NULL); /* the output's aspect */
+    r_game_camera_parts(cur, f->out_w, f->out_h, &f->view, &f->proj, NULL);
     uint64_t t = cur->tick;
     if (!r->have_last || t < r->last_tick || t - r->last_tick > R_FX_MAX_GAP)
         f->reset = true, f->steps = 1;
@@ -157,7 +157,7 @@ static void fx_setup(r_game *r, frame *f)
 void r_frame_setup(r_game *r, frame *f)
 {
     const g_state *cur = f->cur;
-    f->vp = r_game_camera(cur, f->w, f->h, &f->eye);
+    f->vp = r_game_camera(cur, f->out_w, f->out_h, &f->eye); /* the output's aspect: a scaled scene is not stretched */
     f->inv_vp = r_invert(f->vp);
     for (int i = 0; i < 2; i++) {
         bone_matrices(f->prev, cur, i, f->alpha, f->bones[i]);

@@ -47,7 +47,8 @@ enum { R_MAT_PLANKS, R_MAT_PAVED, R_MAT_BUILDING, R_MAT_HOLE };
 typedef struct frame {
     const g_state *prev, *cur;
     float alpha;
-    int w, h;
+    int w, h;         /* the scene's size: every pass up to the tone map */
+    int out_w, out_h; /* the output's: the tone map, the AA pass, the HUD (r_quality.scene_pct) */
     r_mat4 vp, inv_vp, light;
     r_vec3 eye, light_dir, waist[2];
     float bones[2][16][16], colors[2][16][4];

@@ -153,9 +153,9 @@ static void free_targets(r_game *r)
 }
 
 
-static bool make_targets(r_game *r, int w, int h, rs_err *err)
+static bool make_targets(r_game *r, int w, int h, int ow, int oh, rs_err *err)
 {
-    if (r->tw == w && r->th == h && r->tw > 0 && r->tfmt == r->hdr_format)
+    if (r->tw == w && r->th == h && r->tow == ow && r->toh == oh && r->tw > 0 && r->tfmt == r->hdr_format)
         return true;
     free_targets(r);
     GLenum hdr_fmt = r->hdr_format == R_HDR_R11G11B10F ? GL_R11F_G11F_B10F : GL_RGBA16F;
@@ -189,10 +189,10 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
     r->fl_tex = r_tex2d(GL_RGBA16F, r_half(w, 2), r_half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     r->fl_fbo = r_fbo_for(r->fl_tex, 0, 0);
     if (r->opts.q.aa) { /* the tone map's image for the AA pass: linear, its walk taps between texels */
-        r->ldr_tex = r_tex2d(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->ldr_tex = r_tex2d(GL_RGBA8, ow, oh, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->ldr_fbo = r_fbo_for(r->ldr_tex, 0, 0);
         /* and its luma beside it, which the AA pass gathers for its early out */
-        r->luma_tex = r_tex2d(GL_R8, w, h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+        r->luma_tex = r_tex2d(GL_R8, ow, oh, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
         gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, r->luma_tex, 0);
         const GLenum two[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
         gl.DrawBuffers(2, two);
@@ -205,7 +205,7 @@ static bool make_targets(r_game *r, int w, int h, rs_err *err)
         return rs_fail(err, R_ERR_TARGET, "%dx%d HDR target (%s) incomplete (%s)", w, h,
                        hdr_fmt == GL_RGBA16F ? "rgba16f" : "r11g11b10f", rgl_enum_name(st));
     }
-    r->tw = w, r->th = h, r->tfmt = r->hdr_format;
+    r->tw = w, r->th = h, r->tow = ow, r->toh = oh, r->tfmt = r->hdr_format;
     RGL_CHECK("make_targets");
     return true;
 }
@@ -241,6 +241,8 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_GLOW + 3, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define LEVEL2 1\n#define FLARE 1\n"},
         {P_TONE, "cap_fullscreen.vert", "tonemap.frag", NULL},
         {P_TONE + 1, "cap_fullscreen.vert", "tonemap.frag", "#define GLOW 1\n"},
+        {P_TONE + 2, "cap_fullscreen.vert", "tonemap.frag", "#define SCALED 1\n"},
+        {P_TONE + 3, "cap_fullscreen.vert", "tonemap.frag", "#define GLOW 1\n#define SCALED 1\n"},
     };
     /* with the AA pass, the tone map writes the luma too (r_aa.c), and the
      * pass's early out gathers it where the GL can (else five fetches) */
@@ -399,8 +401,9 @@ static bool check_quality(const r_quality *q, rs_err *err)
         {"fog_size", "the mist's density map's side", 64, 1024},
         {"bloom_levels", "the bloom levels added", 1, 2},
         {"snow_light", "the snow's light map's side", 64, 256},
+        {"scene_pct", "the scene's size, percent of the output's", 50, 100},
     };
-    const int v[] = {q->shadow_size, q->sil_size, q->water_grid, q->fog_size, q->bloom_levels, q->snow_light};
+    const int v[] = {q->shadow_size, q->sil_size, q->water_grid, q->fog_size, q->bloom_levels, q->snow_light, q->scene_pct};
     for (size_t i = 0; i < sizeof k / sizeof k[0]; i++)
         if (v[i] != 0 && (v[i] < k[i].lo || v[i] > k[i].hi))
             return rs_fail(err, R_ERR_QUALITY, "quality: %s %d out of range: %s is %d..%d (0 = default)", k[i].name, v[i],
@@ -663,7 +666,9 @@ bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, i
     known_state();
     frame *f = &r->f;
     memset(f, 0, sizeof *f);
-    f->prev = prev, f->cur = cur, f->alpha = 1.0f, f->w = w, f->h = h, f->out_fbo = out;
+    int sw, sh;
+    r_scene_size(&r->opts.q, w, h, &sw, &sh);
+    f->prev = prev, f->cur = cur, f->alpha = 1.0f, f->w = sw, f->h = sh, f->out_w = w, f->out_h = h, f->out_fbo = out;
     r_frame_setup(r, f); /* steps and reset, as a drawn frame counts them */
     r_fx_advance(r);
     leave_state(out);
@@ -692,7 +697,9 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     bool ok = w > 0 && h > 0;
     if (!ok)
         rs_fail(err, R_ERR_SIZE, "cannot draw a %dx%d frame", w, h);
-    if (!ok || !r_game_prepare(r, cur->stage, err) || !make_targets(r, w, h, err)) {
+    int sw = 0, sh = 0;
+    r_scene_size(&r->opts.q, w, h, &sw, &sh);
+    if (!ok || !r_game_prepare(r, cur->stage, err) || !make_targets(r, sw, sh, w, h, err)) {
         gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)out);
         if (w > 0 && h > 0) {
             gl.Viewport(0, 0, w, h);
@@ -707,9 +714,9 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     known_state();
     frame *f = &r->f;
     memset(f, 0, sizeof *f);
-    f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = w, f->h = h, f->out_fbo = out;
+    f->prev = prev, f->cur = cur, f->alpha = alpha, f->w = sw, f->h = sh, f->out_w = w, f->out_h = h, f->out_fbo = out;
     f->depth_only = skip != 0; /* only r_game_advance skips: a warm-up frame */
-    select_fighter_mesh(r, h);
+    select_fighter_mesh(r, sh);
     r_frame_setup(r, f);
     r->mask_final = 0;
     r_graph_run_skip(&r->graph, r, skip);

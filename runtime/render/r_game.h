@@ -50,7 +50,14 @@ typedef struct r_quality {
     int fog_size;     /* the mist's top-down density map, 64..1024: 0 = the module's default */
     int water_grid;   /* water surface quads a side, 16..256: 0 = the module's default */
     int snow_light;   /* the snow's texture-space light map, texels a side, 64..256: 0 = 256 */
+    int scene_pct;    /* the scene and every pass before the tone map drawn at this percentage of the output's
+                         width and height, 50..100: 0 = 100; the tone map scales it up (bilinear) and the
+                         anti-aliasing and the HUD run at the output size */
 } r_quality;
+
+/* The scene's size for an output of w x h under q.scene_pct (w x h itself
+ * at 0 or 100), at least a pixel each way. */
+void r_scene_size(const r_quality *q, int w, int h, int *sw, int *sh);
 
 /* Zero is the default for every field. */
 typedef struct r_game_opts {

@@ -147,9 +147,9 @@ static void run_hud(void *u)
 {
     r_game *r = u;
     frame *f = &r->f;
-    build_hud(r, f->cur, f->w, f->h);
+    build_hud(r, f->cur, f->out_w, f->out_h); /* at the output's size, whatever the scene's */
     gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)f->out_fbo);
-    gl.Viewport(0, 0, f->w, f->h);
+    gl.Viewport(0, 0, f->out_w, f->out_h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_CULL_FACE);
     gl.Enable(GL_BLEND); /* coverage in alpha; the output's alpha stays */
@@ -163,7 +163,7 @@ static void run_hud(void *u)
             end++;
         GLuint p = r->prog[id];
         gl.UseProgram(p);
-        gl.Uniform2f(r_loc(p, "u_screen"), (float)f->w, (float)f->h);
+        gl.Uniform2f(r_loc(p, "u_screen"), (float)f->out_w, (float)f->out_h);
         if (id != P_HUD_RECT)
             r_bind_tex(p, "u_font", 0, GL_TEXTURE_2D, r->font_tex);
         gl.DrawArrays(GL_TRIANGLES, q * 6, (end - q) * 6);

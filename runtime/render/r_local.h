@@ -46,8 +46,8 @@ enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK
        P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_BLUR_TEXELS, /* + 3: reaching 1..4 texels */
        P_DOWN = P_BLUR_TEXELS + 4, P_SUNVIS, P_FLARE, P_HUD, P_HUD_RECT, P_HUD_2TAPS, P_FXAA, P_FXAA_MARK,
        P_GLOW, /* + 4 variants: bloom's last blur with its second level x the flare (r_post.c) */
-       P_TONE = P_GLOW + 4, /* + 1 variant: with the glow */
-       P_COUNT = P_TONE + 2 };
+       P_TONE = P_GLOW + 4, /* + 1: with the glow; + 2: scaling the scene up (r_quality.scene_pct), + 3 both */
+       P_COUNT = P_TONE + 4 };
 
 
 struct r_game {
@@ -86,7 +86,8 @@ struct r_game {
     GLuint shadow_sil_fbo; /* the shadow map and silhouette level 0 together, when their sides agree (else 0) */
     GLuint sil_tex, sil_tmp, sil_fbo[SIL_LEVELS], sil_tmp_fbo[SIL_LEVELS];
     /* screen targets */
-    int tw, th;
+    int tw, th;   /* the scene's targets' size */
+    int tow, toh; /* the output's, for the AA pass's targets */
     r_hdr_format tfmt;
     GLuint hdr_tex, depth_tex, hdr_fbo, depth_fbo;
     GLuint mask_tex[2], mask_fbo[2];

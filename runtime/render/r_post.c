@@ -125,10 +125,11 @@ static void run_tonemap(void *u)
     /* the glow: bloom's (with the flare in it), else the flare's own */
     bool bloom = r_ran(f, r, "bloom_blur"), flare = r_ran(f, r, "flare");
     GLuint glow = bloom ? r->b4_tex[0] : flare ? r->fl_tex : 0;
-    GLuint p = r->prog[P_TONE + (glow ? 1 : 0)];
+    bool scaled = f->w != f->out_w || f->h != f->out_h; /* r_quality.scene_pct: the scene drawn smaller */
+    GLuint p = r->prog[P_TONE + (glow ? 1 : 0) + (scaled ? 2 : 0)];
     /* with anti-aliasing the AA pass (r_aa.c) writes the output from ldr_tex */
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->opts.q.aa ? r->ldr_fbo : (GLuint)f->out_fbo);
-    gl.Viewport(0, 0, f->w, f->h);
+    gl.Viewport(0, 0, f->out_w, f->out_h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.UseProgram(p);
@@ -139,6 +140,8 @@ static void run_tonemap(void *u)
     gl.Uniform1f(r_loc(p, "u_exposure"), f->exposure);
     gl.Uniform1f(r_loc(p, "u_saturation"), f->saturation);
     gl.Uniform1i(r_loc(p, "u_write_mask"), r->opts.mask);
+    if (scaled)
+        gl.Uniform2f(r_loc(p, "u_out"), (float)f->out_w, (float)f->out_h);
     if (glow)
         r_bind_tex(p, "u_glow", 2, GL_TEXTURE_2D, glow);
     r_fullscreen(r);
