@@ -162,7 +162,7 @@ t_encoder_options() {
     id3=$(svc_submit a.rsr "quality=draft") || return 1
     svc_wait_state "$id3" done 60 || return 1
     curl -sf "$SVC_URL/jobs/$id3" >j3.json && [ "$(json_get quality <j3.json)" = draft ] || { cat j3.json; return 1; }
-    curl -sf "$SVC_URL/jobs/$id3/log" | grep -q "(drawn at 160x90, quality draft)" ||
+    curl -sf "$SVC_URL/jobs/$id3/log" | grep -q "(drawn at 160x90, the scene at 96x54, quality draft)" ||
         { echo "job $id3 was not rendered with quality draft"; curl -s "$SVC_URL/jobs/$id3/log"; return 1; }
     # a form field works like the query parameter
     id2=$(curl -s -F replay=@a.rsr -F format=webm -F codec=vp9 -F preset=8 "$SVC_URL/jobs" | json_get id) || return 1
