@@ -607,9 +607,6 @@ static int prepare(render_run *run)
     return plan_split(run);
 }
 
-/* The replay read from standard input, written (rp_write: checked, read
- * back) into a temporary folder the segments' processes can read ($TMPDIR,
- * else /tmp); path gets the file's name, stdin_copy_free removes both. */
 /* "640x360", or "640x360, the scene at 480x270" when the quality draws
  * the scene smaller (r_quality.scene_pct) */
 static void drawn_at(const render_opts *o, char *out, size_t n)
@@ -623,6 +620,9 @@ static void drawn_at(const render_opts *o, char *out, size_t n)
         snprintf(out, n, "%dx%d, the scene at %dx%d", cd->src_w, cd->src_h, sw, sh);
 }
 
+/* The replay read from standard input, written (rp_write: checked, read
+ * back) into a temporary folder the segments' processes can read ($TMPDIR,
+ * else /tmp); path gets the file's name, stdin_copy_free removes both. */
 static bool stdin_copy(const rp_replay *rp, char *path, size_t n, rs_err *err)
 {
     const char *dir = getenv("TMPDIR");
