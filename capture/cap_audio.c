@@ -133,7 +133,11 @@ bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err 
     c->bit_rate = s->audio_bitrate;
     if (fmt->oformat->flags & AVFMT_GLOBALHEADER)
         c->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-    int r = avcodec_open2(c, codec, NULL);
+    AVDictionary *o = NULL;
+    if (s->audio_fast && !strcmp(name, "aac"))
+        av_dict_set(&o, "aac_coder", "fast", 0);
+    int r = avcodec_open2(c, codec, &o);
+    av_dict_free(&o);
     if (r < 0)
         return fail_av(err, CAP_ERR_ENCODER, s->path, "cannot open the audio encoder", r);
     avcodec_parameters_from_context(a->st->codecpar, c);

@@ -468,7 +468,7 @@ bool cap_encoder_open(cap_encoder *x, const cap_sink *s, bool global_header, rs_
     c->color_primaries = AVCOL_PRI_BT709;
     c->color_trc = AVCOL_TRC_BT709;
     c->chroma_sample_location = s->enc.chroma == CAP_CHROMA_444 ? AVCHROMA_LOC_UNSPECIFIED : AVCHROMA_LOC_CENTER;
-    if (s->segment)
+    if (s->segment || s->closed_gop)
         c->flags |= AV_CODEC_FLAG_CLOSED_GOP;
     if (global_header)
         c->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;

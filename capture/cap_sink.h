@@ -103,6 +103,9 @@ struct cap_sink {
      * timestamps start at index_base too, the first frame is a keyframe
      * and no frame refers outside the file (closed GOP) */
     bool segment;
+    /* a closed GOP without being a segment (render --hls-dir): every
+     * keyframe is a place where a piece can start (cap_hls.h) */
+    bool closed_gop;
     /* the container, lower case with its dot (".mp4", ".nut"), from the
      * name's extension or --format: sinks go by it, not by the name */
     char ext[8];
@@ -120,6 +123,7 @@ struct cap_sink {
     void *audio_u;           /* its argument, borrowed until close */
     size_t audio_frames;     /* sample frames: 800 a video frame */
     int64_t audio_bitrate; /* bits/s, filled with the default when 0 */
+    bool audio_fast;         /* AAC: FFmpeg's fast coder (4x faster, for a live stream's track) */
     char audio_codec[8];   /* "aac" or "opus" */
 };
 

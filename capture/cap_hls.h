@@ -1,0 +1,103 @@
+/* HLS pieces: a rendered video cut into short MPEG-TS files that any HLS
+ * player can play while the rest of the job still renders
+ * (docs/service.md, "Watching while it renders").
+ *
+ * One folder per job holds:
+ *   track.ts      the whole match's sound, AAC in MPEG-TS, made once
+ *                 (cap_hls_track) by whichever render needs it first: the
+ *                 track is deterministic, so two makers make the same one;
+ *   tTICK.ts      a piece: the video from its keyframe at TICK up to the
+ *                 next keyframe (or the unit's end), stream-copied (nothing
+ *                 decoded or encoded again), and the track's packets of the
+ *                 same time;
+ *   uFIRST.idx    a unit's index, written last and atomically: the pieces
+ *                 of ticks FIRST..END-1, each with its size and FNV-1a.
+ * An index means its pieces are complete, and they never change after:
+ * a later cut of the same unit keeps an index whose pieces still match
+ * it, and writes the unit again only when they do not.
+ *
+ * Timestamps are the ticks' times plus CAP_HLS_OFFSET_TICKS, in every
+ * piece, so pieces cut by different processes (and machines) play as one
+ * stream; decode times trail the frames' positions by CAP_HLS_REORDER.
+ *
+ *   render:  cap_hls_track(dir, sink)      the sound, unless it is there
+ *            cap_hls_cut(&cut)             pieces, then the index
+ *   serve:   cap_hls_index_read(dir, first, &ix)
+ *            cap_hls_playlist(units, n, ended, prefix)
+ *            cap_hls_piece_check(dir, &piece)  before sending one */
+#ifndef CAP_HLS_H
+#define CAP_HLS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cap_seg.h"
+#include "cap_sink.h"
+
+/* 1 s: the first frame's pts.  B-frames' decode times sit before it. */
+#define CAP_HLS_OFFSET_TICKS 60
+/* The most a frame's pts may trail its decode position (x264 and x265
+ * as capture runs them: 2).  A video with more is refused. */
+#define CAP_HLS_REORDER 8
+/* A piece's length the playlist promises (EXT-X-TARGETDURATION): the
+ * encoder's keyframe interval, 120 frames. */
+#define CAP_HLS_TARGET_SECONDS 2
+
+typedef struct cap_hls_piece {
+    uint64_t tick;   /* its first frame's tick: the file is tTICK.ts */
+    uint64_t frames; /* frames in it */
+    uint64_t bytes;  /* the file's size */
+    uint64_t fnv;    /* FNV-1a 64 of the file */
+} cap_hls_piece;
+
+/* A unit's index: ticks first..end-1 in n pieces (malloc'd). */
+typedef struct cap_hls_index {
+    uint64_t first, end;
+    int n;
+    cap_hls_piece *p;
+} cap_hls_index;
+
+void cap_hls_index_free(cap_hls_index *ix);
+
+/* Makes DIR/track.ts from audio's track (cap_sink_audio filled its
+ * audio, audio_u, audio_frames and bitrate; the track starts at tick 0)
+ * unless it exists.  Written as a temporary of this process and linked
+ * into place: a racing maker's track is kept, never half-replaced. */
+bool cap_hls_track(const char *dir, const cap_sink *audio, rs_err *err);
+
+typedef struct cap_hls_cut_desc {
+    const char *dir;     /* the job's folder; must exist and hold track.ts */
+    const char *video;   /* a render's output (its video stream, pts = tick) or a segment */
+    const cap_seg *seg;  /* the segment as cap_seg_verify filled it, or NULL (a whole render):
+                            its packets must match its manifest (count, CRC-32), as the join checks */
+    uint64_t first, end; /* the video's ticks, first..end-1 */
+    uint64_t total;      /* the match's last tick + 1: the last piece takes the track's rest */
+    bool *kept;          /* optional: set when a good index was there already */
+} cap_hls_cut_desc;
+
+/* Cuts the video at its keyframes into pieces and writes the unit's
+ * index last.  A video that is not H.264 or HEVC is refused
+ * (CAP_ERR_ENC_SETTING: MPEG-TS carries neither VP9 nor AV1); a segment
+ * whose packets differ from its manifest gets CAP_ERR_SEG_MEDIA and
+ * leaves nothing; a write failure CAP_ERR_WRITE. */
+bool cap_hls_cut(const cap_hls_cut_desc *d, rs_err *err);
+
+/* Reads DIR/uFIRST.idx.  0: there is none (nothing cut yet); 1: *ix
+ * filled; -1: unreadable or malformed (err names the file and line). */
+int cap_hls_index_read(const char *dir, uint64_t first, cap_hls_index *ix, rs_err *err);
+
+/* An index's text (parse and format agree; snprintf rules). */
+int cap_hls_index_format(const cap_hls_index *ix, char *out, size_t n);
+bool cap_hls_index_parse(const char *text, const char *path, cap_hls_index *ix, rs_err *err);
+
+/* DIR/tTICK.ts is p's size and FNV-1a: false (CAP_ERR_SEG_MEDIA) says
+ * how it differs.  data: optional, gets the file's bytes (malloc'd). */
+bool cap_hls_piece_check(const char *dir, const cap_hls_piece *p, uint8_t **data, rs_err *err);
+
+/* The playlist of units' pieces in order (HLS version 7, EVENT; "#EXT-X-
+ * ENDLIST" when ended): each piece's URI is prefix, its tick, ".ts".
+ * Returns malloc'd text (NULL: out of memory), its length in *len. */
+char *cap_hls_playlist(const cap_hls_index *units, int n, bool ended, const char *prefix, size_t *len);
+
+#endif
