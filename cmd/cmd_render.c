@@ -15,6 +15,7 @@
 #include "cli.h"
 #include "../runtime/util/rs_log.h"
 #include "job_audio.h"
+#include "job_hls.h"
 #include "job_poster.h"
 #include "job_out.h"
 #include "job_render.h"
@@ -42,7 +43,7 @@ static void help(void)
            "                       [--stage-file FILE] [--passes[=summary|frames]] [--mask] [--no-hud]\n"
            "                       [--hdr-format rgba16f|r11g11b10f]\n"
            "                       [--ticks A:B|A: | --from T [--to T | --duration T]]\n"
-           "                       [--segment KEY] [--progress-fd N] [--poster FILE.png]\n"
+           "                       [--segment KEY] [--hls-dir DIR] [--progress-fd N] [--poster FILE.png]\n"
            "                       [--codec C] [--crf N | --bitrate RATE] [--preset P]\n"
            "                       [--pix-fmt yuv420p|yuv444p] [--hw auto|off|nvenc|vaapi]\n"
            "                       [--audio on|off] [--audio-bitrate RATE] [--loudness LUFS] [--wav FILE]\n"
@@ -111,6 +112,10 @@ static void help(void)
            "                     ticks, sizes, checksums), written last.  KEY ([A-Za-z0-9._:-],\n"
            "                     at most 64) names the job and attempt; --hashes, if given, must\n"
            "                     be OUT with its extension replaced by .hashes (docs/segments.md)\n"
+           "  --hls-dir DIR      also cut the video (.mp4 or .mkv, H.264 or HEVC) at its keyframes\n"
+           "                     into HLS pieces in DIR, with the whole match's sound (DIR/track.ts,\n"
+           "                     made once): what 'ringside serve' streams while a job renders\n"
+           "                     (docs/service.md, Watching while it renders)\n"
            "  --progress-fd N    also report progress on file descriptor N, for programs\n"
            "                     (ringside serve): 'frames DONE TOTAL' lines, and 'desync TICK'\n"
            "                     if the replay's state hashes stop matching\n"
@@ -164,7 +169,8 @@ static void help(void)
 }
 
 /* long-only options (no letter): the encoder's */
-enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW, OPT_JOBS, OPT_FROM, OPT_TO, OPT_DURATION };
+enum { OPT_CODEC = 0x200, OPT_CRF, OPT_BITRATE, OPT_PRESET, OPT_PIXFMT, OPT_HW, OPT_JOBS, OPT_FROM, OPT_TO, OPT_DURATION,
+       OPT_HLS_DIR };
 
 /* What a segment of a parallel render (--jobs) is given of the user's
  * options: the ones that decide the pictures and the encoding.  The rest
@@ -239,11 +245,12 @@ static const struct option opts[] = {
     {"audio", required_argument, 0, JOB_AUDIO_OPT_AUDIO}, {"audio-bitrate", required_argument, 0, JOB_AUDIO_OPT_BITRATE},
     {"loudness", required_argument, 0, JOB_AUDIO_OPT_LOUDNESS}, {"wav", required_argument, 0, JOB_AUDIO_OPT_WAV},
     {"jobs", required_argument, 0, OPT_JOBS}, {"from", required_argument, 0, OPT_FROM},
-    {"to", required_argument, 0, OPT_TO},     {"duration", required_argument, 0, OPT_DURATION}, {0}};
+    {"to", required_argument, 0, OPT_TO},     {"duration", required_argument, 0, OPT_DURATION},
+    {"hls-dir", required_argument, 0, OPT_HLS_DIR}, {0}};
 
 /* What the command line asks for. */
 typedef struct render_opts {
-    const char *replay, *out, *hashes, *backend, *segment, *format, *poster;
+    const char *replay, *out, *hashes, *backend, *segment, *format, *poster, *hls_dir;
     bool overwrite, quiet;
     int progress;             /* rs_progress_mode, or RS_PROGRESS_AUTO */
     cap_desc cd;
@@ -389,6 +396,7 @@ static int render_option(render_opts *o, int c, const char *arg, char **argv)
     case OPT_TO: return cli_time("--to", arg, &o->to) ? -1 : RS_EXIT_USAGE;
     case OPT_DURATION: return cli_time("--duration", arg, &o->duration) ? -1 : RS_EXIT_USAGE;
     case 'H': o->hashes = arg; return -1;
+    case OPT_HLS_DIR: o->hls_dir = arg; return -1;
     case 'S':
         if (!cap_seg_key_ok(arg)) {
             cli_error("render", "--segment '%s': expected a key of 1 to %d characters from A-Z a-z 0-9 . _ : -", arg,
@@ -473,6 +481,14 @@ static int check_options(render_opts *o)
         }
         if (o->hashes && strcmp(o->hashes, o->seg_hashes) != 0) {
             cli_error("render", "--segment: --hashes must be %s (where join looks for it), not %s", o->seg_hashes, o->hashes);
+            return RS_EXIT_USAGE;
+        }
+    }
+    if (o->hls_dir) {
+        const char *f = cap_seg_format_of(o->out);
+        if (!f || !strcmp(f, "webm") || o->enc.codec == CAP_CODEC_VP9 || o->enc.codec == CAP_CODEC_AV1) {
+            cli_error("render", "--hls-dir: HLS pieces are H.264 or HEVC from a .mp4 or .mkv file, not %s%s", o->out,
+                      f && strcmp(f, "webm") ? " with --codec vp9 or av1" : "");
             return RS_EXIT_USAGE;
         }
     }
@@ -594,6 +610,7 @@ static int prepare(render_run *run)
     }
     run->sink.index_base = run->first; /* frame numbers are ticks: f%04d.png of --ticks 600:660 is f0600..f0659 */
     run->sink.segment = o->segment != NULL;
+    run->sink.closed_gop = o->hls_dir != NULL; /* x265 opens its GOPs otherwise: no place to cut */
     bool usage;
     if (!job_audio_check(&o->audio, "render", &run->sink, &usage, err))
         return usage ? RS_EXIT_USAGE : RS_EXIT_FAIL;
@@ -820,6 +837,28 @@ static int render_here(render_run *run)
     return RS_EXIT_OK;
 }
 
+/* --hls-dir: the track begun before the frames; after them the output,
+ * in place, cut into HLS pieces (job_hls.h).  A failure of the cut leaves
+ * the video (it is good) and exits 1. */
+static bool hls_start(render_run *run, job_hls *h)
+{
+    const render_opts *o = run->o;
+    job_hls_desc d = {.dir = o->hls_dir, .video = o->out, .segment = o->segment, .hashes = o->hashes != NULL,
+                      .rp = &run->rp, .name = o->replay, .lufs = o->audio.lufs, .first = run->first, .end = run->end};
+    return job_hls_start(h, &d, &run->err);
+}
+
+static int hls_finish(render_run *run, job_hls *h, int status)
+{
+    double t0 = rs_now();
+    if (!job_hls_finish(h, status == RS_EXIT_OK, &run->err))
+        return status == RS_EXIT_OK ? RS_EXIT_FAIL : status;
+    if (status == RS_EXIT_OK)
+        cli_debug("render", "HLS pieces of %s in %s: the track %.2f s%s, the cut %.2f s", run->o->out, run->o->hls_dir,
+                  h->track_s, h->track_s ? "" : " (made before)", rs_now() - t0);
+    return status;
+}
+
 int cmd_render(int argc, char **argv)
 {
     render_opts o;
@@ -845,8 +884,13 @@ int cmd_render(int argc, char **argv)
     ign.sa_handler = SIG_IGN;
     sigaction(SIGPIPE, &ign, &old_pipe);
     status = prepare(&run);
+    job_hls hls = {0};
+    if (status < 0 && o.hls_dir && !hls_start(&run, &hls))
+        status = RS_EXIT_FAIL;
     if (status < 0)
         status = run.split > 1 ? render_split(&run, argc, argv) : render_here(&run);
+    if (o.hls_dir)
+        status = hls_finish(&run, &hls, status);
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
     sigaction(SIGPIPE, &old_pipe, NULL);

@@ -38,6 +38,8 @@ pts_ticks() { ffprobe -v error -show_entries packet=pts_time -of csv=p=0 "$1" | 
 key_ticks() { ffprobe -v error -show_entries packet=pts_time,flags -of csv=p=0 "$1" | awk -F, '$2 ~ /K/ { printf "%d\n", $1 * 60 + 0.5 }' | sort -n; }
 # the decoded frames' MD5s, in order
 frames() { ffmpeg -v error -i "$1" -f framemd5 - | grep -v '^#' | cut -d, -f6; }
+# the same of the video stream alone
+vframes() { ffmpeg -v error -i "$1" -map 0:v -f framemd5 - | grep -v '^#' | cut -d, -f6; }
 # no output and no temporary left for OUT.mp4 / OUT.hashes
 nothing_left() {
     for f in "$1.mp4" "$1.mp4.part" "$1.hashes" "$1.hashes.part"; do
@@ -218,6 +220,62 @@ t_segment_render_rules() {
     expect_fail 3 "x.mp4: no manifest x.mp4.seg" "$RS_BIN" join --segment k -o y.mp4 --first 10 x.mp4
 }
 
+# render --hls-dir: the pieces a service streams while a job renders
+# (capture/cap_hls.h).  Two segments with their pieces put back to back
+# play as the joined video; a whole render's playlist plays as the video;
+# a unit's pieces never change once indexed, unless they went bad.
+hls_playlist() { # DIR UNIT... -> an HLS playlist of those units' pieces
+    d=$1
+    shift
+    printf '#EXTM3U\n#EXT-X-VERSION:7\n#EXT-X-TARGETDURATION:2\n#EXT-X-PLAYLIST-TYPE:EVENT\n'
+    for u in "$@"; do
+        awk -v d="$d" '$1 == "piece" { printf "#EXTINF:%.6f,\n%s/t%d.ts\n", $3 / 60, d, $2 }' "$d/u$u.idx"
+    done
+    printf '#EXT-X-ENDLIST\n'
+}
+t_hls_pieces() {
+    # a short match: its whole track (made once per folder) is quick to make
+    "$RS_BIN" record --ai --quiet --seconds 5 --seed 8 -o m.rsr || return 1
+    for r in 0:150 150:240; do
+        "$RS_BIN" render m.rsr --ticks "$r" $TINY -q --segment job7 -o "s${r%:*}.mp4" --hashes "s${r%:*}.hashes" \
+            --hls-dir hls || { echo "segment $r with --hls-dir failed"; return 1; }
+    done
+    # pieces at the keyframes: 0 and 120 in the first unit (every 120 frames), 150 in the second
+    [ "$(grep -h '^piece' hls/u0.idx hls/u150.idx | cut -d' ' -f2,3 | tr '\n' ' ')" = "0 120 120 30 150 90 " ] ||
+        { cat hls/u0.idx hls/u150.idx; return 1; }
+    [ -s hls/track.ts ] || { echo "no track"; return 1; }
+    "$RS_BIN" join --segment job7 -y -q -o joined.mp4 --replay m.rsr s0.mp4 s150.mp4 || return 1
+    hls_playlist hls 0 150 >live.m3u8
+    [ "$(vframes joined.mp4 | wc -l)" = 240 ] && [ "$(vframes joined.mp4 | md5sum)" = "$(vframes live.m3u8 | md5sum)" ] ||
+        { echo "the pieces are not the joined video's frames"; return 1; }
+    # the pieces have the sound of their time: 4 s is 187.5 AAC frames
+    n=$(ffprobe -v error -count_packets -select_streams a -show_entries stream=nb_read_packets -of csv=p=0 live.m3u8 | grep -m1 .)
+    [ "$n" -ge 186 ] && [ "$n" -le 190 ] || { echo "$n audio packets for 4 s (about 188)"; return 1; }
+    for p in hls/t*.ts; do
+        [ "$p" = hls/track.ts ] && continue
+        ffprobe -v error -show_entries stream=codec_name -of csv=p=0 "$p" | tr '\n' ' ' | grep -q "h264 aac" ||
+            { echo "$p: not H.264 and AAC"; return 1; }
+    done
+    # indexed pieces stay: the same unit drawn again (other bytes: --crf 30) keeps them
+    sum=$(cat hls/t0.ts hls/t120.ts | md5sum)
+    "$RS_BIN" render m.rsr --ticks 0:150 $TINY -q -y --crf 30 --segment job7 -o s0b.mp4 --hashes s0b.hashes --hls-dir hls || return 1
+    [ "$(cat hls/t0.ts hls/t120.ts | md5sum)" = "$sum" ] || { echo "a listed unit's pieces changed"; return 1; }
+    # ... unless one went bad: then the unit is cut again
+    printf x >>hls/t120.ts
+    "$RS_BIN" render m.rsr --ticks 0:150 $TINY -q -y --crf 30 --segment job7 -o s0b.mp4 --hashes s0b.hashes --hls-dir hls || return 1
+    [ "$(cat hls/t0.ts hls/t120.ts | md5sum)" != "$sum" ] && grep -q "^piece 120 30 $(stat -c %s hls/t120.ts) " hls/u0.idx ||
+        { echo "a damaged piece was not cut again"; return 1; }
+    # a whole render writes its own finished playlist
+    "$RS_BIN" render m.rsr --ticks 0:200 $TINY -q -o whole.mp4 --hls-dir w || return 1
+    grep -q '^#EXT-X-ENDLIST' w/stream.m3u8 && grep -q '^t120.ts' w/stream.m3u8 || { cat w/stream.m3u8; return 1; }
+    [ "$(vframes whole.mp4 | md5sum)" = "$(vframes w/stream.m3u8 | md5sum)" ] || { echo "the whole render's stream is not its frames"; return 1; }
+    # what has no HLS pieces is refused before any work
+    for o in "x.webm" "x.mkv --codec vp9" "x.y4m"; do
+        "$RS_BIN" render m.rsr --ticks 0:10 $TINY -q -o $o --hls-dir h2 2>err.txt
+        [ $? = 2 ] && grep -q "HLS pieces are H.264 or HEVC" err.txt && [ ! -e h2 ] || { echo "-o $o"; cat err.txt; return 1; }
+    done
+}
+
 t_help() {
     "$RS_BIN" render --help >h.txt && grep -q -- "--segment KEY" h.txt || { echo "render --help lacks --segment"; return 1; }
     "$RS_BIN" join --help >h.txt || return 1
@@ -227,5 +285,6 @@ t_help() {
     "$RS_BIN" --help | grep -q "^  join " || { echo "ringside --help does not list join"; return 1; }
 }
 
-t_run mp4_segments_join_to_the_single_render mkv_and_webm bad_segments_exit_3 output_failures_exit_1 segment_render_rules help
+t_run mp4_segments_join_to_the_single_render mkv_and_webm bad_segments_exit_3 output_failures_exit_1 segment_render_rules \
+    hls_pieces help
 t_done
