@@ -183,7 +183,8 @@ FUZZ_SRC_seg := capture/cap_seg.c $(FUZZ_UTIL)
 FUZZ_SRC_config := service/svc_config.c $(FUZZ_CAPTURE) $(FUZZ_UTIL)
 # the HTTP layer's files and what they call (the queue stores' fallbacks)
 FUZZ_SERVICE := service/svc_http_gate.c service/svc_http_routes.c service/svc_http_reply.c service/svc_http_guard.c \
-                service/svc_http_jobs.c service/svc_http_ops.c service/svc_http_recv.c service/svc_auth.c \
+                service/svc_http_jobs.c service/svc_http_ops.c service/svc_http_recv.c service/svc_http_stream.c \
+                service/svc_auth.c capture/cap_hls.c \
                 service/svc_upload.c service/svc_encode.c service/svc_json.c service/svc_log.c service/svc_store.c \
                 service/svc_store_pg.c service/svc_store_sqlite.c service/svc_files.c service/svc_queue_view.c \
                 service/svc_wire.c runtime/replay/rp.c $(wildcard runtime/game/*.c) runtime/render/r_quality.c \

@@ -8,12 +8,13 @@
 #include <string.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "svc_child.h"
 #include "svc_local.h"
 
-bool svc_child_start(const char *exe, char *const argv[], pid_t *pid_out, int *prog_fd, int *err_fd, rs_err *err)
+bool svc_child_start(const char *exe, char *const argv[], int nice, pid_t *pid_out, int *prog_fd, int *err_fd, rs_err *err)
 {
     int prog[2], errp[2];
     if (pipe2(prog, O_CLOEXEC) != 0)
@@ -36,6 +37,8 @@ bool svc_child_start(const char *exe, char *const argv[], pid_t *pid_out, int *p
         /* its own process group: Ctrl-C at the daemon's terminal (or a
          * signal to the daemon's group) reaches the daemon, which decides */
         setpgid(0, 0);
+        if (nice > 0) /* before exec: every thread the render starts inherits it */
+            setpriority(PRIO_PROCESS, 0, nice);
         int devnull = open("/dev/null", O_RDWR);
         if (devnull < 0 || dup2(devnull, 0) < 0 || dup2(devnull, 1) < 0 || dup2(errp[1], 2) < 0 ||
             dup2(prog[1], 3) < 0)

@@ -16,9 +16,11 @@
  * non-blocking).  The child gets its own process group (Ctrl-C at the
  * daemon's terminal reaches the daemon, which decides), dies with the
  * daemon (PR_SET_PDEATHSIG), and inherits no other descriptor, no signal
- * handler and no blocked signal.  False with err filled when a pipe or
- * the fork fails. */
-bool svc_child_start(const char *exe, char *const argv[], pid_t *pid, int *prog_fd, int *err_fd, rs_err *err);
+ * handler and no blocked signal; nice > 0 runs it at that niceness (a
+ * job's later segments: SVC_LATER_NICE).  False with err filled when a
+ * pipe or the fork fails. */
+#define SVC_LATER_NICE 10
+bool svc_child_start(const char *exe, char *const argv[], int nice, pid_t *pid, int *prog_fd, int *err_fd, rs_err *err);
 
 /* Reads what *fd holds now into buf (cap bytes, *len of them a partial
  * line kept from the last call) and hands each whole line, without its

@@ -47,6 +47,10 @@ static const c_row rows[] = {
     {"segment_seconds", C_INT, OFF(segment_seconds), 0, 0, 3600, "30", NULL,
      "split a longer job into segments of this many seconds of game time, rendered by any free worker of any "
      "daemon and then joined (0: never split)"},
+    {"first_segment_seconds", C_INT, OFF(first_segment_seconds), 0, 0, 3600, "2", NULL,
+     "a split job's first segment, in seconds of game time; each next one twice as long, up to segment_seconds, "
+     "so a job's first seconds can be watched soon (0, or not below segment_seconds: every segment "
+     "segment_seconds long, and a job no longer than one rendered whole)"},
     {"size", C_SIZE, OFF(width), OFF(height), 16, 8192, "640x360", NULL, "a job's video size unless it asks"},
     {"max_size", C_SIZE, OFF(max_width), OFF(max_height), 16, 8192, "1920x1080", NULL,
      "the largest video size a job may ask for"},

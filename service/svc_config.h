@@ -56,6 +56,7 @@ typedef struct svc_config {
     int watchdog;         /* seconds without progress before a render is killed */
     int grace;            /* seconds running jobs get to finish on SIGTERM */
     int segment_seconds;  /* split a job into segments of this much game time (0: never) */
+    int first_segment_seconds; /* the first segment's length, doubling up to segment_seconds (0: all equal) */
     int width, height;    /* a job's output size unless it asks for one */
     int max_width, max_height; /* the largest output a job may ask for */
     int render_width, render_height; /* the size the game is drawn at; 0x0 ("auto"): the job's quality

@@ -236,7 +236,11 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
     if (!argv)
         return false;
     pid_t pid;
-    bool started = svc_child_start(d->exe, argv, &pid, &w->prog_fd, &w->err_fd, err);
+    /* a job's later segments yield to any first one (nice 10): a first
+     * segment's pieces are what a viewer is waiting for (docs/service.md,
+     * "Watching while it renders"); the cores are still all used */
+    int nice = j->unit.kind == SVC_UNIT_SEGMENT && j->unit.index > 0 ? SVC_LATER_NICE : 0;
+    bool started = svc_child_start(d->exe, argv, nice, &pid, &w->prog_fd, &w->err_fd, err);
     svc_argv_free(argv);
     if (!started)
         return false;
@@ -399,6 +403,8 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
         return;
     }
     place_poster(d, w);
+    if (j->unit.kind == SVC_UNIT_WHOLE && !svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why))
+        svc_log(SVC_LOG_WARN, j->id, "%s (the video is good: it is kept, the stream is not listed)", why);
     int64_t frames = j->unit.kind == SVC_UNIT_JOIN ? j->frames_total : w->total;
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, frames, &err);
     if (r == 1) {
@@ -434,6 +440,8 @@ static bool finished_segment(svc_daemon *d, worker *w, double secs)
         snprintf(w->last_err, sizeof w->last_err, "the segment render exited 0 but left no manifest (%s)", manifest);
         return false; /* retried like a crash */
     }
+    if (!svc_unit_stream_ok(&w->f, &w->job.unit, w->last_err, sizeof w->last_err))
+        return false; /* likewise: a viewer never gets a piece that is not whole */
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
     if (r == 1) {
         w->keep = true;

@@ -180,3 +180,10 @@ void svc_encode_get(const char *encode, const char *key, char *out, size_t n)
         p += len;
     }
 }
+
+bool svc_encode_streamable(const char *format, const char *encode)
+{
+    char codec[16];
+    svc_encode_get(encode, "codec", codec, sizeof codec);
+    return (!strcmp(format, "mp4") || !strcmp(format, "mkv")) && (!codec[0] || !strcmp(codec, "h264") || !strcmp(codec, "hevc"));
+}

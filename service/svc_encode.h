@@ -30,5 +30,9 @@ bool svc_encode_check(const svc_config *cfg, const svc_encode_req *q, const char
 int svc_encode_argv(const char *encode, char opt[][24], char val[][CAP_ENC_PRESET_MAX], int max);
 /* One key's value ("codec" -> "hevc"), "" when absent. */
 void svc_encode_get(const char *encode, const char *key, char *out, size_t n);
+/* Whether a job of this format and encoder string has a live stream:
+ * MPEG-TS pieces carry H.264 or HEVC, so .mp4 or .mkv with h264 (their
+ * default) or hevc (docs/service.md, "Watching while it renders"). */
+bool svc_encode_streamable(const char *format, const char *encode);
 
 #endif

@@ -10,6 +10,9 @@
  *                                   last stderr lines, appended as it ends
  *   .jobN-PID-aK.fmt/.hashes/.png   an unsplit job's render, claim K, by daemon PID
  *   .jobN-PID-jK.fmt / .hashes      a split job's join, claim K
+ *   N.stream/jobN-NONCE/            the job's live stream, kept with its video
+ *       track.ts, tTICK.ts, uA.idx  (capture/cap_hls.h): written by the renders
+ *                                   (render --hls-dir), served as HLS
  *   .jobN-NONCE/                    a split job's segments: the directory is
  *                                   named by the job's key (svc_store.h), so a
  *                                   reused job id (a new queue, the same output
@@ -37,6 +40,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../capture/cap_hls.h"
 #include "svc_encode.h"
 #include "svc_local.h"
 #include "svc_log.h"
@@ -48,6 +52,8 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
     snprintf(f->replay, sizeof f->replay, "%s/work/job%" PRId64 "-%d-%d.rsr", cfg->data, j->id, pid, slot);
     if (j->segments > 0)
         snprintf(f->segdir, sizeof f->segdir, "%s/.%s", cfg->output, j->key);
+    if (j->unit.kind != SVC_UNIT_JOIN)
+        svc_stream_dir(cfg, j, f->stream, sizeof f->stream);
     switch (j->unit.kind) {
     case SVC_UNIT_SEGMENT:
         svc_segment_path(f->out, sizeof f->out, f->segdir, j->unit.index, j->unit.claim, j->format);
@@ -67,6 +73,32 @@ void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_
                  j->unit.claim);
         snprintf(f->poster, sizeof f->poster, "%s/.job%" PRId64 "-%d-a%d.png", cfg->output, j->id, pid, j->unit.claim);
     }
+}
+
+bool svc_stream_dir(const svc_config *cfg, const svc_job *j, char *out, size_t n)
+{
+    out[0] = 0;
+    if (!svc_encode_streamable(j->format, j->encode) || !j->key[0])
+        return false;
+    snprintf(out, n, "%s/%" PRId64 ".stream/%s", cfg->output, j->id, j->key);
+    return true;
+}
+
+bool svc_unit_stream_ok(const svc_unit_files *f, const svc_unit *u, char *why, size_t n)
+{
+    if (!f->stream[0])
+        return true;
+    cap_hls_index ix;
+    rs_err err = {0};
+    int r = cap_hls_index_read(f->stream, (uint64_t)u->first_tick, &ix, &err);
+    bool ok = r == 1 && ix.end == (uint64_t)u->end_tick;
+    for (int i = 0; ok && i < ix.n; i++)
+        ok = cap_hls_piece_check(f->stream, &ix.p[i], NULL, &err);
+    if (!ok)
+        snprintf(why, n, "its stream pieces do not check: %s",
+                 r == 0 ? "no index" : err.msg[0] ? err.msg : "the index is for other ticks");
+    cap_hls_index_free(&ix);
+    return ok;
 }
 
 void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out, size_t n)
@@ -187,6 +219,10 @@ char **svc_unit_argv(const svc_config *cfg, const svc_job *j, const svc_unit_fil
                                     "--progress-fd", "3", "--progress", "off", "--backend", cfg->backend, "--jobs", jobs};
         for (size_t i = 0; i < sizeof tail / sizeof *tail; i++)
             add(&a, tail[i]);
+        if (f->stream[0]) { /* the pieces a viewer watches while the rest renders */
+            add(&a, "--hls-dir");
+            add(&a, f->stream);
+        }
         if (cfg->render_width) { /* the operator's fixed size; else the job's quality decides */
             add(&a, "--render-size");
             add(&a, rsize);
@@ -277,7 +313,18 @@ int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format
         n += unlink(path) == 0;
     }
     svc_remove_job_files(cfg, id);
-    return n;
+    return n + svc_remove_job_stream(cfg, id);
+}
+
+int svc_remove_job_stream(const svc_config *cfg, int64_t id)
+{
+    char path[1100];
+    struct stat st;
+    svc_job_file(cfg, id, "stream", path, sizeof path);
+    if (lstat(path, &st) != 0)
+        return 0;
+    svc_remove_dir(path);
+    return 1;
 }
 
 /* ".jobN-..." -> N; 0 when the name is not one of ours.  *pid: the daemon
@@ -340,6 +387,56 @@ static int sweep_retention(svc_daemon *d)
     return removed;
 }
 
+/* OUTPUT/N.stream/OTHERKEY: an older queue's job of the same id */
+static int sweep_other_keys(svc_daemon *d, int64_t id, const char *key)
+{
+    char path[1100], sub[1400];
+    svc_job_file(&d->cfg, id, "stream", path, sizeof path);
+    DIR *dir = opendir(path);
+    struct dirent *e;
+    int removed = 0;
+    while (dir && (e = readdir(dir))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..") || !strcmp(e->d_name, key))
+            continue;
+        snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+        svc_remove_dir(sub);
+        removed++;
+        svc_log(SVC_LOG_DEBUG, id, "removed %s (another key's stream)", sub);
+    }
+    if (dir)
+        closedir(dir);
+    return removed;
+}
+
+/* OUTPUT/N.stream of a job this queue does not have, or that failed, was
+ * cancelled or expired (a done job's stream stays with its video). */
+static int sweep_streams(svc_daemon *d)
+{
+    DIR *dir = opendir(d->cfg.output);
+    struct dirent *e;
+    int removed = 0;
+    while (dir && (e = readdir(dir))) {
+        char *end;
+        long long id = strtoll(e->d_name, &end, 10);
+        if (!(end > e->d_name && e->d_name[0] != '0' && id > 0 && !strcmp(end, ".stream")))
+            continue;
+        svc_job j;
+        rs_err err = {0};
+        int r = d->store->ops->get(d->store, id, &j, &err);
+        if (r < 0)
+            break; /* the queue is down: keep everything */
+        if (r == 1 && (j.state == SVC_QUEUED || j.state == SVC_RUNNING || (j.state == SVC_DONE && !j.expired))) {
+            removed += sweep_other_keys(d, id, j.key);
+            continue;
+        }
+        removed += svc_remove_job_stream(&d->cfg, id);
+        svc_log(SVC_LOG_DEBUG, id, "removed its stream (%s)", r == 0 ? "no such job in this queue" : "the job is over");
+    }
+    if (dir)
+        closedir(dir);
+    return removed;
+}
+
 /* The output directory: what belongs to a job that is over or that this
  * queue never had goes; so does a segment directory named by another key
  * than its job's (an older queue's job of the same id), and, on an SQLite
@@ -391,6 +488,7 @@ void svc_sweep(svc_daemon *d, bool startup)
     }
     if (dir)
         closedir(dir);
+    removed += sweep_streams(d);
     char work[1100];
     snprintf(work, sizeof work, "%s/work", d->cfg.data);
     dir = opendir(work);

@@ -117,9 +117,7 @@ static bool may_see(const req *q, const svc_job *j)
     return q->all || (q->tok.id != 0 && j->token_id == q->tok.id);
 }
 
-/* The job of q->m.id as q may see it: false with the answer in *ret (503 when
- * the queue is down, 404 for a missing job or another token's). */
-static bool get_visible(svc_daemon *d, struct MHD_Connection *c, const req *q, svc_job *j, enum MHD_Result *ret)
+bool http_job_visible(svc_daemon *d, struct MHD_Connection *c, const req *q, svc_job *j, enum MHD_Result *ret)
 {
     rs_err err = {0};
     int r = d->http_store->ops->get(d->http_store, q->m.id, j, &err);
@@ -134,7 +132,7 @@ enum MHD_Result http_job(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     svc_job j;
     enum MHD_Result answer;
-    if (!get_visible(d, c, q, &j, &answer))
+    if (!http_job_visible(d, c, q, &j, &answer))
         return answer;
     /* a split job shows its segments: who rendered each, how often */
     svc_unit *units = NULL;
@@ -314,7 +312,7 @@ static enum MHD_Result send_output(svc_daemon *d, struct MHD_Connection *c, req 
 {
     svc_job j;
     enum MHD_Result answer;
-    if (!get_visible(d, c, q, &j, &answer))
+    if (!http_job_visible(d, c, q, &j, &answer))
         return answer;
     const char *what = video ? "video" : "hash list", *ext = video ? j.format : "hashes";
     if (j.state != SVC_DONE)
@@ -359,7 +357,7 @@ enum MHD_Result http_poster(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     svc_job j;
     enum MHD_Result answer;
-    if (!get_visible(d, c, q, &j, &answer))
+    if (!http_job_visible(d, c, q, &j, &answer))
         return answer;
     if (j.expired)
         return http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 "'s poster was removed by retention", q->m.id);
@@ -379,7 +377,7 @@ enum MHD_Result http_log(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     svc_job j;
     enum MHD_Result answer;
-    if (!get_visible(d, c, q, &j, &answer))
+    if (!http_job_visible(d, c, q, &j, &answer))
         return answer;
     char path[1100];
     svc_job_file(&d->cfg, q->m.id, "log", path, sizeof path);

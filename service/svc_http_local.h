@@ -48,6 +48,7 @@ typedef struct svc_match {
     bool open;              /* the path's rows are open */
     bool bad_id;            /* its ":id" segment is no job id */
     int64_t id;
+    int64_t tick;           /* a ":ts" segment's tick ("120" of "120.ts"); -1: none */
     char methods[48];       /* the path's methods, "GET" or "GET or DELETE" */
 } svc_match;
 
@@ -202,7 +203,11 @@ void http_gate_default_hosts(svc_net *n);
 /* Who asks: true to go on (q->tok, q->all say who); false answered (401, 503). */
 bool http_auth(svc_daemon *d, struct MHD_Connection *c, req *q, enum MHD_Result *ret);
 
-/* --- handlers (svc_http_jobs.c, svc_http_ops.c) --- */
+/* --- handlers (svc_http_jobs.c, svc_http_stream.c, svc_http_ops.c) --- */
+
+/* The job of q->m.id as q may see it: false with the answer in *ret (503
+ * when the queue is down, 404 for a missing job or another token's). */
+bool http_job_visible(svc_daemon *d, struct MHD_Connection *c, const req *q, svc_job *j, enum MHD_Result *ret);
 
 enum MHD_Result http_submit(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_list(svc_daemon *d, struct MHD_Connection *c, req *q);
@@ -212,6 +217,8 @@ enum MHD_Result http_video(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_hashes(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_poster(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_log(svc_daemon *d, struct MHD_Connection *c, req *q);
+enum MHD_Result http_stream(svc_daemon *d, struct MHD_Connection *c, req *q);
+enum MHD_Result http_piece(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_retry(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_health(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_metrics(svc_daemon *d, struct MHD_Connection *c, req *q);

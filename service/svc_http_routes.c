@@ -27,6 +27,8 @@ static const svc_route routes[] = {
     {"GET",    "/jobs/:id/hashes",   http_hashes,    false, false, ""},
     {"GET",    "/jobs/:id/poster",   http_poster,    false, false, ""},
     {"GET",    "/jobs/:id/log",      http_log,       false, false, ""},
+    {"GET",    "/jobs/:id/stream.m3u8", http_stream, false, false, ""},
+    {"GET",    "/jobs/:id/stream/:ts", http_piece,   false, false, ""},
     {"POST",   "/jobs/:id/retry",    http_retry,     false, false, ""},
 };
 
@@ -54,10 +56,23 @@ static bool collection(const char *path)
     return false;
 }
 
+/* "TICK.ts": a stream piece's name, TICK 1 to 12 digits, no leading zero */
+static bool parse_piece(const char *s, size_t n, int64_t *tick)
+{
+    size_t d = 0;
+    int64_t v = 0;
+    while (d < n && d < 13 && isdigit((unsigned char)s[d]))
+        v = v * 10 + (s[d++] - '0');
+    if (d == 0 || d > 12 || (s[0] == '0' && d > 1) || n != d + 3 || strncmp(s + d, ".ts", 3) != 0)
+        return false;
+    *tick = v;
+    return true;
+}
+
 /* Whether url is pattern: segment by segment, ":id" a job id (*bad_id when
- * everything else fits but it is not one).  A collection also answers
- * with one trailing slash ("/jobs/"). */
-static bool path_is(const char *pattern, const char *url, int64_t *id, bool *bad_id)
+ * everything else fits but it is not one), ":ts" a piece's name (*tick).
+ * A collection also answers with one trailing slash ("/jobs/"). */
+static bool path_is(const char *pattern, const char *url, int64_t *id, int64_t *tick, bool *bad_id)
 {
     const char *p = pattern, *u = url;
     bool id_ok = true;
@@ -65,6 +80,11 @@ static bool path_is(const char *pattern, const char *url, int64_t *id, bool *bad
         if (!strncmp(p, ":id", 3)) {
             size_t n = strcspn(u, "/");
             id_ok = http_parse_id(u, n, id);
+            p += 3, u += n;
+        } else if (!strncmp(p, ":ts", 3)) {
+            size_t n = strcspn(u, "/");
+            if (!parse_piece(u, n, tick))
+                return false;
             p += 3, u += n;
         } else if (*p++ != *u++)
             return false;
@@ -84,9 +104,10 @@ void svc_route_match(const char *url, const char *method, svc_match *m)
 {
     *m = (svc_match){0};
     for (size_t i = 0; i < sizeof routes / sizeof *routes; i++) {
-        int64_t id = 0;
-        if (!path_is(routes[i].path, url, &id, &m->bad_id))
+        int64_t id = 0, tick = -1;
+        if (!path_is(routes[i].path, url, &id, &tick, &m->bad_id))
             continue;
+        m->tick = tick;
         size_t k = strlen(m->methods);
         snprintf(m->methods + k, sizeof m->methods - k, "%s%s", k ? " or " : "", routes[i].method);
         m->known = true;
@@ -113,9 +134,9 @@ enum MHD_Result svc_route_dispatch(svc_daemon *d, struct MHD_Connection *c, req 
 
 bool svc_routes_print(FILE *out)
 {
-    fprintf(out, "%-7s %-18s %-6s %-5s %s\n", "METHOD", "PATH", "TOKEN", "BODY", "QUERY");
+    fprintf(out, "%-7s %-22s %-6s %-5s %s\n", "METHOD", "PATH", "TOKEN", "BODY", "QUERY");
     for (size_t i = 0; i < sizeof routes / sizeof *routes; i++)
-        fprintf(out, "%-7s %-18s %-6s %-5s %s\n", routes[i].method, routes[i].path, routes[i].open ? "no" : "yes",
+        fprintf(out, "%-7s %-22s %-6s %-5s %s\n", routes[i].method, routes[i].path, routes[i].open ? "no" : "yes",
                 routes[i].body ? "yes" : "no", routes[i].params[0] ? routes[i].params : "-");
     return true;
 }

@@ -140,7 +140,20 @@ typedef struct svc_unit_files {
     char hashes[1100];  /* its --hashes */
     char segdir[1100];  /* a split job's segment directory ("" unsplit) */
     char poster[1100];  /* its --poster ("" for the join, which takes a segment's) */
+    char stream[1100];  /* its --hls-dir: the job's stream folder ("" for the join, or a job
+                           that cannot be streamed) */
 } svc_unit_files;
+/* "OUTPUT/N.stream/KEY": the job's live stream (capture/cap_hls.h: the
+ * match's sound, the pieces, an index per unit).  The key (a new nonce per
+ * job) keeps a reused job id from meeting an older queue's pieces.  False
+ * ("" in out) when the job cannot be streamed: MPEG-TS pieces carry H.264
+ * or HEVC, so a .webm job or a vp9/av1 one has no stream. */
+bool svc_stream_dir(const svc_config *cfg, const svc_job *j, char *out, size_t n);
+/* A finished render's stream pieces as it wrote them (f->stream): the
+ * index of u's ticks there, and every piece the bytes it names, read back
+ * as a viewer will get them.  True for a job without a stream; false with
+ * why filled ("its stream pieces do not check: ..."). */
+bool svc_unit_stream_ok(const svc_unit_files *f, const svc_unit *u, char *why, size_t n);
 void svc_unit_paths(const svc_config *cfg, const svc_job *j, int slot, svc_unit_files *f);
 /* The child's argv: `ringside render` for a WHOLE unit or a SEGMENT,
  * `ringside join` for the JOIN, whose segment files come from units (the
@@ -168,6 +181,9 @@ void svc_remove_job_files(const svc_config *cfg, int64_t id);
 /* N.fmt, N.hashes, N.png, N.log and everything hidden of job id: the
  * number of visible files removed.  For a job that is over. */
 int svc_remove_job_outputs(const svc_config *cfg, int64_t id, const char *format);
+/* OUTPUT/N.stream and everything in it (a job failed, cancelled, deleted
+ * or expired: its stream goes with its video).  1 when there was one. */
+int svc_remove_job_stream(const svc_config *cfg, int64_t id);
 /* Leftovers of jobs that are over or unknown, and of dead daemons' work
  * files; finished jobs past retention.  startup: no render of ours runs
  * yet, so files under our own pid are an earlier daemon's. */

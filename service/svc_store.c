@@ -81,3 +81,25 @@ void svc_unit_context(char *out, size_t n, const svc_unit *u)
     else if (n)
         out[0] = 0;
 }
+
+int svc_plan_segments(int64_t total, int64_t seg, int64_t first, int64_t *ends, int max)
+{
+    if (seg <= 0 || total <= 0)
+        return 0;
+    bool growing = first > 0 && first < seg;
+    if (total <= (growing ? first : seg))
+        return 0; /* a segment and a join would only add their start-up to the same frames */
+    int n = 0;
+    int64_t at = 0, len = growing ? first : seg, min_len = growing ? first : 1;
+    while (at < total) {
+        int64_t end = at + len;
+        if (end >= total || total - end < min_len)
+            end = total; /* the rest, or a remnant too short for a process of its own */
+        if (n < max)
+            ends[n] = end;
+        n++;
+        at = end;
+        len = len * 2 < seg ? len * 2 : seg;
+    }
+    return n;
+}

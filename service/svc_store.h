@@ -150,6 +150,7 @@ typedef struct svc_job {
     char owner[SVC_OWNER_MAX];   /* "host:pid" of the daemon running it */
     int64_t created, started, finished, claimed_until; /* Unix seconds; 0: not yet */
     int segment_ticks;           /* submit: split into segments this long (0: unsplit) */
+    int first_segment_ticks;     /* submit: the first segment this long, doubling (svc_plan_segments) */
     int segments;                /* how many it was split into (0: unsplit, one WHOLE unit) */
     char key[SVC_KEY_MAX];       /* "job<id>-<nonce>" */
     int64_t token_id;            /* the API token that submitted it (0: none; svc_token) */
@@ -170,6 +171,17 @@ typedef struct svc_job {
 } svc_job;
 
 void svc_job_free(svc_job *j);
+
+/* The segments a job of `total` ticks is split into: their end ticks in
+ * ends[0..n-1] (the first starts at 0, each next where the one before
+ * ends); returns n, 0 for a job rendered whole.  seg <= 0: never split.
+ * first in 1..seg-1: the first segment is `first` ticks long and each
+ * next one twice the one before, up to seg (the first seconds of a job
+ * are rendered, and can be watched, soon), split when total > first;
+ * otherwise every segment is seg long, split when total > seg.  A last
+ * segment shorter than the first is merged into the one before.  At most
+ * max ends are written (the count returned is the plan's). */
+int svc_plan_segments(int64_t total, int64_t seg, int64_t first, int64_t *ends, int max);
 
 /* DESIGN: a daemon killed by its job (memory exhausted, say) dies before
  * it can tell a render failure from its own death, so lost leases are not

@@ -31,9 +31,13 @@ bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
 {
     sq_store *s = S(bs);
     int64_t seg = j->segment_ticks > 0 ? j->segment_ticks : 0;
-    /* a replay no longer than one segment is rendered whole: a segment and
-     * a join would only add their start-up to the same frames */
-    int64_t n = seg > 0 && j->frames_total > seg ? (j->frames_total + seg - 1) / seg : 0;
+    /* the plan (svc_plan_segments): whole, equal segments, or growing ones */
+    int64_t n = svc_plan_segments(j->frames_total, seg, j->first_segment_ticks, NULL, 0);
+    int64_t *ends = n > 0 ? malloc((size_t)n * sizeof *ends) : NULL;
+    if (n > 0 && !ends)
+        return rs_fail(err, SVC_STORE_ERR_NOMEM, "out of memory");
+    if (n > 0)
+        svc_plan_segments(j->frames_total, seg, j->first_segment_ticks, ends, (int)n);
     char nonce[24];
     new_nonce(nonce, sizeof nonce);
     int64_t now;
@@ -54,13 +58,12 @@ bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
         ok = run(s, "insert the job's unit",
                  "INSERT INTO units (job_id, idx, kind, first_tick, end_tick) VALUES (?1, 0, 0, 0, ?2)",
                  ARGS(I(id), I(j->frames_total)), NULL, err) >= 0;
-    else if (ok)
-        ok = run(s, "insert the job's segments",
-                 "WITH RECURSIVE k(i) AS (SELECT 0 UNION ALL SELECT i + 1 FROM k WHERE i + 1 < ?2)"
-                 " INSERT INTO units (job_id, idx, kind, first_tick, end_tick)"
-                 " SELECT ?1, i, 1, i * ?3, CASE WHEN (i + 1) * ?3 < ?4 THEN (i + 1) * ?3 ELSE ?4 END FROM k",
-                 ARGS(I(id), I(n), I(seg), I(j->frames_total)), NULL, err) == n &&
-             run(s, "insert the job's join",
+    for (int64_t i = 0; ok && i < n; i++)
+        ok = run(s, "insert a segment of the job",
+                 "INSERT INTO units (job_id, idx, kind, first_tick, end_tick) VALUES (?1, ?2, 1, ?3, ?4)",
+                 ARGS(I(id), I(i), I(i ? ends[i - 1] : 0), I(ends[i])), NULL, err) >= 0;
+    if (ok && n > 0)
+        ok = run(s, "insert the job's join",
                  "INSERT INTO units (job_id, idx, kind, first_tick, end_tick) VALUES (?1, ?2, 2, 0, ?3)",
                  ARGS(I(id), I(n), I(j->frames_total)), NULL, err) >= 0;
     if (sq_tx_end(s, ok, 1, err) == 1) {
@@ -74,6 +77,7 @@ bool sq_submit(svc_store *bs, svc_job *j, rs_err *err)
         ok = false;
 out:
     pthread_mutex_unlock(&s->mu);
+    free(ends);
     return ok;
 }
 

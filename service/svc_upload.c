@@ -156,6 +156,7 @@ bool svc_upload_job(const svc_config *cfg, svc_upload *u, svc_job *j, rs_err *er
     j->replay = u->body;
     j->replay_len = u->len;
     j->segment_ticks = cfg->segment_seconds * 60; /* the store splits it if it is longer */
+    j->first_segment_ticks = cfg->first_segment_seconds * 60;
     return true;
 }
 

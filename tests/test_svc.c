@@ -154,7 +154,7 @@ static const set_case set_cases[] = {
     {"listen", "host:", 0, "the port must be 0..65535"}, {"listen", "host:-1", 0, "the port must be 0..65535"},
     {"listen", "host:80x", 0, "the port must be 0..65535"}, {"listen", "[::1]", 0, "an IPv6 address goes in brackets"},
     {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
-                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, quality, format, backend, log_level, allowed_hosts, cors_origins, "
+                        "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, first_segment_seconds, size, max_size, render_size, quality, format, backend, log_level, allowed_hosts, cors_origins, "
                         "max_connections, max_connections_per_ip, header_timeout, min_body_rate, upload_memory, "
                         "token_max_queued, token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)"},
     {"", "1", 0, "unknown setting ''"},
@@ -283,7 +283,7 @@ static void t_config_load_errors(void)
     LOAD_BAD("# c\n\nworkers = 0\n", ":3: workers: 0 is out of range (expected 1..64)");
     LOAD_BAD("workers = 2\ngarbage here\n", ":2: expected 'name = value', got 'garbage here'");
     LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, "
-                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, size, max_size, render_size, quality, "
+                                   "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, first_segment_seconds, size, max_size, render_size, quality, "
                                    "format, backend, log_level, allowed_hosts, cors_origins, max_connections, "
                                    "max_connections_per_ip, header_timeout, min_body_rate, upload_memory, token_max_queued, "
                                    "token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)");
@@ -672,6 +672,25 @@ static void t_json_job(void)
     j = job(SVC_CANCELLED);
     j.frames_total = 0; /* no division by zero */
     job_is(&j, JOB_HEAD "\"cancelled\"," JOB_NAME "\"frames_done\":0,\"frames_total\":0,\"progress\":0.0000,", false);
+    /* the live stream: H.264 or HEVC in .mp4 or .mkv, while the job can still have one */
+    for (int st = SVC_QUEUED; st <= SVC_CANCELLED; st++) {
+        j = job(st);
+        snprintf(j.format, sizeof j.format, "mp4");
+        svc_buf sb = {0};
+        svc_json_job(&sb, &j, 3, NULL, 0, NULL);
+        bool has = strstr(sb.p, ",\"stream\":\"/jobs/42/stream.m3u8\"}") != NULL;
+        T_ASSERTF(has == (st != SVC_FAILED && st != SVC_CANCELLED), "state %d: %s", st, sb.p);
+        svc_buf_free(&sb);
+    }
+    j = job(SVC_DONE);
+    snprintf(j.format, sizeof j.format, "mkv");
+    snprintf(j.encode, sizeof j.encode, "codec=hevc crf=24");
+    job_is(&j, ",\"stream\":\"/jobs/42/stream.m3u8\"}", false);
+    j.expired = true;
+    job_is(&j, "\"expired\":true,\"log\":\"/jobs/42/log\"}", false);
+    j.expired = false;
+    snprintf(j.encode, sizeof j.encode, "codec=av1");
+    job_is(&j, "\"log\":\"/jobs/42/log\"}", false); /* AV1: none */
 }
 
 /* A split job: its segment count, and with its units who rendered what. */
@@ -1176,9 +1195,70 @@ static void t_route_table(void)
     T_ASSERT(!m.route && m.known && m.open && !strcmp(m.methods, "GET"));
     svc_route_match("/metrics", "GET", &m);
     T_ASSERT(m.route && !m.open && !m.route->params[0]);
+    /* a stream's playlist and pieces: "TICK.ts", the tick without a leading zero */
+    svc_route_match("/jobs/7/stream.m3u8", "GET", &m);
+    T_ASSERT(m.route && m.id == 7 && !m.open);
+    svc_route_match("/jobs/7/stream/120.ts", "GET", &m);
+    T_ASSERT(m.route && m.id == 7 && m.tick == 120 && !m.open);
+    svc_route_match("/jobs/7/stream/0.ts", "GET", &m);
+    T_ASSERT(m.route && m.tick == 0);
+    const char *bad[] = {"/jobs/7/stream/0120.ts", "/jobs/7/stream/.ts", "/jobs/7/stream/12.tsx", "/jobs/7/stream/12",
+                         "/jobs/7/stream/-1.ts", "/jobs/7/stream/1234567890123.ts", "/jobs/7/stream/12.ts/",
+                         "/jobs/7/stream/", "/jobs/7/stream"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        svc_route_match(bad[i], "GET", &m);
+        T_ASSERTF(!m.route && !m.known, "%s matched", bad[i]);
+    }
+    svc_route_match("/jobs/7/stream/12.ts", "DELETE", &m);
+    T_ASSERT(!m.route && m.known && !strcmp(m.methods, "GET"));
 #else
     T_SKIP_ENV("built without libmicrohttpd");
 #endif
+}
+
+/* A job's plan: whole, equal segments, or growing ones from a short first */
+static void plan_is(int64_t total, int64_t seg, int64_t first, const char *want)
+{
+    int64_t ends[64];
+    int n = svc_plan_segments(total, seg, first, ends, 64);
+    char got[512] = "";
+    size_t at = 0;
+    for (int i = 0; i < n && i < 64; i++)
+        at += (size_t)snprintf(got + at, sizeof got - at, "%s%lld", i ? " " : "", (long long)ends[i]);
+    T_ASSERTF(!strcmp(got, want), "total %lld, segments %lld, first %lld: ends '%s', want '%s'", (long long)total,
+              (long long)seg, (long long)first, got, want);
+}
+
+static void t_plan_segments(void)
+{
+    plan_is(1800, 1800, 0, "");                    /* one segment's worth: whole */
+    plan_is(1801, 1800, 0, "1800 1801");           /* equal segments, the last shorter */
+    plan_is(5400, 1800, 0, "1800 3600 5400");
+    plan_is(5400, 0, 120, "");                     /* 0: never split */
+    plan_is(120, 1800, 120, "");                   /* no longer than the first: whole */
+    plan_is(480, 1800, 120, "120 360 480");        /* 2 s, 4 s, the 2 s left */
+    plan_is(1200, 1800, 120, "120 360 840 1200");  /* the 20 s job: 2, 4, 8, 6 s */
+    plan_is(10800, 1800, 120, "120 360 840 1800 3600 5400 7200 9000 10800"); /* 3 minutes: 2 4 8 16 30... */
+    plan_is(400, 1800, 120, "120 400");            /* a rest shorter than the first joins the one before */
+    plan_is(600, 60, 120, "60 120 180 240 300 360 420 480 540 600"); /* first not below seg: equal */
+    plan_is(5400, 1800, 1800, "1800 3600 5400");
+    /* the count without room for the ends */
+    T_EQ(svc_plan_segments(10800, 1800, 120, NULL, 0), 9);
+    int64_t two[2];
+    T_EQ(svc_plan_segments(10800, 1800, 120, two, 2), 9);
+    T_ASSERT(two[0] == 120 && two[1] == 360);
+    /* every plan covers its ticks, each segment from where the last ended, none empty */
+    for (int64_t total = 1; total < 4000; total += 37)
+        for (int64_t first = 0; first <= 240; first += 60) {
+            int64_t ends[128];
+            int n = svc_plan_segments(total, 600, first, ends, 128);
+            T_ASSERT(n >= 0 && n < 128);
+            for (int i = 0; i < n; i++)
+                T_ASSERTF(ends[i] > (i ? ends[i - 1] : 0) && ends[i] - (i ? ends[i - 1] : 0) <= 600 + 240,
+                          "total %lld first %lld: segment %d ends at %lld", (long long)total, (long long)first, i,
+                          (long long)ends[i]);
+            T_ASSERT(n == 0 || ends[n - 1] == total);
+        }
 }
 
 /* An upload without HTTP: the body within the limit, form fields and query
@@ -1444,6 +1524,6 @@ T_MAIN({"sha256_known_answers", t_sha256_known_answers}, {"tokens_and_bearer", t
        {"upload_corruptions", t_upload_corruptions}, {"error_ids_have_texts", t_error_ids_have_texts},
        {"upload_verified", t_upload_verified},
        {"http_status_table", t_http_status_table}, {"encode_options", t_encode_options},
-       {"route_table", t_route_table}, {"upload_params", t_upload_params},
+       {"route_table", t_route_table}, {"plan_segments", t_plan_segments}, {"upload_params", t_upload_params},
        {"config_error_ids", t_config_error_ids}, {"wire_cases", t_wire_cases}, {"wire_framing", t_wire_framing},
        {"wire_random", t_wire_random})

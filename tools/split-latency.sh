@@ -1,25 +1,32 @@
 #!/bin/sh
 # How long one replay takes through `ringside serve`, from upload to the
-# finished video: unsplit or split into segments, with N workers.
+# first piece of its live stream and to the finished video: unsplit or
+# split into segments, with N workers.
 #
-#   tools/split-latency.sh [-w WORKERS] [-s SEGMENT_SECONDS] REPLAY [SERVE OPTIONS...]
+#   tools/split-latency.sh [-w WORKERS] [-s SEGMENT_SECONDS] [-f FIRST_SECONDS] [-1] REPLAY [SERVE OPTIONS...]
 #
 # Starts a daemon of build/ringside on a free loopback port with a fresh
 # data directory, uploads REPLAY, waits for the job to finish and prints one
-# line: wall seconds from upload to "done", the video's frames, frames per
-# second, and game seconds per wall second.  With -s > 0 it also prints
-# the job's units (segments and join) as GET /jobs/N lists them.  The
-# daemon is stopped and its directory removed at the end.
-# docs/service.md ("Split jobs: measured") has the numbers it gave.
+# line: wall seconds from upload to the first piece listed in
+# GET /jobs/N/stream.m3u8 (time to first frame; "no stream" from a daemon
+# without one), from upload to "done", the video's frames, frames per
+# second, and game seconds per wall second.  It also prints the job's
+# units (segments and join) as GET /jobs/N lists them.  -f sets
+# first_segment_seconds (default: the daemon's, 2); -1 stops at the first
+# piece and prints only its time.  The daemon is stopped
+# and its directory removed at the end.  docs/service.md ("Throughput",
+# "Watching while it renders") has the numbers it gave.
 set -eu
 here=$(cd "$(dirname "$0")/.." && pwd)
 BIN=${RS_BIN:-$here/build/ringside}
-workers=1 seg=0
-while getopts w:s:h opt; do
+workers=1 seg=0 first="" only_first=""
+while getopts w:s:f:1h opt; do
     case $opt in
+    1) only_first=1 ;;
     w) workers=$OPTARG ;;
     s) seg=$OPTARG ;;
-    h) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    f) first="--first-segment-seconds $OPTARG" ;;
+    h) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) exit 2 ;;
     esac
 done
@@ -36,9 +43,9 @@ cleanup() {
     rm -rf "$dir"
 }
 trap cleanup EXIT INT TERM
-# shellcheck disable=SC2086 # extra is a list of options
+# shellcheck disable=SC2086 # extra and first are lists of options
 "$BIN" serve --listen 127.0.0.1:0 --data "$dir/data" --workers "$workers" --segment-seconds "$seg" \
-    $extra >"$dir/serve.log" 2>&1 &
+    $first $extra >"$dir/serve.log" 2>&1 &
 pid=$!
 url=""
 for _ in $(seq 200); do
@@ -57,23 +64,33 @@ t0=$(date +%s.%N)
 id=$(curl -sf -X POST --data-binary @"$replay" -H 'Content-Type: application/octet-stream' \
     "$url/jobs?name=$(basename "$replay")" | field id)
 [ -n "$id" ] || { echo "split-latency: upload refused" >&2; exit 1; }
+tf="" # the first piece's time: polled every 0.1 s until it comes
 while :; do
+    if [ -z "$tf" ] && curl -sf "$url/jobs/$id/stream.m3u8" 2>/dev/null | grep -q '\.ts$'; then
+        tf=$(date +%s.%N)
+        if [ -n "$only_first" ]; then
+            python3 -c 'import sys; print(f"{sys.argv[3]}: {float(sys.argv[1]) - float(sys.argv[2]):.1f} s to the first piece")' \
+                "$tf" "$t0" "$replay"
+            exit 0
+        fi
+    fi
     curl -sf "$url/jobs/$id" >"$dir/job.json" || { echo "split-latency: GET /jobs/$id failed" >&2; exit 1; }
     st=$(field state <"$dir/job.json")
     case $st in
     done) break ;;
     failed | cancelled) echo "split-latency: job $st: $(field error <"$dir/job.json")" >&2; exit 1 ;;
     esac
-    sleep 0.5
+    if [ -z "$tf" ]; then sleep 0.1; else sleep 0.5; fi
 done
 t1=$(date +%s.%N)
 frames=$(field frames_total <"$dir/job.json")
-python3 - "$t0" "$t1" "$frames" "$workers" "$seg" "$replay" "$dir/job.json" <<'EOF'
+python3 - "$t0" "$t1" "$frames" "$workers" "$seg" "$replay" "$dir/job.json" "${tf:-none}" <<'EOF'
 import json, sys
-t0, t1, frames, workers, seg, replay, job = sys.argv[1:]
+t0, t1, frames, workers, seg, replay, job, tf = sys.argv[1:]
 wall = float(t1) - float(t0)
 frames = int(frames)
-print(f"{replay}: {frames} frames, {workers} worker(s), segment_seconds {seg}: {wall:.1f} s from upload to done, "
+first = "no stream" if tf == "none" else f"{float(tf) - float(t0):.1f} s to the first piece"
+print(f"{replay}: {frames} frames, {workers} worker(s), segment_seconds {seg}: {first}, {wall:.1f} s from upload to done, "
       f"{frames / wall:.1f} fps, {frames / 60 / wall:.2f}x real time")
 j = json.load(open(job))
 for u in j.get("segments") or []:

@@ -16,8 +16,10 @@ svc_cleanup() {
     $SVC_ON_EXIT
 }
 
-# small and fast: the tests check the service, not the picture
-SVC_FAST="--render-size 160x90 --size 160x90 --lease 6 --log-level debug"
+# small and fast: the tests check the service, not the picture; and a job
+# no longer than segment_seconds is one unit, as most cases expect (the
+# growing plan's own cases, test_stream.sh, ask for it)
+SVC_FAST="--render-size 160x90 --size 160x90 --lease 6 --log-level debug --first-segment-seconds 0"
 
 json_get() { # FIELD < json
     python3 -c 'import json,sys

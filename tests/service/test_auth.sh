@@ -56,7 +56,7 @@ t_every_route_wants_a_token() {
     guarded=0
     while read -r rm rp rtok rest <&3; do
         [ "$rm" = METHOD ] && continue
-        rp=$(printf '%s' "$rp" | sed "s/:id/$id/")
+        rp=$(printf '%s' "$rp" | sed "s/:id/$id/; s/:ts/0.ts/")
         if [ "$rtok" = no ]; then
             c=$(code "$rm" "$rp")
             [ "$c" != 401 ] || { echo "$rm $rp is open but answered 401"; return 1; }
@@ -103,8 +103,12 @@ t_tokens_see_only_their_jobs() {
         done
     done
     A="Authorization: Bearer $a"
-    for p in "/jobs/$jb" "/jobs/$jb/video" "/jobs/$jb/hashes"; do
+    for p in "/jobs/$jb" "/jobs/$jb/video" "/jobs/$jb/hashes" "/jobs/$jb/stream.m3u8" "/jobs/$jb/stream/0.ts"; do
         [ "$(code GET "$p" -H "$A")" = 404 ] || { echo "alice GET $p: $(cat body.txt)"; return 1; }
+    done
+    # ... bob's own stream is there (a 1 s job, rendered whole, cut at the end)
+    for p in "/jobs/$jb/stream.m3u8" "/jobs/$jb/stream/0.ts"; do
+        [ "$(code GET "$p" -H "Authorization: Bearer $b")" = 200 ] || { echo "bob GET $p: $(cat body.txt)"; return 1; }
     done
     [ "$(code DELETE "/jobs/$jb" -H "$A")" = 404 ] || { echo "alice DELETE bob's job: $(cat body.txt)"; return 1; }
     [ "$(code GET "/jobs/$ja/video" -H "$A")" = 200 ] || { echo "alice's own video"; return 1; }

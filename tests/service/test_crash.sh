@@ -101,11 +101,11 @@ t_retention_and_delete() {
     svc_start d $SVC_FAST || return 1
     b=$(svc_submit a.rsr) || return 1
     svc_wait_state "$b" done 60 || return 1
-    for ext in mp4 hashes png log; do # the video, its hashes, its poster, its render log
-        [ -f "d/videos/$b.$ext" ] || { echo "no $b.$ext after the job:"; ls -la d/videos; return 1; }
+    for ext in mp4 hashes png log stream; do # the video, its hashes, its poster, its render log, its stream
+        [ -e "d/videos/$b.$ext" ] || { echo "no $b.$ext after the job:"; ls -la d/videos; return 1; }
     done
     [ "$(curl -s -o c.json -w '%{http_code}' -X DELETE "$SVC_URL/jobs/$b")" = 200 ] || { cat c.json; return 1; }
-    [ "$(json_get files_removed <c.json)" = 4 ] || { cat c.json; return 1; }
+    [ "$(json_get files_removed <c.json)" = 5 ] || { cat c.json; return 1; }
     [ -z "$(ls -A d/videos)" ] || { echo "DELETE left files:"; ls -la d/videos; return 1; }
     [ "$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/$b")" = 404 ] || return 1
     [ "$(curl -s -o /dev/null -w '%{http_code}' -X DELETE "$SVC_URL/jobs/$b")" = 404 ] || return 1

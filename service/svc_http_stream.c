@@ -1,0 +1,179 @@
+/* svc_http_stream: a job's live stream, HLS (docs/service.md, "Watching
+ * while it renders").
+ *
+ *   GET /jobs/N/stream.m3u8    the playlist: the pieces of the job's units
+ *                              that are done, in tick order up to the first
+ *                              that is not, and #EXT-X-ENDLIST once the job
+ *                              is done; it grows as units finish
+ *   GET /jobs/N/stream/T.ts    the piece from tick T, checked against its
+ *                              unit's index (size and FNV-1a) as it is sent
+ *
+ * DESIGN: the playlist is made from the queue (which units are done) and
+ * the units' index files, on every request; nothing is cached, so any
+ * daemon that sees the output directory answers the same.  A unit is
+ * listed only when the queue says it is done, and the daemon that finished
+ * it read its pieces back first (svc_daemon.c, stream_ok): a listed piece
+ * is complete, and a unit rendered again later keeps the pieces already
+ * listed (cap_hls.h).  Tokens apply as for the video: another token's job
+ * is 404. */
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "svc.h"
+
+#if defined(RS_HAVE_MHD)
+#include "../capture/cap_hls.h"
+#include "svc_encode.h"
+#include "svc_http_local.h"
+#include "svc_log.h"
+
+/* The job's listed units: their indexes in ix[0..*n-1] (malloc'd), and
+ * whether that is all of the job (*all).  False with the answer in *ret. */
+static bool listed_units(svc_daemon *d, struct MHD_Connection *c, const svc_job *j, const char *dir, cap_hls_index **ix,
+                         int *n, bool *all, enum MHD_Result *ret)
+{
+    int cap = j->segments > 0 ? j->segments + 1 : 1;
+    svc_unit *units = calloc((size_t)cap, sizeof *units);
+    *ix = calloc((size_t)cap, sizeof **ix);
+    *n = 0;
+    *all = false;
+    rs_err err = {0};
+    if (!units || !*ix) {
+        free(units);
+        free(*ix);
+        *ret = http_error(c, SVC_ERR_NOMEM, NULL, NULL, "out of memory");
+        return false;
+    }
+    int nu = d->http_store->ops->units(d->http_store, j->id, units, cap, &err);
+    if (nu < 0) {
+        free(units);
+        free(*ix);
+        *ret = http_store_error(c, &err);
+        return false;
+    }
+    int want = 0, k = 0;
+    for (int i = 0; i < nu; i++) {
+        if (units[i].kind == SVC_UNIT_JOIN)
+            continue;
+        want++;
+        if (k < want - 1 || units[i].state != SVC_DONE)
+            continue; /* after a gap nothing is listed */
+        int r = cap_hls_index_read(dir, (uint64_t)units[i].first_tick, &(*ix)[k], &err);
+        if (r == 1 && (*ix)[k].end == (uint64_t)units[i].end_tick)
+            k++;
+        else {
+            if (r == 1)
+                cap_hls_index_free(&(*ix)[k]);
+            if (r != 0)
+                svc_log(SVC_LOG_WARN, j->id, "stream: %s", r < 0 ? err.msg : "an index for other ticks");
+        }
+    }
+    free(units);
+    *n = k;
+    *all = k == want && want > 0;
+    return true;
+}
+
+static void free_units(cap_hls_index *ix, int n)
+{
+    for (int i = 0; i < n; i++)
+        cap_hls_index_free(&ix[i]);
+    free(ix);
+}
+
+/* The job, visible, with a stream that can exist: false with the answer in *ret. */
+static bool stream_job(svc_daemon *d, struct MHD_Connection *c, const req *q, svc_job *j, char *dir, size_t n,
+                       enum MHD_Result *ret)
+{
+    if (!http_job_visible(d, c, q, j, ret))
+        return false;
+    if (!svc_stream_dir(&d->cfg, j, dir, n)) {
+        char codec[16];
+        svc_encode_get(j->encode, "codec", codec, sizeof codec);
+        *ret = http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL,
+                          "job %" PRId64 " has no stream: a live stream carries H.264 or HEVC in .mp4 or .mkv jobs, "
+                          "and this one is %s%s%s",
+                          j->id, j->format, codec[0] ? " " : "", codec);
+        return false;
+    }
+    if (j->expired) {
+        *ret = http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 "'s stream was removed by retention (kept %ld s after it finished)",
+                          j->id, d->cfg.retention);
+        return false;
+    }
+    if (j->state == SVC_FAILED || j->state == SVC_CANCELLED) {
+        *ret = http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL, "job %" PRId64 " is %s: it has no stream", j->id,
+                          svc_state_name(j->state));
+        return false;
+    }
+    return true;
+}
+
+enum MHD_Result http_stream(svc_daemon *d, struct MHD_Connection *c, req *q)
+{
+    svc_job j;
+    char dir[1100];
+    enum MHD_Result ret;
+    if (!stream_job(d, c, q, &j, dir, sizeof dir, &ret))
+        return ret;
+    cap_hls_index *ix;
+    int n;
+    bool all;
+    if (!listed_units(d, c, &j, dir, &ix, &n, &all, &ret))
+        return ret;
+    if (j.state == SVC_DONE && !all) {
+        free_units(ix, n);
+        return http_error(c, SVC_ERR_GONE, NULL, NULL,
+                          "job %" PRId64 " is done but its stream is not whole on this server (%s; the video is at /jobs/%"
+                          PRId64 "/video)", j.id, dir, j.id);
+    }
+    size_t len;
+    char *text = cap_hls_playlist(ix, n, j.state == SVC_DONE, "stream/", &len);
+    free_units(ix, n);
+    if (!text)
+        return http_error(c, SVC_ERR_NOMEM, NULL, NULL, "out of memory");
+    ret = http_reply(c, 200, "application/vnd.apple.mpegurl", text, len);
+    free(text);
+    return ret;
+}
+
+enum MHD_Result http_piece(svc_daemon *d, struct MHD_Connection *c, req *q)
+{
+    svc_job j;
+    char dir[1100];
+    enum MHD_Result ret;
+    if (!stream_job(d, c, q, &j, dir, sizeof dir, &ret))
+        return ret;
+    cap_hls_index *ix;
+    int n;
+    bool all;
+    if (!listed_units(d, c, &j, dir, &ix, &n, &all, &ret))
+        return ret;
+    const cap_hls_piece *p = NULL;
+    for (int u = 0; u < n && !p; u++)
+        for (int i = 0; i < ix[u].n && !p; i++)
+            if (ix[u].p[i].tick == (uint64_t)q->m.tick)
+                p = &ix[u].p[i];
+    if (!p) {
+        free_units(ix, n);
+        return http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL, "job %" PRId64 " lists no piece from tick %" PRId64 " (yet)",
+                          j.id, q->m.tick);
+    }
+    uint8_t *data = NULL;
+    rs_err err = {0};
+    bool ok = cap_hls_piece_check(dir, p, &data, &err);
+    uint64_t len = p->bytes;
+    free_units(ix, n);
+    if (!ok) {
+        svc_log(SVC_LOG_WARN, j.id, "stream: %s", err.msg);
+        return http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 "'s piece from tick %" PRId64
+                          " is missing or damaged on this server", j.id, q->m.tick);
+    }
+    ret = http_reply(c, 200, "video/mp2t", (const char *)data, (size_t)len);
+    free(data);
+    return ret;
+}
+
+#endif
