@@ -111,27 +111,37 @@ static bool stream_job(svc_daemon *d, struct MHD_Connection *c, const req *q, sv
     return true;
 }
 
-enum MHD_Result http_stream(svc_daemon *d, struct MHD_Connection *c, req *q)
-{
+/* What a request of a job's stream sees: the job and its listed units. */
+typedef struct stream_view {
     svc_job j;
     char dir[1100];
-    enum MHD_Result ret;
-    if (!stream_job(d, c, q, &j, dir, sizeof dir, &ret))
-        return ret;
-    cap_hls_index *ix;
+    cap_hls_index *ix; /* the listed units' indexes, in tick order */
     int n;
-    bool all;
-    if (!listed_units(d, c, &j, dir, &ix, &n, &all, &ret))
+    bool all;          /* every unit of the job is listed */
+} stream_view;
+
+/* False with the answer in *ret. */
+static bool view_stream(svc_daemon *d, struct MHD_Connection *c, const req *q, stream_view *v, enum MHD_Result *ret)
+{
+    return stream_job(d, c, q, &v->j, v->dir, sizeof v->dir, ret) &&
+           listed_units(d, c, &v->j, v->dir, &v->ix, &v->n, &v->all, ret);
+}
+
+enum MHD_Result http_stream(svc_daemon *d, struct MHD_Connection *c, req *q)
+{
+    stream_view v;
+    enum MHD_Result ret;
+    if (!view_stream(d, c, q, &v, &ret))
         return ret;
-    if (j.state == SVC_DONE && !all) {
-        free_units(ix, n);
+    if (v.j.state == SVC_DONE && !v.all) {
+        free_units(v.ix, v.n);
         return http_error(c, SVC_ERR_GONE, NULL, NULL,
                           "job %" PRId64 " is done but its stream is not whole on this server (%s; the video is at /jobs/%"
-                          PRId64 "/video)", j.id, dir, j.id);
+                          PRId64 "/video)", v.j.id, v.dir, v.j.id);
     }
     size_t len;
-    char *text = cap_hls_playlist(ix, n, j.state == SVC_DONE, "stream/", &len);
-    free_units(ix, n);
+    char *text = cap_hls_playlist(v.ix, v.n, v.j.state == SVC_DONE, "stream/", &len);
+    free_units(v.ix, v.n);
     if (!text)
         return http_error(c, SVC_ERR_NOMEM, NULL, NULL, "out of memory");
     ret = http_reply(c, 200, "application/vnd.apple.mpegurl", text, len);
@@ -141,35 +151,29 @@ enum MHD_Result http_stream(svc_daemon *d, struct MHD_Connection *c, req *q)
 
 enum MHD_Result http_piece(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
-    svc_job j;
-    char dir[1100];
+    stream_view v;
     enum MHD_Result ret;
-    if (!stream_job(d, c, q, &j, dir, sizeof dir, &ret))
-        return ret;
-    cap_hls_index *ix;
-    int n;
-    bool all;
-    if (!listed_units(d, c, &j, dir, &ix, &n, &all, &ret))
+    if (!view_stream(d, c, q, &v, &ret))
         return ret;
     const cap_hls_piece *p = NULL;
-    for (int u = 0; u < n && !p; u++)
-        for (int i = 0; i < ix[u].n && !p; i++)
-            if (ix[u].p[i].tick == (uint64_t)q->m.tick)
-                p = &ix[u].p[i];
+    for (int u = 0; u < v.n && !p; u++)
+        for (int i = 0; i < v.ix[u].n && !p; i++)
+            if (v.ix[u].p[i].tick == (uint64_t)q->m.tick)
+                p = &v.ix[u].p[i];
     if (!p) {
-        free_units(ix, n);
+        free_units(v.ix, v.n);
         return http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL, "job %" PRId64 " lists no piece from tick %" PRId64 " (yet)",
-                          j.id, q->m.tick);
+                          v.j.id, q->m.tick);
     }
     uint8_t *data = NULL;
     rs_err err = {0};
-    bool ok = cap_hls_piece_check(dir, p, &data, &err);
+    bool ok = cap_hls_piece_check(v.dir, p, &data, &err);
     uint64_t len = p->bytes;
-    free_units(ix, n);
+    free_units(v.ix, v.n);
     if (!ok) {
-        svc_log(SVC_LOG_WARN, j.id, "stream: %s", err.msg);
+        svc_log(SVC_LOG_WARN, v.j.id, "stream: %s", err.msg);
         return http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 "'s piece from tick %" PRId64
-                          " is missing or damaged on this server", j.id, q->m.tick);
+                          " is missing or damaged on this server", v.j.id, q->m.tick);
     }
     ret = http_reply(c, 200, "video/mp2t", (const char *)data, (size_t)len);
     free(data);
