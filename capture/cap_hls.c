@@ -23,6 +23,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -184,7 +185,6 @@ bool cap_hls_piece_check(const char *dir, const cap_hls_piece *p, uint8_t **data
 
 /* Grows *b by the printf; false once out of memory (then *b is NULL). */
 static bool put(char **b, size_t *len, size_t *cap, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
-#include <stdarg.h>
 static bool put(char **b, size_t *len, size_t *cap, const char *fmt, ...)
 {
     for (;;) {
