@@ -27,6 +27,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include "../runtime/util/rs_file.h"
@@ -385,16 +386,20 @@ static bool piece_open(cutter *c, uint64_t tick, rs_err *err)
     if (!(c->out = ts_open(c->part, err)))
         return false;
     AVStream *in = c->vin->streams[c->vi];
-    if (!(c->ost = avformat_new_stream(c->out, NULL)) || !(c->oast = avformat_new_stream(c->out, NULL)))
+    if (!(c->ost = avformat_new_stream(c->out, NULL)) || (c->ain && !(c->oast = avformat_new_stream(c->out, NULL))))
         return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", c->part);
     int r;
     if ((r = avcodec_parameters_copy(c->ost->codecpar, in->codecpar)) < 0 ||
-        (r = avcodec_parameters_copy(c->oast->codecpar, c->ain->streams[0]->codecpar)) < 0)
+        (c->ain && (r = avcodec_parameters_copy(c->oast->codecpar, c->ain->streams[0]->codecpar)) < 0))
         return fail_av(err, CAP_ERR_NOMEM, c->part, "codec parameters", r);
-    c->ost->codecpar->codec_tag = c->oast->codecpar->codec_tag = 0;
-    if (!c->oast->codecpar->frame_size)
-        c->oast->codecpar->frame_size = 1024; /* AAC's; MPEG-TS does not keep it */
-    c->ost->time_base = c->oast->time_base = (AVRational){1, 90000};
+    c->ost->codecpar->codec_tag = 0;
+    c->ost->time_base = (AVRational){1, 90000};
+    if (c->oast) {
+        c->oast->codecpar->codec_tag = 0;
+        if (!c->oast->codecpar->frame_size)
+            c->oast->codecpar->frame_size = 1024; /* AAC's; MPEG-TS does not keep it */
+        c->oast->time_base = (AVRational){1, 90000};
+    }
     AVDictionary *o = ts_opts();
     r = avformat_write_header(c->out, &o);
     av_dict_free(&o);
@@ -410,7 +415,7 @@ static bool piece_close(cutter *c, uint64_t upto, rs_err *err)
     bool ok = true;
     int r;
     uint64_t from = c->ix.p[c->ix.n - 1].tick;
-    while (ok && !c->a_eof) {
+    while (ok && c->ain && !c->a_eof) {
         if (!c->apkt->data) {
             r = av_read_frame(c->ain, c->apkt);
             if (r == AVERROR_EOF) {
@@ -482,6 +487,8 @@ static bool open_inputs(cutter *c, rs_err *err)
     if (id != AV_CODEC_ID_H264 && id != AV_CODEC_ID_HEVC)
         return rs_fail(err, CAP_ERR_ENC_SETTING, "%s: HLS pieces carry H.264 or HEVC, not %s (MPEG-TS has no place for it)",
                        d->video, avcodec_get_name(id));
+    if (d->silent)
+        return true;
     snprintf(track, sizeof track, "%s/track.ts", d->dir);
     if ((r = avformat_open_input(&c->ain, track, NULL, NULL)) < 0)
         return fail_av(err, CAP_ERR_SEG_MISSING, track, "cannot open the match's sound", r);
@@ -499,13 +506,15 @@ static bool cut_all(cutter *c, rs_err *err)
     uint64_t k = 0;
     uint32_t crc = 0;
     int r;
+    /* a segment's pts are its ticks; any other render's start at 0 */
+    int64_t base = d->seg ? 0 : (int64_t)d->first;
     while ((r = av_read_frame(c->vin, c->pkt)) >= 0) {
         if (c->pkt->stream_index != c->vi) {
             av_packet_unref(c->pkt);
             continue;
         }
         crc = rs_crc32(crc, c->pkt->data, (size_t)c->pkt->size);
-        int64_t t = av_rescale_q(c->pkt->pts, in_tb, tick);
+        int64_t t = av_rescale_q(c->pkt->pts, in_tb, tick) + base;
         uint64_t pos = d->first + k;
         if (k >= d->end - d->first || t < (int64_t)pos - CAP_HLS_REORDER || t < (int64_t)d->first || t >= (int64_t)d->end) {
             av_packet_unref(c->pkt);
@@ -549,6 +558,27 @@ fail:
     return false;
 }
 
+static bool cut_locked(const cap_hls_cut_desc *d, rs_err *err);
+
+/* The index through a temporary of this process, synced, then renamed */
+static bool write_index(const char *dir, const char *idx, const char *text, size_t n, rs_err *err)
+{
+    char part[1200];
+    snprintf(part, sizeof part, "%s/.%s.%d.part", dir, strrchr(idx, '/') + 1, (int)getpid());
+    int fd = open(part, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    bool ok = fd >= 0 && write(fd, text, n) == (ssize_t)n && fsync(fd) == 0;
+    int e = errno;
+    if (fd >= 0 && close(fd) != 0 && ok)
+        ok = false, e = errno;
+    if (ok && rename(part, idx) != 0)
+        ok = false, e = errno;
+    if (!ok) {
+        unlink(part);
+        return rs_fail(err, CAP_ERR_WRITE, "%s: cannot write it: %s", idx, strerror(e ? e : EIO));
+    }
+    return true;
+}
+
 bool cap_hls_cut(const cap_hls_cut_desc *d, rs_err *err)
 {
     if (d->kept)
@@ -556,6 +586,22 @@ bool cap_hls_cut(const cap_hls_cut_desc *d, rs_err *err)
     if (d->end <= d->first || d->end > d->total)
         return rs_fail(err, CAP_ERR_ARG, "%s: ticks %" PRIu64 "..%" PRIu64 " are not within the match's %" PRIu64, d->video,
                        d->first, d->end, d->total);
+    char lock[1100];
+    snprintf(lock, sizeof lock, "%s/.u%" PRIu64 ".lock", d->dir, d->first);
+    int lfd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lfd < 0 || flock(lfd, LOCK_EX) != 0) {
+        int e = errno;
+        if (lfd >= 0)
+            close(lfd);
+        return rs_fail(err, CAP_ERR_CREATE, "%s: %s", lock, strerror(e));
+    }
+    bool ok = cut_locked(d, err);
+    close(lfd); /* and the lock with it */
+    return ok;
+}
+
+static bool cut_locked(const cap_hls_cut_desc *d, rs_err *err)
+{
     if (index_good(d->dir, d->first, d->end)) {
         if (d->kept)
             *d->kept = true;
@@ -585,7 +631,7 @@ bool cap_hls_cut(const cap_hls_cut_desc *d, rs_err *err)
             ok = rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", idx);
         else {
             cap_hls_index_format(&c.ix, text, (size_t)n + 1);
-            ok = rs_write_part(idx, text, (size_t)n, err) && rs_commit_file(idx, err);
+            ok = write_index(d->dir, idx, text, (size_t)n, err);
         }
         free(text);
     }

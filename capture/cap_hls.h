@@ -67,17 +67,20 @@ void cap_hls_index_free(cap_hls_index *ix);
 bool cap_hls_track(const char *dir, const cap_sink *audio, rs_err *err);
 
 typedef struct cap_hls_cut_desc {
-    const char *dir;     /* the job's folder; must exist and hold track.ts */
-    const char *video;   /* a render's output (its video stream, pts = tick) or a segment */
+    const char *dir;     /* the job's folder; must exist and hold track.ts unless !sound */
+    const char *video;   /* a segment (pts = tick), or a render's output (pts from 0 at tick first) */
     const cap_seg *seg;  /* the segment as cap_seg_verify filled it, or NULL (a whole render):
                             its packets must match its manifest (count, CRC-32), as the join checks */
     uint64_t first, end; /* the video's ticks, first..end-1 */
     uint64_t total;      /* the match's last tick + 1: the last piece takes the track's rest */
+    bool silent;         /* pieces without sound (a job asked for none): no track needed */
     bool *kept;          /* optional: set when a good index was there already */
 } cap_hls_cut_desc;
 
 /* Cuts the video at its keyframes into pieces and writes the unit's
- * index last.  A video that is not H.264 or HEVC is refused
+ * index last, all under DIR/.uFIRST.lock (flock): two renders of the same
+ * unit (a lease lost while the old one still ran) cut one after the
+ * other, and the second keeps the first's pieces.  A video that is not H.264 or HEVC is refused
  * (CAP_ERR_ENC_SETTING: MPEG-TS carries neither VP9 nor AV1); a segment
  * whose packets differ from its manifest gets CAP_ERR_SEG_MEDIA and
  * leaves nothing; a write failure CAP_ERR_WRITE. */

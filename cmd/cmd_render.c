@@ -117,8 +117,9 @@ static void help(void)
            "                     made once): what 'ringside serve' streams while a job renders\n"
            "                     (docs/service.md, Watching while it renders)\n"
            "  --progress-fd N    also report progress on file descriptor N, for programs\n"
-           "                     (ringside serve): 'frames DONE TOTAL' lines, and 'desync TICK'\n"
-           "                     if the replay's state hashes stop matching\n"
+           "                     (ringside serve): 'frames DONE TOTAL' lines, 'desync TICK'\n"
+           "                     if the replay's state hashes stop matching, and 'hls-failed'\n"
+           "                     when the video is written but --hls-dir's pieces are not\n"
            "  --codec C          h264, hevc, vp9 or av1 (.mp4: h264, hevc, av1; .webm: vp9, av1;\n"
            "                     .mkv: all); default h264, vp9 for .webm\n"
            "  --crf N            constant quality, lower is better (x264/x265 1..51, default\n"
@@ -252,6 +253,7 @@ static const struct option opts[] = {
 typedef struct render_opts {
     const char *replay, *out, *hashes, *backend, *segment, *format, *poster, *hls_dir;
     bool overwrite, quiet;
+    bool audio_off;           /* --audio off given: --hls-dir's pieces get no sound */
     int progress;             /* rs_progress_mode, or RS_PROGRESS_AUTO */
     cap_desc cd;
     cap_enc enc;
@@ -389,7 +391,10 @@ static int render_option(render_opts *o, int c, const char *arg, char **argv)
     case OPT_CODEC: case OPT_CRF: case OPT_BITRATE: case OPT_PRESET: case OPT_PIXFMT: case OPT_HW:
         return encoder_option(&o->enc, c, arg) ? -1 : RS_EXIT_USAGE;
     case JOB_AUDIO_OPT_AUDIO: case JOB_AUDIO_OPT_BITRATE: case JOB_AUDIO_OPT_LOUDNESS: case JOB_AUDIO_OPT_WAV:
-        return job_audio_option(&o->audio, "render", c, arg) ? -1 : RS_EXIT_USAGE;
+        if (!job_audio_option(&o->audio, "render", c, arg))
+            return RS_EXIT_USAGE;
+        o->audio_off = o->audio.mode == JOB_AUDIO_OFF; /* asked for: a segment is silent anyway */
+        return -1;
     case 'o': o->out = arg; return -1;
     case 'K': o->ticks_given = true; return parse_ticks(o, arg) ? -1 : RS_EXIT_USAGE;
     case OPT_FROM: return cli_time("--from", arg, &o->from) ? -1 : RS_EXIT_USAGE;
@@ -844,15 +849,20 @@ static bool hls_start(render_run *run, job_hls *h)
 {
     const render_opts *o = run->o;
     job_hls_desc d = {.dir = o->hls_dir, .video = o->out, .segment = o->segment, .hashes = o->hashes != NULL,
-                      .rp = &run->rp, .name = o->replay, .lufs = o->audio.lufs, .first = run->first, .end = run->end};
+                      .rp = &run->rp, .name = o->replay, .lufs = o->audio.lufs, .bitrate = o->audio.bitrate,
+                      .silent = o->audio_off, .first = run->first, .end = run->end};
     return job_hls_start(h, &d, &run->err);
 }
 
 static int hls_finish(render_run *run, job_hls *h, int status)
 {
     double t0 = rs_now();
-    if (!job_hls_finish(h, status == RS_EXIT_OK, &run->err))
+    if (!job_hls_finish(h, status == RS_EXIT_OK, &run->err)) {
+        /* the video is good: a program (ringside serve) keeps it and lists no pieces */
+        if (status == RS_EXIT_OK && run->o->progress_fd >= 0)
+            dprintf((int)run->o->progress_fd, "hls-failed\n");
         return status == RS_EXIT_OK ? RS_EXIT_FAIL : status;
+    }
     if (status == RS_EXIT_OK)
         cli_debug("render", "HLS pieces of %s in %s: the track %.2f s%s, the cut %.2f s", run->o->out, run->o->hls_dir,
                   h->track_s, h->track_s ? "" : " (made before)", rs_now() - t0);

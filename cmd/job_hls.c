@@ -24,7 +24,7 @@ typedef struct track_src {
 static bool read_track(void *u, float *dst, size_t frames, rs_err *err)
 {
     track_src *t = u;
-    if (t->h->stop)
+    if (atomic_load(&t->h->stop))
         return rs_fail(err, CAP_ERR_FAILED, "%s/track.ts: stopped (the render failed)", t->h->d.dir);
     return au_replay_read(t->s, dst, frames, err);
 }
@@ -43,9 +43,10 @@ static bool make_track(job_hls *h, rs_err *err)
     if (fd < 0)
         return rs_fail(err, CAP_ERR_CREATE, "%s: %s", lock, strerror(errno));
     while (flock(fd, LOCK_EX | LOCK_NB) != 0) {
-        if (h->stop || (errno != EWOULDBLOCK && errno != EINTR)) {
+        int e = errno;
+        if (atomic_load(&h->stop) || (e != EWOULDBLOCK && e != EINTR)) {
             close(fd);
-            return rs_fail(err, CAP_ERR_FAILED, "%s: %s", lock, h->stop ? "stopped" : strerror(errno));
+            return rs_fail(err, CAP_ERR_FAILED, "%s: %s", lock, atomic_load(&h->stop) ? "stopped" : strerror(e));
         }
         nanosleep(&(struct timespec){0, 50000000}, NULL);
     }
@@ -56,7 +57,8 @@ static bool make_track(job_hls *h, rs_err *err)
         track_src src = {.h = h, .s = au_replay_open(d->rp, d->name, 0, d->rp->ticks, &o, err)};
         ok = src.s != NULL;
         if (ok) {
-            cap_sink sink = {.audio = read_track, .audio_u = &src, .audio_frames = au_replay_info(src.s)->frames};
+            cap_sink sink = {.audio = read_track, .audio_u = &src, .audio_frames = au_replay_info(src.s)->frames,
+                             .audio_bitrate = d->bitrate};
             ok = cap_hls_track(d->dir, &sink, err);
             au_replay_close(src.s);
         }
@@ -75,11 +77,13 @@ static void *track_thread(void *u)
 
 bool job_hls_start(job_hls *h, const job_hls_desc *d, rs_err *err)
 {
-    *h = (job_hls){.d = *d};
+    *h = (job_hls){.d = *d, .track_ok = true};
     char probe[1100];
     snprintf(probe, sizeof probe, "%s/.", d->dir);
     if (!rs_mkdirs_for(probe, err))
         return false;
+    if (d->silent)
+        return true; /* no track to make */
     if (pthread_create(&h->thread, NULL, track_thread, h) != 0)
         return rs_fail(err, CAP_ERR_NOMEM, "%s: cannot start a thread for the track", d->dir);
     h->running = true;
@@ -112,13 +116,12 @@ static bool whole_playlist(const job_hls_desc *d, rs_err *err)
 
 bool job_hls_finish(job_hls *h, bool ok, rs_err *err)
 {
-    if (!h->running)
-        return !ok;
     if (!ok)
-        h->stop = 1;
-    pthread_join(h->thread, NULL);
+        atomic_store(&h->stop, 1);
+    if (h->running)
+        pthread_join(h->thread, NULL);
     h->running = false;
-    if (!ok)
+    if (!ok || !h->d.dir)
         return false;
     if (!h->track_ok) {
         *err = h->track_err;
@@ -135,7 +138,8 @@ bool job_hls_finish(job_hls *h, bool ok, rs_err *err)
         }
     }
     if (!cap_hls_cut(&(cap_hls_cut_desc){.dir = d->dir, .video = d->video, .seg = d->segment ? &seg : NULL,
-                                         .first = d->first, .end = d->end, .total = d->rp->ticks},
+                                         .first = d->first, .end = d->end, .total = d->rp->ticks,
+                                         .silent = d->silent},
                      err))
         return false;
     return d->segment || whole_playlist(d, err); /* a segment's: the service lists the units it knows are done */

@@ -23,7 +23,7 @@
 #define JOB_HLS_H
 
 #include <pthread.h>
-#include <signal.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -38,6 +38,8 @@ typedef struct job_hls_desc {
     const rp_replay *rp;  /* the replay: its whole match is the track; lives until finish */
     const char *name;     /* the replay's name, for messages */
     double lufs;          /* the track's loudness target; 0: the default */
+    int64_t bitrate;      /* the track's AAC bits/s; 0: the default, 192k */
+    bool silent;          /* no sound in the pieces (--audio off): no track */
     uint64_t first, end;  /* the video's ticks */
 } job_hls_desc;
 
@@ -45,7 +47,7 @@ typedef struct job_hls {
     job_hls_desc d;
     pthread_t thread;
     bool running;
-    volatile sig_atomic_t stop; /* set: the track maker gives up */
+    atomic_int stop;            /* set (by the render's thread): the track maker gives up */
     bool track_ok;
     rs_err track_err;
     double track_s;             /* what making the track took (0: it was there) */

@@ -7,7 +7,9 @@
  * for a split job's join (svc_files.c: the files and the command line):
  *
  *   claim a unit (store) -> write the replay to DATA/work -> fork+exec
- *     fd 3: "frames DONE TOTAL" / "desync TICK" / "bad INDEX REASON" lines
+ *     fd 3: "frames DONE TOTAL" / "desync TICK" / "bad INDEX REASON" /
+ *       "hls-failed" lines (the last: the video is written, its stream
+ *       pieces are not: exit 1 that counts as done, the stream unlisted)
  *     fd 2: its messages; the last line is the unit's error if it fails, and
  *       the last SVC_LOG_LINES go to the job's render log (OUTPUT/N.log,
  *       appended when the unit ends; GET /jobs/N/log shows it and, while
@@ -72,6 +74,7 @@ typedef struct worker {
     int *bad, nbad;             /* the join: segments it found bad ("bad INDEX REASON") */
     char bad_why[SVC_ERROR_MAX];
     bool keep;                  /* a segment the queue recorded: its files stay */
+    bool hls_failed;            /* "hls-failed": its output is good, its stream pieces are not */
     int prog_fd, err_fd;        /* read ends, non-blocking; -1 closed */
     char prog_buf[1024], err_buf[1024];
     size_t prog_len, err_len;
@@ -275,6 +278,8 @@ static void on_prog_line(worker *w, char *line)
         w->total = b;
     } else if (sscanf(line, "desync %lld", &a) == 1)
         w->desync = a;
+    else if (!strcmp(line, "hls-failed"))
+        w->hls_failed = true;
     else if (w->bad && sscanf(line, "bad %d %n", &idx, &off) == 1 && off > 0 && idx >= 0 && idx < w->job.segments) {
         /* the join: segment idx failed its checks; keep the first reasons */
         bool seen = false;
@@ -440,8 +445,9 @@ static bool finished_segment(svc_daemon *d, worker *w, double secs)
         snprintf(w->last_err, sizeof w->last_err, "the segment render exited 0 but left no manifest (%s)", manifest);
         return false; /* retried like a crash */
     }
-    if (!svc_unit_stream_ok(&w->f, &w->job.unit, w->last_err, sizeof w->last_err))
-        return false; /* likewise: a viewer never gets a piece that is not whole */
+    char why[SVC_ERROR_MAX];
+    if (!svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why)) /* a viewer never gets a piece that is not whole */
+        svc_log(SVC_LOG_WARN, j->id, "%s%s (the segment is good: it is kept, the stream stops before it)", ctx(w), why);
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
     if (r == 1) {
         w->keep = true;
@@ -516,7 +522,12 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
                 kind == SVC_UNIT_JOIN ? "join" : "render", secs);
         goto out;
     }
-    /* a finished child counts even if a stop signal came just too late */
+    /* a finished child counts even if a stop signal came just too late;
+     * so does one whose video is good but its stream pieces are not */
+    if (code == 1 && w->hls_failed && w->killed == K_NONE && kind != SVC_UNIT_JOIN) {
+        svc_log(SVC_LOG_WARN, j->id, "%sits stream pieces could not be made: %s", ctx(w), w->last_err);
+        code = 0;
+    }
     if (code == 0 && kind != SVC_UNIT_SEGMENT) {
         finished_video(d, w, secs);
         goto out;

@@ -387,7 +387,22 @@ static int sweep_retention(svc_daemon *d)
     return removed;
 }
 
-/* OUTPUT/N.stream/OTHERKEY: an older queue's job of the same id */
+/* A stream temporary (".NAME.PID.part") of a render process that is gone */
+static bool dead_stream_part(const char *name)
+{
+    size_t n = strlen(name);
+    if (name[0] != '.' || n < 8 || strcmp(name + n - 5, ".part") != 0)
+        return false;
+    const char *p = name + n - 5;
+    while (p > name && p[-1] >= '0' && p[-1] <= '9')
+        p--;
+    long pid = p[-1] == '.' ? strtol(p, NULL, 10) : 0;
+    return pid > 0 && pid < INT32_MAX && dead_writer((int)pid, false);
+}
+
+/* OUTPUT/N.stream/OTHERKEY: an older queue's job of the same id; and, on
+ * an SQLite queue (one machine: a pid says who), the temporaries a killed
+ * render left in the job's own stream folder */
 static int sweep_other_keys(svc_daemon *d, int64_t id, const char *key)
 {
     char path[1100], sub[1400];
@@ -396,6 +411,19 @@ static int sweep_other_keys(svc_daemon *d, int64_t id, const char *key)
     struct dirent *e;
     int removed = 0;
     while (dir && (e = readdir(dir))) {
+        if (!strcmp(e->d_name, key) && !strcmp(d->store->ops->name, "sqlite")) {
+            snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+            DIR *own = opendir(sub);
+            struct dirent *f;
+            char part[1700];
+            while (own && (f = readdir(own)))
+                if (dead_stream_part(f->d_name)) {
+                    snprintf(part, sizeof part, "%s/%s", sub, f->d_name);
+                    removed += unlink(part) == 0;
+                }
+            if (own)
+                closedir(own);
+        }
         if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..") || !strcmp(e->d_name, key))
             continue;
         snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);

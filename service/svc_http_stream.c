@@ -58,7 +58,9 @@ static bool listed_units(svc_daemon *d, struct MHD_Connection *c, const svc_job 
         if (units[i].kind == SVC_UNIT_JOIN)
             continue;
         want++;
-        if (k < want - 1 || units[i].state != SVC_DONE)
+        /* done once is enough: a segment the join sent back keeps its
+         * pieces (cap_hls.h), and the playlist never takes back a line */
+        if (k < want - 1 || (units[i].state != SVC_DONE && units[i].renders == 0))
             continue; /* after a gap nothing is listed */
         int r = cap_hls_index_read(dir, (uint64_t)units[i].first_tick, &(*ix)[k], &err);
         if (r == 1 && (*ix)[k].end == (uint64_t)units[i].end_tick)

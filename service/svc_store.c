@@ -101,5 +101,5 @@ int svc_plan_segments(int64_t total, int64_t seg, int64_t first, int64_t *ends, 
         at = end;
         len = len * 2 < seg ? len * 2 : seg;
     }
-    return n;
+    return n > 1 ? n : 0; /* one segment and a join would be the whole job, twice the start-up */
 }

@@ -265,10 +265,14 @@ t_hls_pieces() {
     "$RS_BIN" render m.rsr --ticks 0:150 $TINY -q -y --crf 30 --segment job7 -o s0b.mp4 --hashes s0b.hashes --hls-dir hls || return 1
     [ "$(cat hls/t0.ts hls/t120.ts | md5sum)" != "$sum" ] && grep -q "^piece 120 30 $(stat -c %s hls/t120.ts) " hls/u0.idx ||
         { echo "a damaged piece was not cut again"; return 1; }
-    # a whole render writes its own finished playlist
-    "$RS_BIN" render m.rsr --ticks 0:200 $TINY -q -o whole.mp4 --hls-dir w || return 1
-    grep -q '^#EXT-X-ENDLIST' w/stream.m3u8 && grep -q '^t120.ts' w/stream.m3u8 || { cat w/stream.m3u8; return 1; }
+    # a whole render (its pts from 0 at its first tick) writes its own finished
+    # playlist; --audio off: pieces without sound, and no track made
+    "$RS_BIN" render m.rsr --ticks 60:200 $TINY -q -o whole.mp4 --audio off --hls-dir w || return 1
+    grep -q '^#EXT-X-ENDLIST' w/stream.m3u8 && [ "$(grep -c '^t' w/stream.m3u8)" = 2 ] && grep -q '^t180.ts' w/stream.m3u8 ||
+        { cat w/stream.m3u8; return 1; }
     [ "$(vframes whole.mp4 | md5sum)" = "$(vframes w/stream.m3u8 | md5sum)" ] || { echo "the whole render's stream is not its frames"; return 1; }
+    [ ! -e w/track.ts ] && [ -z "$(ffprobe -v error -select_streams a -show_entries stream=codec_name -of csv=p=0 w/t60.ts)" ] ||
+        { echo "--audio off made a track or sound"; return 1; }
     # what has no HLS pieces is refused before any work
     for o in "x.webm" "x.mkv --codec vp9" "x.y4m"; do
         "$RS_BIN" render m.rsr --ticks 0:10 $TINY -q -o $o --hls-dir h2 2>err.txt

@@ -1240,6 +1240,7 @@ static void t_plan_segments(void)
     plan_is(1200, 1800, 120, "120 360 840 1200");  /* the 20 s job: 2, 4, 8, 6 s */
     plan_is(10800, 1800, 120, "120 360 840 1800 3600 5400 7200 9000 10800"); /* 3 minutes: 2 4 8 16 30... */
     plan_is(400, 1800, 120, "120 400");            /* a rest shorter than the first joins the one before */
+    plan_is(180, 1800, 120, "");                   /* ... and when that leaves one segment: whole */
     plan_is(600, 60, 120, "60 120 180 240 300 360 420 480 540 600"); /* first not below seg: equal */
     plan_is(5400, 1800, 1800, "1800 3600 5400");
     /* the count without room for the ends */
@@ -1252,7 +1253,7 @@ static void t_plan_segments(void)
         for (int64_t first = 0; first <= 240; first += 60) {
             int64_t ends[128];
             int n = svc_plan_segments(total, 600, first, ends, 128);
-            T_ASSERT(n >= 0 && n < 128);
+            T_ASSERT(n >= 0 && n < 128 && n != 1); /* never one segment and a join */
             for (int i = 0; i < n; i++)
                 T_ASSERTF(ends[i] > (i ? ends[i - 1] : 0) && ends[i] - (i ? ends[i - 1] : 0) <= 600 + 240,
                           "total %lld first %lld: segment %d ends at %lld", (long long)total, (long long)first, i,

@@ -78,6 +78,16 @@ t_no_stream_answers() {
     c=$(curl -s -o body.txt -w '%{http_code}' "$SVC_URL/jobs/$id/stream/0.ts")
     [ "$c" = 410 ] || { echo "a damaged piece: $c"; return 1; }
     grep -q "t0.ts: not the bytes of its index" d.log || { tail -5 d.log; return 1; }
+    # what a killed render left in the folder goes with the next sweep; a live one's stays
+    sh -c 'exit 0' & dead=$!
+    wait $dead
+    k=$(dirname "$p")
+    touch "$k/.t120.ts.$dead.part" "$k/.u0.idx.$SVC_PID.part"
+    i=0
+    while [ -e "$k/.t120.ts.$dead.part" ]; do
+        sleep 0.5; i=$((i + 1)); [ $i -lt 30 ] || { echo "a dead render's temporary stays"; ls -la "$k"; return 1; }
+    done
+    [ -e "$k/.u0.idx.$SVC_PID.part" ] || { echo "a live process's temporary was removed"; return 1; }
     svc_stop
 }
 
