@@ -184,6 +184,20 @@ bool cap_hls_piece_check(const char *dir, const cap_hls_piece *p, uint8_t **data
     return true;
 }
 
+bool cap_hls_unit_check(const char *dir, uint64_t first, uint64_t end, rs_err *err)
+{
+    cap_hls_index ix;
+    int r = cap_hls_index_read(dir, first, &ix, err);
+    if (r == 0)
+        return rs_fail(err, CAP_ERR_SEG_MISSING, "%s/u%" PRIu64 ".idx: no index", dir, first);
+    bool ok = r == 1 && (ix.end == end || rs_fail(err, CAP_ERR_SEG_MANIFEST, "%s/u%" PRIu64 ".idx: ends at tick %" PRIu64
+                                                  ", not %" PRIu64, dir, first, ix.end, end));
+    for (int i = 0; ok && i < ix.n; i++)
+        ok = cap_hls_piece_check(dir, &ix.p[i], NULL, err);
+    cap_hls_index_free(&ix);
+    return ok;
+}
+
 /* Grows *b by the printf; false once out of memory (then *b is NULL). */
 static bool put(char **b, size_t *len, size_t *cap, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 static bool put(char **b, size_t *len, size_t *cap, const char *fmt, ...)
@@ -338,20 +352,6 @@ bool cap_hls_track(const char *dir, const cap_sink *audio, rs_err *err)
     if (ok && link(part, path) != 0 && errno != EEXIST)
         ok = rs_fail(err, CAP_ERR_WRITE, "%s: cannot link %s into place: %s", path, part, strerror(errno));
     unlink(part);
-    return ok;
-}
-
-/* The index there is good: every piece as it says. */
-static bool index_good(const char *dir, uint64_t first, uint64_t end)
-{
-    cap_hls_index ix;
-    rs_err e = {0};
-    if (cap_hls_index_read(dir, first, &ix, &e) != 1)
-        return false;
-    bool ok = ix.end == end;
-    for (int i = 0; ok && i < ix.n; i++)
-        ok = cap_hls_piece_check(dir, &ix.p[i], NULL, &e);
-    cap_hls_index_free(&ix);
     return ok;
 }
 
@@ -602,7 +602,7 @@ bool cap_hls_cut(const cap_hls_cut_desc *d, rs_err *err)
 
 static bool cut_locked(const cap_hls_cut_desc *d, rs_err *err)
 {
-    if (index_good(d->dir, d->first, d->end)) {
+    if (cap_hls_unit_check(d->dir, d->first, d->end, &(rs_err){0})) {
         if (d->kept)
             *d->kept = true;
         return true;

@@ -90,6 +90,10 @@ bool cap_hls_cut(const cap_hls_cut_desc *d, rs_err *err);
  * filled; -1: unreadable or malformed (err names the file and line). */
 int cap_hls_index_read(const char *dir, uint64_t first, cap_hls_index *ix, rs_err *err);
 
+/* DIR/uFIRST.idx is there, for ticks first..end-1, and every piece is
+ * the bytes it names.  False with err saying what is not ("no index"). */
+bool cap_hls_unit_check(const char *dir, uint64_t first, uint64_t end, rs_err *err);
+
 /* An index's text (parse and format agree; snprintf rules). */
 int cap_hls_index_format(const cap_hls_index *ix, char *out, size_t n);
 bool cap_hls_index_parse(const char *text, const char *path, cap_hls_index *ix, rs_err *err);

@@ -86,19 +86,11 @@ bool svc_stream_dir(const svc_config *cfg, const svc_job *j, char *out, size_t n
 
 bool svc_unit_stream_ok(const svc_unit_files *f, const svc_unit *u, char *why, size_t n)
 {
-    if (!f->stream[0])
-        return true;
-    cap_hls_index ix;
     rs_err err = {0};
-    int r = cap_hls_index_read(f->stream, (uint64_t)u->first_tick, &ix, &err);
-    bool ok = r == 1 && ix.end == (uint64_t)u->end_tick;
-    for (int i = 0; ok && i < ix.n; i++)
-        ok = cap_hls_piece_check(f->stream, &ix.p[i], NULL, &err);
-    if (!ok)
-        snprintf(why, n, "its stream pieces do not check: %s",
-                 r == 0 ? "no index" : err.msg[0] ? err.msg : "the index is for other ticks");
-    cap_hls_index_free(&ix);
-    return ok;
+    if (!f->stream[0] || cap_hls_unit_check(f->stream, (uint64_t)u->first_tick, (uint64_t)u->end_tick, &err))
+        return true;
+    snprintf(why, n, "its stream pieces do not check: %s", err.msg);
+    return false;
 }
 
 void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out, size_t n)
