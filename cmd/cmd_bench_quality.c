@@ -89,6 +89,8 @@ static const config fixed_configs[] = {
     {"1x cheap scene 75%", 1, {CHEAP_Q, .scene_pct = 75}, 1},
     {"1x lean scene 60%", 1, {LEAN_Q, .scene_pct = 60}, 1},
     {"1x lean scene 90%", 1, {LEAN_Q, .scene_pct = 90}, 1},
+    /* each stage at its own size (its standard_scene_pct, chosen from the rows above) */
+    {"1x lean stage scene", 1, {LEAN_Q, .stage_scene = true}, 1},
     {"1x fxaa lean scene 75%", 1, {LEAN_Q, .aa = R_AA_FXAA, .scene_pct = 75}, 1},
     {"1x fxaa lean scene 85%", 1, {LEAN_Q, .aa = R_AA_FXAA, .scene_pct = 85}, 1},
     {"1.5x fxaa", 1.5, {.aa = R_AA_FXAA}, 1},
@@ -110,6 +112,7 @@ static int NCONFIGS;
 typedef struct result {
     bool done;
     double ms, psnr, ssim;
+    int scene_pct; /* the scene's size drawn, percent of the output's */
 } result;
 
 static void help(void)
@@ -207,9 +210,10 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* Draws demo d's frames under config c: their pixels (frames x w x h x 4,
- * top row first) into px, and the median ms a frame into *ms. */
+ * top row first) into px, the median ms a frame into *ms and the scene's
+ * size drawn into *scene_pct. */
 static bool draw_frames(const char *data, int d, const config *c, int frames, int w, int h, uint8_t *px, double *ms,
-                        rs_err *err)
+                        int *scene_pct, rs_err *err)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/demos/%s.rsr", data, demos[d].name);
@@ -234,6 +238,7 @@ static bool draw_frames(const char *data, int d, const config *c, int frames, in
     if (!(r = r_game_create_opts(&(r_game_opts){.q = c->q, .quiet = true}, err)) || !r_game_prepare(r, rp.stage, err) ||
         !r_target_create(&src, rw, rh, err) || !(sc = cap_scaler_create(CAP_FILTER_BOX, rw, rh, w, h, err)))
         goto done;
+    *scene_pct = r_scene_pct(&c->q, r_game_stage(r)->standard_scene_pct);
     gl.GenTextures(1, &dtex);
     gl.BindTexture(GL_TEXTURE_2D, dtex);
     gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
@@ -305,7 +310,7 @@ static bool q_equal(const r_quality *a, const r_quality *b)
     return a->shadow_size == b->shadow_size && a->sil_size == b->sil_size && a->mask_half == b->mask_half &&
            a->bloom_levels == b->bloom_levels && a->aa == b->aa && a->lspsm_size == b->lspsm_size &&
            a->fog_size == b->fog_size && a->water_grid == b->water_grid && a->snow_light == b->snow_light &&
-           a->scene_pct == b->scene_pct;
+           a->scene_pct == b->scene_pct && a->stage_scene == b->stage_scene;
 }
 
 /* The config whose scale and knobs are these, or -1. */
@@ -424,7 +429,7 @@ static bool measure(const quality_opts *o, const char *data, quality_res *q, rs_
         k++;
         for (int ci = 0; ok && ci < NCONFIGS; ci++) {
             result *rr = &q->res[d][ci];
-            if (!(ok = draw_frames(data, d, &configs[ci], frames, w, h, ci == 0 ? ref : px, &rr->ms, err)))
+            if (!(ok = draw_frames(data, d, &configs[ci], frames, w, h, ci == 0 ? ref : px, &rr->ms, &rr->scene_pct, err)))
                 break;
             if (ci == 0)
                 rr->psnr = 99, rr->ssim = 1;
@@ -537,7 +542,7 @@ static bool write_outputs(const quality_opts *o, const quality_res *q, rs_err *e
                 const result *rr = &q->res[d][ci];
                 fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
                         cf->q.aa == R_AA_FXAA ? "fxaa" : "off", cf->q.shadow_size, cf->q.sil_size, cf->q.mask_half,
-                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, cf->q.snow_light, cf->q.scene_pct, rr->ms, rr->psnr, rr->ssim,
+                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, cf->q.snow_light, rr->scene_pct, rr->ms, rr->psnr, rr->ssim,
                         o->frames, o->w, o->h);
             }
         if (cli_fclose(f) != 0)

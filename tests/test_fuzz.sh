@@ -6,11 +6,11 @@
 # the corpus as a regression case (tests/fuzz/<target>/, or demos/ for the
 # replay reader).  docs/testing.md, "Fuzzing", lists the targets and says
 # how to run one for an hour.  FUZZ_CI_SECONDS sets the time of each
-# (default 8: eight targets on a 2-core CI machine).  The targets the
+# (default 6: eight targets on a 2-core CI machine).  The targets the
 # chosen cases need are built first, by one make call.
 . "$(dirname "$0")/lib.sh"
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-SECS=${FUZZ_CI_SECONDS:-8}
+SECS=${FUZZ_CI_SECONDS:-6}
 
 # case: target, longest input, seed folders (read only; new inputs go to ./corpus)
 target() {

@@ -444,21 +444,27 @@ static void t_scene_pct(void)
     T_ASSERTF(either > 500 && both * 10 > either * 9, "the HUD touched other pixels at 75%%: %ld in both of %ld", both, either);
     for (int k = 0; k < 2; k++)
         free(px[k][0]), free(px[k][1]);
+    /* stage: r_quality.stage_scene, the stage file's standard_scene_pct
+     * (dojo 75, temple 100) unless scene_pct says otherwise */
     static const struct {
         int pct, w, h, want_w, want_h;
-    } c[] = {{0, 320, 180, 320, 180}, {75, 320, 180, 240, 135}, {50, 64, 36, 32, 18}, {60, 101, 57, 61, 34}};
+        bool stage;
+        const char *demo;
+    } c[] = {{0, 320, 180, 320, 180, false, "dojo"},  {75, 320, 180, 240, 135, false, "dojo"}, {50, 64, 36, 32, 18, false, "dojo"},
+             {60, 101, 57, 61, 34, false, "dojo"},   {0, 320, 180, 240, 135, true, "dojo"},   {0, 320, 180, 320, 180, true, "temple"},
+             {60, 320, 180, 192, 108, true, "dojo"}};
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
-        r_game *r = t_game_opts(&(r_game_opts){.q = {.scene_pct = c[i].pct}});
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.scene_pct = c[i].pct, .stage_scene = c[i].stage}});
         t_fb f;
         t_fb_make(&f, c[i].w, c[i].h);
         g_state prev, cur;
-        t_state_at("dojo", 1200, &prev, &cur);
+        t_state_at(c[i].demo, 900, &prev, &cur);
         t_draw(r, &f, &prev, &cur, c[i].w, c[i].h);
         float *hdr = malloc((size_t)c[i].w * c[i].h * 4 * sizeof *hdr);
         int hw = 0, hh = 0;
         T_ASSERT(hdr && r_game_read_buffer(r, "hdr", hdr, &hw, &hh));
-        T_ASSERTF(hw == c[i].want_w && hh == c[i].want_h, "scene_pct %d at %dx%d: the scene is %dx%d, want %dx%d", c[i].pct,
-                  c[i].w, c[i].h, hw, hh, c[i].want_w, c[i].want_h);
+        T_ASSERTF(hw == c[i].want_w && hh == c[i].want_h, "%s, scene_pct %d%s at %dx%d: the scene is %dx%d, want %dx%d",
+                  c[i].demo, c[i].pct, c[i].stage ? " and the stage's" : "", c[i].w, c[i].h, hw, hh, c[i].want_w, c[i].want_h);
         free(hdr);
         t_fb_free(&f);
         r_game_destroy(r);
@@ -684,6 +690,8 @@ static void t_presets_are_the_documented_table(void)
                 scale = a;
             else if (!strncmp(tok, "FXAA", 4))
                 q.aa = R_AA_FXAA;
+            else if (!strncmp(tok, "the stage's scene size", 22))
+                q.stage_scene = true;
             else if (!strncmp(tok, "mask half", 9))
                 q.mask_half = true;
             else if (sscanf(tok, "shadow %d", &v) == 1)

@@ -16,7 +16,7 @@ t_passes_summary_and_frames() {
     for pass in shadow_map silhouette_mips shadow_mask mask_filter scene sky lens bloom_blur sun_visibility flare tonemap hud total; do
         grep -q "^$pass " p.txt || { echo "no '$pass' row"; cat p.txt; return 1; }
     done
-    grep -q "passes (stage dojo, 320x180, 10 frames" p.txt || { cat p.txt; return 1; }
+    grep -q "passes (stage dojo, 320x180, the scene at 240x135, 10 frames" p.txt || { cat p.txt; return 1; }
     # dojo's sun is on screen: every pass ran all 10 frames
     awk '$1 == "scene" && ($2 != 10 || $3 != 0) { exit 1 }' p.txt || { cat p.txt; return 1; }
     # per frame
@@ -31,7 +31,7 @@ t_passes_summary_and_frames() {
     expect_fail 2 "--passes='often': expected summary or frames" "$RS_BIN" render short.rsr --passes=often -o d.y4m || return 1
     # play prints the same table
     "$RS_BIN" play --headless --replay short.rsr --size 160x90 --passes --quiet 2>q.txt || { cat q.txt; return 1; }
-    grep -q "passes (stage dojo, 160x90, 300 frames" q.txt || { cat q.txt; return 1; }
+    grep -q "passes (stage dojo, 160x90, the scene at 120x68, 300 frames" q.txt || { cat q.txt; return 1; }
     grep -q "^tonemap  *300  *0 " q.txt || { cat q.txt; return 1; }
     expect_fail 2 "--passes='often'" "$RS_BIN" play --headless --replay short.rsr --passes=often
 }
@@ -126,11 +126,13 @@ t_help_lists_the_options() {
 }
 
 # --quality sets the render size from the output size (unless --render-size says)
-# and the renderer's knobs; --size alone works from 16x16 to 3840x2160
+# and the renderer's knobs; --size alone works from 16x16 to 3840x2160.
+# Standard draws the dojo's scene at the stage's 75% (standard_scene_pct).
 t_quality_and_sizes() {
     short_replay || return 1
-    for qs in "draft:160x90:160x90, the scene at 96x54" "standard:160x90:160x90" "high:160x90:320x180" "reference:160x90:640x360" \
-        "standard:1920x1080:1920x1080" "standard:16x16:16x16" "standard:3840x2160:3840x2160"; do
+    for qs in "draft:160x90:160x90, the scene at 96x54" "standard:160x90:160x90, the scene at 120x68" "high:160x90:320x180" \
+        "reference:160x90:640x360" "standard:1920x1080:1920x1080, the scene at 1440x810" "standard:16x16:16x16, the scene at 12x12" \
+        "standard:3840x2160:3840x2160, the scene at 2880x1620"; do
         q=${qs%%:*} rest=${qs#*:}
         size=${rest%%:*} drawn=${rest#*:}
         "$RS_BIN" render short.rsr --ticks 100:101 --size "$size" --quality "$q" -o "q_$q.y4m" -y 2>q.txt ||
@@ -142,11 +144,19 @@ t_quality_and_sizes() {
     for q in draft standard; do
         "$RS_BIN" render short.rsr --ticks 100:102 --size 160x90 --render-size 320x180 --quality $q --passes \
             -o r_$q.y4m -y 2>r_$q.txt || { cat r_$q.txt; return 1; }
-        drawn=320x180
+        drawn="320x180, the scene at 240x135"
         [ $q = standard ] || drawn="320x180, the scene at 192x108"
         grep -q "(drawn at $drawn, quality $q)" r_$q.txt || { cat r_$q.txt; return 1; }
     done
     ! cmp -s r_draft.y4m r_standard.y4m || { echo "--render-size: draft drew what standard drew"; return 1; }
+    # a stage file's standard_scene_pct is standard's size; 100 (or none) draws 1:1
+    sed 's/^standard_scene_pct.*//' "$SRC/stages/dojo.stage" >whole.stage
+    printf 'standard_scene_pct = 50\n' >>half.stage && cat whole.stage >>half.stage
+    for sq in whole:160x90 half:"160x90, the scene at 80x45"; do
+        "$RS_BIN" render short.rsr --ticks 100:101 --size 160x90 --stage-file "${sq%%:*}.stage" -o s.y4m -y 2>s.txt ||
+            { cat s.txt; return 1; }
+        grep -q "(drawn at ${sq#*:}, quality standard)" s.txt || { echo "$sq:"; cat s.txt; return 1; }
+    done
     grep -q "^fxaa  *0  *2 " r_standard.txt || { echo "standard runs FXAA"; cat r_standard.txt; return 1; }
     expect_fail 2 "--quality 'ultra': expected draft, standard, high or reference" "$RS_BIN" render short.rsr --quality ultra \
         -o x.y4m || return 1
@@ -164,7 +174,8 @@ t_quality_and_sizes() {
 }
 
 # An output that cannot be written fails the render and leaves nothing: an
-# image sequence on a full filesystem (a 160 KiB tmpfs, most of it filled),
+# image sequence on a full filesystem (a 160 KiB tmpfs, all but about 16 KiB
+# filled: less than one frame of any sequence, half of any video here),
 # in a read-only folder and in a missing one, the video beside it for
 # comparison.  What was there before stays as it was.
 t_outputs_on_a_full_disk() {
@@ -172,10 +183,9 @@ t_outputs_on_a_full_disk() {
     mkdir -p full && mount -t tmpfs -o size=160k tmpfs full 2>mount.err ||
         { t_skip_env "cannot mount a tmpfs here ($(head -c 120 mount.err))"; return 0; }
     echo keep >full/keep.txt
-    head -c 110k /dev/zero >full/filler # about 50 KiB left: a frame or two
+    head -c 140k /dev/zero >full/filler # about 16 KiB left; 60 frames at 320x180 are 33-36 KiB in any container
     for out in full/f%04d.png full/f%04d.exr full/f%04d.tif full/v.mp4 full/v.y4m full/v.webm full/v.mkv full/v.nut; do
-        case $out in *%*) what="--ticks 0:40 --size 320x180" ;; *) what="--ticks 0:120 --size 640x360" ;; esac
-        "$RS_BIN" render short.rsr $what -q -o "$out" 2>err.txt
+        "$RS_BIN" render short.rsr --ticks 0:60 --size 320x180 -q -o "$out" 2>err.txt
         rc=$?
         left=$(ls -A full | grep -Ev '^(keep.txt|filler)$' | tr '\n' ' ')
         if [ $rc = 0 ] || [ -n "$left" ] || [ "$(cat full/keep.txt)" != keep ]; then
@@ -185,14 +195,14 @@ t_outputs_on_a_full_disk() {
             { echo "$out:"; cat err.txt; umount full; return 1; } ;; esac
     done
     # the stream: a full disk behind standard output is a write error on it
-    "$RS_BIN" render short.rsr --ticks 0:120 --size 640x360 -q -o - >full/stream.y4m 2>err.txt
+    "$RS_BIN" render short.rsr --ticks 0:60 --size 320x180 -q -o - >full/stream.y4m 2>err.txt
     rc=$?
     rm -f full/stream.y4m # the shell's file, not ours
     [ $rc = 1 ] && grep -q "^ringside render: standard output: .*No space left on device" err.txt ||
         { echo "-o - on a full disk: exit $rc"; cat err.txt; umount full; return 1; }
     # the join: segments made elsewhere, joined onto the full disk
     for r in 0:60 60:120; do
-        "$RS_BIN" render short.rsr --ticks "$r" --size 640x360 -q --segment fulljob -y -o "s${r%:*}.mp4" 2>err.txt ||
+        "$RS_BIN" render short.rsr --ticks "$r" --size 320x180 -q --segment fulljob -y -o "s${r%:*}.mp4" 2>err.txt ||
             { cat err.txt; umount full; return 1; }
     done
     "$RS_BIN" join --segment fulljob -q -o full/j.mp4 s0.mp4 s60.mp4 2>err.txt

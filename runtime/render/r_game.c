@@ -667,7 +667,7 @@ bool r_game_advance(r_game *r, const g_state *prev, const g_state *cur, int w, i
     frame *f = &r->f;
     memset(f, 0, sizeof *f);
     int sw, sh;
-    r_scene_size(&r->opts.q, w, h, &sw, &sh);
+    r_scene_size(r_scene_pct(&r->opts.q, r->stage.standard_scene_pct), w, h, &sw, &sh);
     f->prev = prev, f->cur = cur, f->alpha = 1.0f, f->w = sw, f->h = sh, f->out_w = w, f->out_h = h, f->out_fbo = out;
     r_frame_setup(r, f); /* steps and reset, as a drawn frame counts them */
     r_fx_advance(r);
@@ -698,8 +698,9 @@ static bool draw(r_game *r, const g_state *prev, const g_state *cur, float alpha
     if (!ok)
         rs_fail(err, R_ERR_SIZE, "cannot draw a %dx%d frame", w, h);
     int sw = 0, sh = 0;
-    r_scene_size(&r->opts.q, w, h, &sw, &sh);
-    if (!ok || !r_game_prepare(r, cur->stage, err) || !make_targets(r, sw, sh, w, h, err)) {
+    if (ok && (ok = r_game_prepare(r, cur->stage, err))) /* the stage's scene size (r_quality.stage_scene) */
+        r_scene_size(r_scene_pct(&r->opts.q, r->stage.standard_scene_pct), w, h, &sw, &sh);
+    if (!ok || !make_targets(r, sw, sh, w, h, err)) {
         gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)out);
         if (w > 0 && h > 0) {
             gl.Viewport(0, 0, w, h);
@@ -762,8 +763,11 @@ void r_game_passes(r_game *r, bool per_frame, FILE *out)
 void r_game_report(r_game *r, FILE *out)
 {
     r_graph_flush(&r->graph);
-    fprintf(out, "passes (stage %s, %dx%d, %llu frames; gpu: %s%s):\n", r->have_stage ? r->stage.name : "-", r->tw, r->th,
-            (unsigned long long)r->graph.frame, r->graph.gpu_timer ? "GL_TIMESTAMP queries" : "not available, cpu only",
+    char scene[48] = ""; /* the scene drawn smaller (r_quality.scene_pct, the stage's size) */
+    if (r->tw != r->tow || r->th != r->toh)
+        snprintf(scene, sizeof scene, ", the scene at %dx%d", r->tw, r->th);
+    fprintf(out, "passes (stage %s, %dx%d%s, %llu frames; gpu: %s%s):\n", r->have_stage ? r->stage.name : "-", r->tow, r->toh,
+            scene, (unsigned long long)r->graph.frame, r->graph.gpu_timer ? "GL_TIMESTAMP queries" : "not available, cpu only",
             r->graph.serial ? "; software renderer: glFinish after each pass, cpu ms = wall time" : "");
     r_graph_report(&r->graph, out);
 }

@@ -53,11 +53,17 @@ typedef struct r_quality {
     int scene_pct;    /* the scene and every pass before the tone map drawn at this percentage of the output's
                          width and height, 50..100: 0 = 100; the tone map scales it up (bilinear) and the
                          anti-aliasing and the HUD run at the output size */
+    bool stage_scene; /* scene_pct 0: the stage's standard_scene_pct (r_stage.h), measured per stage */
 } r_quality;
 
-/* The scene's size for an output of w x h under q.scene_pct (w x h itself
- * at 0 or 100), at least a pixel each way. */
-void r_scene_size(const r_quality *q, int w, int h, int *sw, int *sh);
+/* The scene's percentage of the output's size under q for a stage whose
+ * standard_scene_pct is stage_pct: q.scene_pct, else the stage's when
+ * q.stage_scene, else 100. */
+int r_scene_pct(const r_quality *q, int stage_pct);
+
+/* The scene's size for an output of w x h at pct percent (w x h itself at
+ * 100), at least a pixel each way. */
+void r_scene_size(int pct, int w, int h, int *sw, int *sh);
 
 /* Zero is the default for every field. */
 typedef struct r_game_opts {

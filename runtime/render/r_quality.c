@@ -9,16 +9,23 @@
 const r_preset r_presets[R_PRESETS] = {
     {"draft", 1.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128, .scene_pct = 60},
      34.0, "the scene at 60% size, the cheaper maps: previews"},
-    {"standard", 1.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128}, 38.0,
-     "1:1, the cheaper maps: the default"},
+    {"standard", 1.0,
+     {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128, .stage_scene = true},
+     38.0, "the stage's scene size, the cheaper maps: the default"},
     {"high", 2.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128}, 44.0,
      "2x2 pixels drawn per output pixel"},
     {"reference", 4.0, {0}, 0.0, "4x4, every knob at full: the measure"},
 };
 
-void r_scene_size(const r_quality *q, int w, int h, int *sw, int *sh)
+int r_scene_pct(const r_quality *q, int stage_pct)
 {
-    int pct = q->scene_pct ? q->scene_pct : 100;
+    if (q->scene_pct)
+        return q->scene_pct;
+    return q->stage_scene && stage_pct > 0 ? stage_pct : 100;
+}
+
+void r_scene_size(int pct, int w, int h, int *sw, int *sh)
+{
     *sw = w, *sh = h;
     if (pct < 100 && w > 0 && h > 0) {
         *sw = (int)(((long)w * pct + 50) / 100), *sh = (int)(((long)h * pct + 50) / 100);

@@ -68,6 +68,7 @@ static const row rows[] = {
     {"flare", K_BOOL, F(flare), 0, 0, "yes"},
     {"shadows", K_BOOL, F(shadows), 0, 0, "yes"},
     {"hdr_format", K_FORMAT, F(hdr_format), 0, 0, "rgba16f"},
+    {"standard_scene_pct", K_INT, F(standard_scene_pct), 50, 100, "100"},
     {"water", K_BOOL, F(water), 0, 0, "no"},
     {"snow", K_BOOL, F(snow), 0, 0, "no"},
     {"fog", K_BOOL, F(fog), 0, 0, "no"},

@@ -81,6 +81,10 @@ typedef struct r_stage {
     bool flare;           /* sun flare when the sun is on screen */
     bool shadows;         /* SSFSM + blurred mipmap projection shadows */
     r_hdr_format hdr_format;
+    /* the scene's size at the standard quality, percent of the output's
+     * (r_quality.stage_scene), 50..100: the smallest that keeps this
+     * stage inside standard's error budget (docs/accuracy.md) */
+    int standard_scene_pct;
 
     /* stage effects (docs/effects.md) */
     bool water, snow, fog, holes;
