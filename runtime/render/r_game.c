@@ -131,9 +131,10 @@ const r_stage *r_game_stage(const r_game *r)
 static void free_targets(r_game *r)
 {
     GLuint tex[] = {r->hdr_tex, r->depth_tex, r->mask_tex[0], r->mask_tex[1], r->b2_tex, r->b4_tex[0],
-                    r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex, r->luma_tex};
+                    r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex, r->luma_tex,
+                    r->sc_tex};
     GLuint fbo[] = {r->hdr_fbo, r->depth_fbo, r->mask_fbo[0], r->mask_fbo[1], r->b2_fbo, r->b4_fbo[0],
-                    r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo};
+                    r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo, r->sc_fbo};
     for (size_t i = 0; i < sizeof tex / sizeof tex[0]; i++)
         if (tex[i])
             gl.DeleteTextures(1, &tex[i]);
@@ -145,7 +146,7 @@ static void free_targets(r_game *r)
             gl.DeleteFramebuffers(1, &fbo[i]);
     r->hdr_tex = r->depth_tex = r->b2_tex = r->sunvis_tex = r->fl_tex = 0;
     r->hdr_fbo = r->depth_fbo = r->b2_fbo = r->sunvis_fbo = r->fl_fbo = 0;
-    r->ldr_tex = r->ldr_fbo = r->luma_tex = 0;
+    r->ldr_tex = r->ldr_fbo = r->luma_tex = r->sc_tex = r->sc_fbo = 0;
     memset(r->mask_tex, 0, sizeof r->mask_tex), memset(r->mask_fbo, 0, sizeof r->mask_fbo);
     memset(r->b4_tex, 0, sizeof r->b4_tex), memset(r->b4_fbo, 0, sizeof r->b4_fbo);
     memset(r->b8_tex, 0, sizeof r->b8_tex), memset(r->b8_fbo, 0, sizeof r->b8_fbo);
@@ -188,6 +189,10 @@ static bool make_targets(r_game *r, int w, int h, int ow, int oh, rs_err *err)
     r->sunvis_fbo = r_fbo_for(r->sunvis_tex, 0, 0);
     r->fl_tex = r_tex2d(GL_RGBA16F, r_half(w, 2), r_half(h, 2), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     r->fl_fbo = r_fbo_for(r->fl_tex, 0, 0);
+    if ((w != ow || h != oh) && !r->opts.q.aa) { /* the tone map at the scene's size, then a linear blit up */
+        r->sc_tex = r_tex2d(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->sc_fbo = r_fbo_for(r->sc_tex, 0, 0);
+    }
     if (r->opts.q.aa) { /* the tone map's image for the AA pass: linear, its walk taps between texels */
         r->ldr_tex = r_tex2d(GL_RGBA8, ow, oh, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->ldr_fbo = r_fbo_for(r->ldr_tex, 0, 0);

@@ -98,6 +98,8 @@ struct r_game {
     GLuint fl_tex, fl_fbo; /* the flare image, quarter size */
     GLuint sunvis_tex, sunvis_fbo;
     GLuint ldr_tex, ldr_fbo; /* the tone map's output when the AA pass runs after it (RGBA8) */
+    GLuint sc_tex, sc_fbo;   /* the tone map's output at the scene's size when that is smaller than the
+                                output's (r_quality.scene_pct) and no AA pass follows: RGBA8, blitted up */
     GLuint luma_tex;         /* beside it (attachment 1): its luma, R8, for the AA pass's early out (r_aa.c) */
     bool aa_gather;          /* the AA pass's early out may use textureGather (GL 4.0 or ARB_texture_gather) */
     int mask_final; /* index of the filtered mask */

@@ -125,11 +125,16 @@ static void run_tonemap(void *u)
     /* the glow: bloom's (with the flare in it), else the flare's own */
     bool bloom = r_ran(f, r, "bloom_blur"), flare = r_ran(f, r, "flare");
     GLuint glow = bloom ? r->b4_tex[0] : flare ? r->fl_tex : 0;
-    bool scaled = f->w != f->out_w || f->h != f->out_h; /* r_quality.scene_pct: the scene drawn smaller */
-    GLuint p = r->prog[P_TONE + (glow ? 1 : 0) + (scaled ? 2 : 0)];
+    /* r_quality.scene_pct: the scene drawn smaller.  Without an AA pass
+     * the tone map runs at the scene's size into sc_tex and a linear blit
+     * scales its 8-bit image up (the blit's taps cost a fraction of the
+     * tone map's at the output's size); the AA pass, which also wants the
+     * luma at the output's size, gets the SCALED variant there instead. */
+    bool scaled = f->w != f->out_w || f->h != f->out_h, at_scene = scaled && r->sc_fbo;
+    GLuint p = r->prog[P_TONE + (glow ? 1 : 0) + (scaled && !at_scene ? 2 : 0)];
     /* with anti-aliasing the AA pass (r_aa.c) writes the output from ldr_tex */
-    gl.BindFramebuffer(GL_FRAMEBUFFER, r->opts.q.aa ? r->ldr_fbo : (GLuint)f->out_fbo);
-    gl.Viewport(0, 0, f->out_w, f->out_h);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, at_scene ? r->sc_fbo : r->opts.q.aa ? r->ldr_fbo : (GLuint)f->out_fbo);
+    gl.Viewport(0, 0, at_scene ? f->w : f->out_w, at_scene ? f->h : f->out_h);
     gl.Disable(GL_DEPTH_TEST);
     gl.Disable(GL_BLEND);
     gl.UseProgram(p);
@@ -140,11 +145,17 @@ static void run_tonemap(void *u)
     gl.Uniform1f(r_loc(p, "u_exposure"), f->exposure);
     gl.Uniform1f(r_loc(p, "u_saturation"), f->saturation);
     gl.Uniform1i(r_loc(p, "u_write_mask"), r->opts.mask);
-    if (scaled)
+    if (scaled && !at_scene)
         gl.Uniform2f(r_loc(p, "u_out"), (float)f->out_w, (float)f->out_h);
     if (glow)
         r_bind_tex(p, "u_glow", 2, GL_TEXTURE_2D, glow);
     r_fullscreen(r);
+    if (at_scene) {
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r->sc_fbo);
+        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)f->out_fbo);
+        gl.BlitFramebuffer(0, 0, f->w, f->h, 0, 0, f->out_w, f->out_h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, (GLuint)f->out_fbo);
+    }
 }
 
 /* The flare image (glow and ghosts along the axis through the centre,
