@@ -11,9 +11,10 @@
 // variant exists only when one of them ran this frame.  With the
 // AA pass after it (AA), it writes the image's luma beside it, as the AA
 // pass's early out reads it (fxaa.frag).  SCALED: the scene was drawn
-// smaller than the output (r_quality.scene_pct); this pass runs at the
-// output's size and reads it bilinearly, so everything after it (the AA
-// pass, the HUD) is at the output's size.
+// smaller than the output (r_quality.scene_pct) and the AA pass follows;
+// this pass runs at the output's size and reads it bilinearly, so the AA
+// pass and the HUD are at the output's size.  Without the AA pass a
+// smaller scene is tone mapped at its own size and blitted up (r_post.c).
 uniform sampler2D u_hdr;
 uniform sampler1D u_lut;
 uniform int u_lut_size;

@@ -51,8 +51,9 @@ typedef struct r_quality {
     int water_grid;   /* water surface quads a side, 16..256: 0 = the module's default */
     int snow_light;   /* the snow's texture-space light map, texels a side, 64..256: 0 = 256 */
     int scene_pct;    /* the scene and every pass before the tone map drawn at this percentage of the output's
-                         width and height, 50..100: 0 = 100; the tone map scales it up (bilinear) and the
-                         anti-aliasing and the HUD run at the output size */
+                         width and height, 50..100: 0 = 100; the tone map too, its 8-bit image then
+                         blitted up (bilinear), and the HUD at the output size (with anti-aliasing the tone
+                         map runs at the output size, reading the scene bilinearly) */
     bool stage_scene; /* scene_pct 0: the stage's standard_scene_pct (r_stage.h), measured per stage */
 } r_quality;
 
