@@ -630,15 +630,11 @@ static int prepare(render_run *run)
 }
 
 /* "640x360", or "640x360, the scene at 480x270" when the quality draws
- * the scene smaller (r_quality.scene_pct, or the stage's own size) */
-static void drawn_at(const render_opts *o, int game_stage, char *out, size_t n)
+ * the scene smaller (r_quality.scene_pct, or stage_pct: the look's own
+ * size, r_stage.standard_scene_pct) */
+static void drawn_at(const render_opts *o, int stage_pct, char *out, size_t n)
 {
     const cap_desc *cd = &o->cd;
-    r_stage look;
-    rs_err err = {0}; /* the render itself reports a stage that does not load */
-    int stage_pct = (o->go.stage_file ? r_stage_load(&look, o->go.stage_file, &err) : r_stage_for_game(&look, game_stage, &err))
-                        ? look.standard_scene_pct
-                        : 100;
     int sw, sh;
     r_scene_size(r_scene_pct(&o->quality->q, stage_pct), cd->src_w, cd->src_h, &sw, &sh);
     if (sw == cd->src_w && sh == cd->src_h)
@@ -718,7 +714,7 @@ static int render_split(render_run *run, int argc, char **argv)
     exe[ne] = 0;
     const cap_desc *cd = &o->cd;
     char drawn[64];
-    drawn_at(o, run->rp.stage, drawn, sizeof drawn);
+    drawn_at(o, look.standard_scene_pct, drawn, sizeof drawn);
     snprintf(what, sizeof what, "%dx%d (drawn at %s, quality %s)", cd->w, cd->h, drawn, o->quality->name);
     /* a replay from standard input: the segments read a copy of it */
     char copy[PATH_MAX] = "";
@@ -780,7 +776,7 @@ static void summary(const render_run *run, const cap_stats *st, const job_render
     const render_opts *o = run->o;
     const cap_desc *cd = &o->cd;
     char said[300], drawn[64];
-    drawn_at(o, run->rp.stage, drawn, sizeof drawn);
+    drawn_at(o, r_game_stage(run->r)->standard_scene_pct, drawn, sizeof drawn); /* the look it drew */
     job_audio_describe(&o->audio, &run->sink, said, sizeof said);
     fprintf(stderr,
             "ringside render: wrote %s: %" PRIu64 " frames %dx%d (drawn at %s, quality %s) in %.1f s, %.1f fps; %s capture, "
