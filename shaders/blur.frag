@@ -1,11 +1,20 @@
 #version 330 core
-// variants: - REACH=1 REACH=2 REACH=3 REACH=4 GLOW GLOW+LEVEL2 GLOW+FLARE GLOW+LEVEL2+FLARE
+// variants: - REACH=1 REACH=2 REACH=3 REACH=4 REACH=4+RGBE REACH=4+RGBE+GLOW REACH=4+RGBE+GLOW+LEVEL2 REACH=4+RGBE+GLOW+FLARE REACH=4+RGBE+GLOW+LEVEL2+FLARE
 // Separable Gaussian (9 taps, sigma 2 texels, as 5 bilinear fetches) along
 // u_dir (one texel of the source in uv units).  Used by the shadow mask,
 // the silhouette mip chain and bloom.  The output has the source's size.
+// RGBE: the source and the output are bloom's RGBA8 levels (rgbe_common.glsl),
+// read texel by texel (REACH) and decoded.
 // GLOW: bloom's last blur also makes the one image the tone map adds (the
 // glow, r_post.c): u_bloom x (this blur + the second level, LEVEL2) + the
-// sun's flare (FLARE), so the tone map taps one texture a pixel, not three.
+// sun's flare (FLARE), so the tone map taps one texture a pixel, not three;
+// the glow itself is RGBA16F (the tone map filters it).
+#ifdef RGBE
+#include "rgbe_common.glsl"
+#endif
+#if defined(GLOW) && !defined(RGBE)
+#error "GLOW reads bloom's RGBE levels"
+#endif
 uniform sampler2D u_src;
 uniform vec2 u_dir;
 #ifdef REACH
@@ -40,9 +49,15 @@ void main()
     // a texel off the edge: the edge's (u_zero_border 0) or zero (1, as
     // the silhouette's CLAMP_TO_BORDER with a zero border)
     int along = u_axis.x != 0 ? p.x : p.y, last = u_axis.x != 0 ? hi.x : hi.y;
-#define SIDE(q, j) texelFetch(u_src, clamp(q, ivec2(0), hi), l) * (u_zero_border == 1 && (j < 0 || j > last) ? 0.0 : 1.0)
+#ifdef RGBE
+#define FETCH(q) vec4(rgbe_texel(u_src, q, hi, l), 1.0)
+#define SIDE(q, j) FETCH(q) // bloom's levels: clamped at the edge
+#else
+#define FETCH(q) texelFetch(u_src, clamp(q, ivec2(0), hi), l)
+#define SIDE(q, j) FETCH(q) * (u_zero_border == 1 && (j < 0 || j > last) ? 0.0 : 1.0)
+#endif
 #define TAP(i) (SIDE(p + i * u_axis, along + i) + SIDE(p - i * u_axis, along - i)) * u_w[i]
-    vec4 c = texelFetch(u_src, p, l) * u_w[0] + TAP(1);
+    vec4 c = FETCH(p) * u_w[0] + TAP(1);
 #if REACH > 1
     c += TAP(2);
 #endif
@@ -61,12 +76,14 @@ void main()
     c += (textureLod(u_src, uv + u_dir * o1, u_lod) + textureLod(u_src, uv - u_dir * o1, u_lod)) * w1;
     c += (textureLod(u_src, uv + u_dir * o2, u_lod) + textureLod(u_src, uv - u_dir * o2, u_lod)) * w2;
 #endif
-#ifndef GLOW
+#if !defined(GLOW) && defined(RGBE)
+    o_color = rgbe_encode(c.rgb);
+#elif !defined(GLOW)
     o_color = c;
 #else
     vec3 g = c.rgb;
 #ifdef LEVEL2
-    g += texture(u_level2, uv).rgb;
+    g += rgbe_bilinear(u_level2, uv, 0);
 #endif
     g *= u_bloom;
 #ifdef FLARE

@@ -286,6 +286,120 @@ static void t_shader_matches_curve_gamma_1(void) { shader_vs_curve(1.0, 1.0f); }
 static void t_shader_saturation_0_is_grey(void) { shader_vs_curve(2.2, 0.0f); }
 static void t_shader_matches_curve_gamma_10(void) { shader_vs_curve(10.0, 1.0f); }
 
+/* ---- bloom's levels: RGBE in RGBA8 (shaders/rgbe_common.glsl) ---- */
+
+/* One pass of downsample.frag (defines) from src into a 1x1 target of
+ * format dst_fmt; out gets the pixel as floats (RGBA8: the bytes / 255). */
+static void down_1x1(const char *defines, GLuint src, GLenum dst_fmt, float out[4])
+{
+    rs_err e = {0};
+    GLuint prog = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "downsample.frag", .defines = defines}, &e);
+    T_ASSERTF(prog, "%s", e.msg);
+    GLuint dst, fbo, vao;
+    gl.GenTextures(1, &dst);
+    gl.BindTexture(GL_TEXTURE_2D, dst);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, dst_fmt, 1, 1, 0, GL_RGBA, GL_FLOAT, NULL);
+    gl.GenFramebuffers(1, &fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, dst, 0);
+    T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    gl.Viewport(0, 0, 1, 1);
+    gl.UseProgram(prog);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, src);
+    gl.Uniform1i(gl.GetUniformLocation(prog, "u_src"), 0);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "u_lod"), 0);
+    gl.Uniform2f(gl.GetUniformLocation(prog, "u_dst"), 1, 1);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "u_threshold"), -1);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "u_scale"), 1);
+    gl.GenVertexArrays(1, &vao);
+    gl.BindVertexArray(vao);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.ReadPixels(0, 0, 1, 1, GL_RGBA, GL_FLOAT, out);
+    T_EQ(gl.GetError(), GL_NO_ERROR);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteVertexArrays(1, &vao);
+    gl.DeleteFramebuffers(1, &fbo);
+    gl.DeleteTextures(1, &dst);
+    gl.DeleteProgram(prog);
+}
+
+static GLuint tex_of(GLenum fmt, int w, int h, const float *px)
+{
+    GLuint t;
+    gl.GenTextures(1, &t);
+    gl.BindTexture(GL_TEXTURE_2D, t);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, fmt, w, h, 0, GL_RGBA, GL_FLOAT, px);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+/* The format as docs/renderer.md states it, worked here without the
+ * shader's code: RGB bytes / 255 x 2^(A byte - 128). */
+static void rgbe_value(const float px[4], double v[3])
+{
+    int k = (int)lround(px[3] * 255);
+    for (int c = 0; c < 3; c++)
+        v[c] = round(px[c] * 255) / 255 * ldexp(1, k - 128);
+}
+
+static void t_bloom_levels_rgbe(void)
+{
+    plat *p = t_context("egl");
+    /* a colour (v, v/3, v/40) at every power of two half floats hold, and between them */
+    double worst = 0;
+    int n = 0;
+    for (double v = 1e-7; v <= 65504; v *= 1.7, n++) {
+        float c[3] = {(float)v, (float)(v / 3), (float)(v / 40)}, src[4 * 4];
+        for (int i = 0; i < 4; i++)
+            src[4 * i] = c[0], src[4 * i + 1] = c[1], src[4 * i + 2] = c[2], src[4 * i + 3] = 1;
+        /* a 2x2 source of one colour: the box down to 1x1 is that colour */
+        GLuint hdr = tex_of(GL_RGBA32F, 2, 2, src);
+        float enc[4], again[4];
+        down_1x1("#define RGBE_OUT 1\n", hdr, GL_RGBA8, enc);
+        double got[3];
+        rgbe_value(enc, got);
+        /* 8 bits of mantissa for the largest channel: within half a step of 2^k / 255, k its power of two */
+        double step = ldexp(1, (int)lround(enc[3] * 255) - 128) / 255;
+        T_ASSERTF(enc[0] >= 0.5f - 1e-6f && enc[0] <= 1, "%g: the largest channel's mantissa %.4f is outside [0.5, 1]", v, enc[0]);
+        for (int ch = 0; ch < 3; ch++) {
+            double d = fabs(got[ch] - c[ch]);
+            T_ASSERTF(d <= 0.5001 * step, "%g channel %d: stored %g (%.2f steps off)", v, ch, got[ch], d / step);
+            worst = fmax(worst, d / c[0]);
+        }
+        /* read back as a level and written again (RGBE_IN): the same bytes */
+        GLuint lvl = tex_of(GL_RGBA8, 1, 1, enc);
+        down_1x1("#define RGBE_IN 1\n#define RGBE_OUT 1\n", lvl, GL_RGBA8, again);
+        for (int ch = 0; ch < 4; ch++)
+            T_ASSERTF(lround(again[ch] * 255) == lround(enc[ch] * 255), "%g: channel %d %ld after a second pass, %ld before", v,
+                      ch, lround(again[ch] * 255), lround(enc[ch] * 255));
+        gl.DeleteTextures(1, &hdr);
+        gl.DeleteTextures(1, &lvl);
+    }
+    /* zero, and what a half float cannot hold (clamped; NaN becomes 0) */
+    const float odd[][3] = {{0, 0, 0}, {1e30f, 1, 0}, {NAN, 2, 0}};
+    const double want[][3] = {{0, 0, 0}, {65504, 1, 0}, {0, 2, 0}};
+    for (int k = 0; k < 3; k++) {
+        float src[16];
+        for (int i = 0; i < 4; i++)
+            src[4 * i] = odd[k][0], src[4 * i + 1] = odd[k][1], src[4 * i + 2] = odd[k][2], src[4 * i + 3] = 1;
+        GLuint hdr = tex_of(GL_RGBA32F, 2, 2, src);
+        float enc[4];
+        down_1x1("#define RGBE_OUT 1\n", hdr, GL_RGBA8, enc);
+        double got[3];
+        rgbe_value(enc, got);
+        for (int ch = 0; ch < 3; ch++)
+            T_ASSERTF(fabs(got[ch] - want[k][ch]) <= 0.004 * fmax(want[k][0], want[k][1]) + 1e-30, "case %d channel %d: %g, want %g",
+                      k, ch, got[ch], want[k][ch]);
+        gl.DeleteTextures(1, &hdr);
+    }
+    fprintf(stderr, "    %d colours, worst error %.3f%% of the largest channel\n", n, 100 * worst);
+    plat_destroy(p);
+}
+
 T_MAIN({"curve_shape", t_curve_shape}, {"curve_known_points", t_curve_known_points},
        {"lut_entries_are_the_curve", t_lut_entries_are_the_curve},
        {"default_lut_error_under_a_tenth_step", t_default_lut_error_under_a_tenth_step},
@@ -295,4 +409,4 @@ T_MAIN({"curve_shape", t_curve_shape}, {"curve_known_points", t_curve_known_poin
        {"shader_saturation_0_is_grey", t_shader_saturation_0_is_grey},
        {"shader_known_points", t_shader_known_points},
        {"shader_matches_curve_gamma_10", t_shader_matches_curve_gamma_10},
-       {"every_gamma_meets_the_goal", t_every_gamma_meets_the_goal})
+       {"every_gamma_meets_the_goal", t_every_gamma_meets_the_goal}, {"bloom_levels_rgbe", t_bloom_levels_rgbe})

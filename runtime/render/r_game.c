@@ -132,9 +132,10 @@ static void free_targets(r_game *r)
 {
     GLuint tex[] = {r->hdr_tex, r->depth_tex, r->mask_tex[0], r->mask_tex[1], r->b2_tex, r->b4_tex[0],
                     r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex, r->luma_tex,
-                    r->sc_tex};
+                    r->sc_tex, r->glow_tex};
     GLuint fbo[] = {r->hdr_fbo, r->depth_fbo, r->mask_fbo[0], r->mask_fbo[1], r->b2_fbo, r->b4_fbo[0],
-                    r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo, r->sc_fbo};
+                    r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo, r->sc_fbo,
+                    r->glow_fbo};
     for (size_t i = 0; i < sizeof tex / sizeof tex[0]; i++)
         if (tex[i])
             gl.DeleteTextures(1, &tex[i]);
@@ -146,7 +147,7 @@ static void free_targets(r_game *r)
             gl.DeleteFramebuffers(1, &fbo[i]);
     r->hdr_tex = r->depth_tex = r->b2_tex = r->sunvis_tex = r->fl_tex = 0;
     r->hdr_fbo = r->depth_fbo = r->b2_fbo = r->sunvis_fbo = r->fl_fbo = 0;
-    r->ldr_tex = r->ldr_fbo = r->luma_tex = r->sc_tex = r->sc_fbo = 0;
+    r->ldr_tex = r->ldr_fbo = r->luma_tex = r->sc_tex = r->sc_fbo = r->glow_tex = r->glow_fbo = 0;
     memset(r->mask_tex, 0, sizeof r->mask_tex), memset(r->mask_fbo, 0, sizeof r->mask_fbo);
     memset(r->b4_tex, 0, sizeof r->b4_tex), memset(r->b4_fbo, 0, sizeof r->b4_fbo);
     memset(r->b8_tex, 0, sizeof r->b8_tex), memset(r->b8_fbo, 0, sizeof r->b8_fbo);
@@ -173,9 +174,10 @@ static bool make_targets(r_game *r, int w, int h, int ow, int oh, rs_err *err)
     for (int i = 0; i < 2; i++) {
         r->mask_tex[i] = r_tex2d(GL_R8, r->mask_w, r->mask_h, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
         r->mask_fbo[i] = r_fbo_for(r->mask_tex[i], 0, 0);
-        r->b4_tex[i] = r_tex2d(GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        /* bloom's levels: RGBE in RGBA8, read texel by texel (rgbe_common.glsl) */
+        r->b4_tex[i] = r_tex2d(GL_RGBA8, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
         r->b4_fbo[i] = r_fbo_for(r->b4_tex[i], 0, 0);
-        r->b8_tex[i] = r_tex2d(GL_RGBA16F, r->b8_w, BLOOM_ROWS / 2, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+        r->b8_tex[i] = r_tex2d(GL_RGBA8, r->b8_w, BLOOM_ROWS / 2, GL_RGBA, GL_UNSIGNED_BYTE, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
         r->b8_fbo[i] = r_fbo_for(r->b8_tex[i], 0, 0);
     }
     for (int k = 2; k < r->bloom_steps; k++) {
@@ -183,6 +185,8 @@ static bool make_targets(r_game *r, int w, int h, int ow, int oh, rs_err *err)
                                    GL_CLAMP_TO_EDGE);
         r->bx_fbo[k - 2] = r_fbo_for(r->bx_tex[k - 2], 0, 0);
     }
+    r->glow_tex = r_tex2d(GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    r->glow_fbo = r_fbo_for(r->glow_tex, 0, 0);
     r->b2_tex = r_tex2d(GL_RGBA16F, r_half(w, 1), r_half(h, 1), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     r->b2_fbo = r_fbo_for(r->b2_tex, 0, 0);
     r->sunvis_tex = r_tex2d(GL_R16F, 1, 1, GL_RED, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
@@ -233,6 +237,9 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_BLUR_TEXELS + 2, "cap_fullscreen.vert", "blur.frag", "#define REACH 3\n"},
         {P_BLUR_TEXELS + 3, "cap_fullscreen.vert", "blur.frag", "#define REACH 4\n"},
         {P_DOWN, "cap_fullscreen.vert", "downsample.frag", NULL},
+        {P_DOWN_RGBE, "cap_fullscreen.vert", "downsample.frag", "#define RGBE_OUT 1\n"},
+        {P_DOWN_RGBE_IN, "cap_fullscreen.vert", "downsample.frag", "#define RGBE_IN 1\n#define RGBE_OUT 1\n"},
+        {P_BLUR_RGBE, "cap_fullscreen.vert", "blur.frag", "#define REACH 4\n#define RGBE 1\n"},
         {P_SUNVIS, "cap_fullscreen.vert", "sun_vis.frag", NULL},
         {P_FLARE, "cap_fullscreen.vert", "flare.frag", NULL},
         {P_HUD, "hud.vert", "hud.frag", NULL},
@@ -240,10 +247,10 @@ static bool build_programs(r_game *r, rs_err *err)
         {P_HUD_2TAPS, "hud.vert", "hud.frag", "#define TAPS 2\n"},
         {P_FXAA, "cap_fullscreen.vert", "fxaa.frag", NULL},
         {P_FXAA_MARK, "cap_fullscreen.vert", "fxaa.frag", "#define MARK 1\n"},
-        {P_GLOW, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n"},
-        {P_GLOW + 1, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define LEVEL2 1\n"},
-        {P_GLOW + 2, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define FLARE 1\n"},
-        {P_GLOW + 3, "cap_fullscreen.vert", "blur.frag", "#define GLOW 1\n#define LEVEL2 1\n#define FLARE 1\n"},
+        {P_GLOW, "cap_fullscreen.vert", "blur.frag", "#define REACH 4\n#define RGBE 1\n#define GLOW 1\n"},
+        {P_GLOW + 1, "cap_fullscreen.vert", "blur.frag", "#define REACH 4\n#define RGBE 1\n#define GLOW 1\n#define LEVEL2 1\n"},
+        {P_GLOW + 2, "cap_fullscreen.vert", "blur.frag", "#define REACH 4\n#define RGBE 1\n#define GLOW 1\n#define FLARE 1\n"},
+        {P_GLOW + 3, "cap_fullscreen.vert", "blur.frag", "#define REACH 4\n#define RGBE 1\n#define GLOW 1\n#define LEVEL2 1\n#define FLARE 1\n"},
         {P_TONE, "cap_fullscreen.vert", "tonemap.frag", NULL},
         {P_TONE + 1, "cap_fullscreen.vert", "tonemap.frag", "#define GLOW 1\n"},
         {P_TONE + 2, "cap_fullscreen.vert", "tonemap.frag", "#define SCALED 1\n"},
@@ -784,7 +791,7 @@ bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)
     if (!strcmp(name, "hdr"))
         tex = r->hdr_tex;
     else if (!strcmp(name, "bloom"))
-        tex = r->b4_tex[0], tw = r->b4_w, th = BLOOM_ROWS;
+        tex = r->glow_tex, tw = r->b4_w, th = BLOOM_ROWS;
     else if (!strcmp(name, "mask"))
         tex = r->mask_tex[r->mask_final], tw = r->mask_w, th = r->mask_h;
     else if (!strncmp(name, "silhouette", 10) && (!name[10] || (name[10] >= '1' && name[10] < '0' + SIL_LEVELS && !name[11]))) {

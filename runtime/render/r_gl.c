@@ -189,9 +189,23 @@ void r_blur_texels_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int 
     r_fullscreen(r);
 }
 
+void r_blur_rgbe_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int w, int h, bool across)
+{
+    float kw[5];
+    int reach = r_blur_kernel(1, kw); /* 4: blur.frag's RGBE variants are REACH 4 */
+    r_blur_setup(p, dst_fbo, src_tex, 0, w, h, across, !across);
+    gl.Uniform2i(r_loc(p, "u_axis"), across, !across);
+    gl.Uniform1fv(r_loc(p, "u_w"), reach + 1, kw);
+    gl.Uniform1i(r_loc(p, "u_zero_border"), 0);
+}
+
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale)
 {
-    GLuint p = r->prog[P_DOWN];
+    r_down_with(r, r->prog[P_DOWN], dst_fbo, src_tex, lod, w, h, threshold, scale);
+}
+
+void r_down_with(r_game *r, GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale)
+{
     gl.BindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
     gl.Viewport(0, 0, w, h);
     gl.UseProgram(p);

@@ -44,7 +44,9 @@ typedef struct prog {
  * without them). */
 enum { P_FIGHTER, P_STAGE, P_STAGE_BUILDING, P_STAGE_HOLE, P_LENS, P_SKY, P_LOOK_END,
        P_DEPTH = P_LOOK_END, P_SIL, P_MASK, P_GROW, P_BLUR, P_BLUR_TEXELS, /* + 3: reaching 1..4 texels */
-       P_DOWN = P_BLUR_TEXELS + 4, P_SUNVIS, P_FLARE, P_HUD, P_HUD_RECT, P_HUD_2TAPS, P_FXAA, P_FXAA_MARK,
+       P_DOWN = P_BLUR_TEXELS + 4, P_DOWN_RGBE, P_DOWN_RGBE_IN, /* into a bloom level (RGBE), and from one too */
+       P_BLUR_RGBE, /* one of bloom's levels (RGBE) across or down */
+       P_SUNVIS, P_FLARE, P_HUD, P_HUD_RECT, P_HUD_2TAPS, P_FXAA, P_FXAA_MARK,
        P_GLOW, /* + 4 variants: bloom's last blur with its second level x the flare (r_post.c) */
        P_TONE = P_GLOW + 4, /* + 1: with the glow; + 2: scaling the scene up (r_quality.scene_pct), + 3 both */
        P_COUNT = P_TONE + 4 };
@@ -91,7 +93,8 @@ struct r_game {
     r_hdr_format tfmt;
     GLuint hdr_tex, depth_tex, hdr_fbo, depth_fbo;
     GLuint mask_tex[2], mask_fbo[2];
-    GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2];
+    /* bloom: b2 and bx RGBA16F, the levels b4 and b8 RGBE in RGBA8 (rgbe_common.glsl), the glow RGBA16F */
+    GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2], glow_tex, glow_fbo;
     GLuint bx_tex[BLOOM_XSTEPS], bx_fbo[BLOOM_XSTEPS]; /* halvings between b2 and b4 (renders over 720 rows) */
     int bloom_steps, b4_w, b8_w; /* hdr -> b4 in bloom_steps steps; b4 BLOOM_ROWS rows, b8 half */
     int mask_w, mask_h;          /* the shadow mask: the render size, or half (q.mask_half) */
@@ -147,6 +150,11 @@ int r_blur_kernel(float k, float w[5]);
 void r_blur_texels_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float dx, float dy,
                         bool zero_border);
 void r_down_into(r_game *r, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
+/* r_down_into with program p: P_DOWN, or the RGBE variants for bloom's levels */
+void r_down_with(r_game *r, GLuint p, GLuint dst_fbo, GLuint src_tex, int lod, int w, int h, float threshold, float scale);
+/* r_blur_setup for blur.frag's RGBE variants (program p): one texel a
+ * step along x (across) or y, read texel by texel, clamped at the edge */
+void r_blur_rgbe_setup(GLuint p, GLuint dst_fbo, GLuint src_tex, int w, int h, bool across);
 /* The bloom pyramid for a w x h render: *steps down from the HDR image
  * to the BLOOM_ROWS level (halvings, the last a resample), *w4 its width. */
 void r_bloom_plan(int w, int h, int *steps, int *w4);
