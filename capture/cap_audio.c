@@ -31,7 +31,9 @@
 #include <string.h>
 #include <strings.h>
 
+#include "cap_seg.h"
 #include "cap_sink.h"
+#include "../runtime/util/rs_progress.h"
 
 #define AAC_DEFAULT 192000
 #define OPUS_DEFAULT 128000
@@ -170,6 +172,22 @@ bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err 
     return true;
 }
 
+/* a packet kept for later (cap_atrack_encode) */
+static bool keep(cap_atrack *t, AVPacket *pkt)
+{
+    if (t->n == t->cap) {
+        size_t cap = t->cap ? 2 * t->cap : 1024;
+        AVPacket **p = realloc(t->pkt, cap * sizeof *p);
+        if (!p)
+            return false;
+        t->pkt = p, t->cap = cap;
+    }
+    if (!(t->pkt[t->n] = av_packet_alloc()))
+        return false;
+    av_packet_move_ref(t->pkt[t->n++], pkt);
+    return true;
+}
+
 static bool drain(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *err)
 {
     for (;;) {
@@ -180,8 +198,12 @@ static bool drain(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *
             return fail_av(err, CAP_ERR_ENCODER, s->path, "audio encoder", r);
         av_packet_rescale_ts(a->pkt, a->ctx->time_base, a->st->time_base);
         a->pkt->stream_index = a->st->index;
-        if ((r = av_interleaved_write_frame(fmt, a->pkt)) < 0)
+        if (a->keep) {
+            if (!keep(a->keep, a->pkt))
+                return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory for the encoded track", s->path);
+        } else if ((r = av_interleaved_write_frame(fmt, a->pkt)) < 0) {
             return fail_av(err, CAP_ERR_WRITE, s->path, "write failed", r);
+        }
     }
 }
 
@@ -240,7 +262,73 @@ void cap_aenc_close(cap_aenc *a)
     avcodec_free_context(&a->ctx);
 }
 
+cap_atrack *cap_atrack_encode(const cap_sink *audio, const char *out, rs_err *err)
+{
+    /* the container the packets are for, without a file: its flags and
+     * name are what cap_aenc_open asks of it */
+    const char *ext = cap_seg_format_of(out);
+    AVFormatContext *fmt = NULL;
+    cap_atrack *t = calloc(1, sizeof *t);
+    if (!t || !ext || avformat_alloc_output_context2(&fmt, NULL, !strcmp(ext, "mkv") ? "matroska" : ext, NULL) < 0) {
+        free(t);
+        rs_fail(err, !t ? CAP_ERR_NOMEM : CAP_ERR_OUTPUT, "%s: %s", out, !t ? "out of memory" : "no container for the track");
+        return NULL;
+    }
+    double t0 = rs_now();
+    cap_av_log_level();
+    cap_aenc a = {0};
+    bool ok = cap_aenc_open(&a, audio, fmt, err);
+    a.keep = t;
+    ok = ok && cap_aenc_finish(&a, audio, fmt, err);
+    if (ok && (!(t->par = avcodec_parameters_alloc()) || avcodec_parameters_copy(t->par, a.st->codecpar) < 0))
+        ok = rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", out);
+    if (ok)
+        t->tb = a.st->time_base;
+    cap_aenc_close(&a);
+    avformat_free_context(fmt);
+    t->secs = rs_now() - t0;
+    if (!ok) {
+        cap_atrack_free(t);
+        return NULL;
+    }
+    return t;
+}
+
+double cap_atrack_secs(const cap_atrack *t)
+{
+    return t ? t->secs : 0;
+}
+
+void cap_atrack_free(cap_atrack *t)
+{
+    if (!t)
+        return;
+    for (size_t i = 0; i < t->n; i++)
+        av_packet_free(&t->pkt[i]);
+    free(t->pkt);
+    avcodec_parameters_free(&t->par);
+    free(t);
+}
+
 #else
+
+cap_atrack *cap_atrack_encode(const cap_sink *audio, const char *out, rs_err *err)
+{
+    (void)audio;
+    rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this build has no FFmpeg libraries, so no audio stream", out);
+    return NULL;
+}
+
+double cap_atrack_secs(const cap_atrack *t)
+{
+    (void)t;
+    return 0;
+}
+
+void cap_atrack_free(cap_atrack *t)
+{
+    (void)t;
+}
 
 bool cap_sink_audio(cap_sink *s, cap_audio_read_fn read, void *u, size_t frames, int64_t bitrate, rs_err *err)
 {

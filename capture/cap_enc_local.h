@@ -37,7 +37,20 @@ typedef struct cap_aenc {
     size_t sent;        /* frames read from the track (the priming's stand-in, then encoded) */
     size_t chunk;       /* the encoder's frame size */
     size_t skip;        /* frames of the track's start that stand in for the priming (AAC in MKV, NUT) */
+    struct cap_atrack *keep; /* set: packets are kept there (cap_atrack_encode), not written */
 } cap_aenc;
+
+/* A track encoded ahead of its container (cap_seg.h): the stream's
+ * parameters and time base as cap_aenc_open set them for the container,
+ * and every packet, in that time base. */
+struct cap_atrack {
+    AVCodecParameters *par;
+    AVRational tb;
+    AVPacket **pkt;
+    size_t n, cap;
+    size_t next; /* the next packet to write (cap_join.c) */
+    double secs; /* how long the encoding took */
+};
 
 /* Adds the audio stream to fmt (before its header is written). */
 bool cap_aenc_open(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *err);

@@ -11,7 +11,8 @@
  * Audio (cap_join_audio): segments carry none; the job's track, mixed
  * once for the joined ticks, is encoded here beside the copied video,
  * up to the end of each packet's tick as it is written (cap_audio.c), so
- * the sound has no seam where the segments meet. */
+ * the sound has no seam where the segments meet; or, encoded ahead
+ * (cap_join_audio_track), its packets written up to the same point. */
 #include "cap_seg.h"
 
 #include <errno.h>
@@ -40,6 +41,8 @@ struct cap_join {
     bool header;
     cap_sink audio; /* audio.audio NULL: no sound */
     cap_aenc a;
+    cap_atrack *track; /* the sound encoded ahead, instead of audio */
+    AVStream *ast;     /* its stream */
 };
 
 static int fail_av(rs_err *err, int id, const char *path, const char *what, int code)
@@ -110,6 +113,13 @@ static bool write_header(cap_join *j, const AVFormatContext *ic, const AVStream 
     j->st->avg_frame_rate = j->st->r_frame_rate = (AVRational){60, 1};
     if (j->audio.audio && !cap_aenc_open(&j->a, &j->audio, j->fmt, err))
         return false;
+    if (j->track) {
+        if (!(j->ast = avformat_new_stream(j->fmt, NULL)))
+            return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", j->d.out);
+        if ((r = avcodec_parameters_copy(j->ast->codecpar, j->track->par)) < 0)
+            return fail_av(err, CAP_ERR_NOMEM, j->d.out, "codec parameters", r);
+        j->ast->time_base = j->track->tb;
+    }
     AVDictionary *opts = NULL;
     if (mp4) /* the index before the frames: plays while it downloads; every metadata key kept */
         av_dict_set(&opts, "movflags", "+faststart+use_metadata_tags", 0);
@@ -118,6 +128,26 @@ static bool write_header(cap_join *j, const AVFormatContext *ic, const AVStream 
     if (r < 0)
         return fail_av(err, CAP_ERR_WRITE, j->d.out, "cannot write the header", r);
     j->header = true;
+    return true;
+}
+
+/* The track's packets encoded ahead up to sample frame upto, as the
+ * encoder fed to there would have given them (cap_aenc_feed: whole
+ * encoder frames; its priming delay holds back what it holds back, and
+ * the muxer interleaves by time either way); all of them when upto is
+ * past the end. */
+static bool write_track(cap_join *j, size_t upto, rs_err *err)
+{
+    cap_atrack *t = j->track;
+    int64_t end = av_rescale_q((int64_t)upto, (AVRational){1, 48000}, t->tb);
+    while (t->next < t->n && t->pkt[t->next]->pts < end) {
+        AVPacket *p = t->pkt[t->next++];
+        av_packet_rescale_ts(p, t->tb, j->ast->time_base);
+        p->stream_index = j->ast->index;
+        int r = av_interleaved_write_frame(j->fmt, p); /* takes the packet's reference */
+        if (r < 0)
+            return fail_av(err, CAP_ERR_WRITE, j->d.out, "write failed", r);
+    }
     return true;
 }
 
@@ -193,7 +223,8 @@ static bool copy_one(cap_join *j, const cap_seg *s, int64_t origin, int reorder,
         k++;
         (*done)++;
         /* the sound up to the end of this packet's tick */
-        if (j->a.ctx && !cap_aenc_feed(&j->a, &j->audio, j->fmt, (size_t)(s->m.first + k - (uint64_t)origin) * 800, err)) {
+        size_t upto = (size_t)(s->m.first + k - (uint64_t)origin) * 800;
+        if ((j->a.ctx && !cap_aenc_feed(&j->a, &j->audio, j->fmt, upto, err)) || (j->track && !write_track(j, upto, err))) {
             *seg_fault = false;
             goto done;
         }
@@ -257,6 +288,8 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
         rs_fail(err, CAP_ERR_ARG, "%s: closed before any segment was copied", j->d.out);
     if (good && j->a.ctx)
         good = cap_aenc_finish(&j->a, &j->audio, j->fmt, err);
+    if (good && j->track)
+        good = write_track(j, SIZE_MAX, err);
     if (good && (r = av_write_trailer(j->fmt)) < 0) /* MP4: moves the index to the front, rewriting the file */
         good = fail_av(err, CAP_ERR_WRITE, j->d.out, "write failed", r);
     if (j->fmt && j->fmt->pb) {
@@ -307,6 +340,11 @@ void cap_join_audio(cap_join *j, const cap_sink *audio)
     j->audio = *audio;
 }
 
+void cap_join_audio_track(cap_join *j, cap_atrack *t)
+{
+    j->track = t;
+}
+
 #else /* no FFmpeg: nothing to join with */
 struct cap_join {
     int unused;
@@ -334,5 +372,10 @@ bool cap_join_close(cap_join *j, bool ok, rs_err *err)
 void cap_join_audio(cap_join *j, const cap_sink *audio)
 {
     (void)j, (void)audio;
+}
+
+void cap_join_audio_track(cap_join *j, cap_atrack *t)
+{
+    (void)j, (void)t;
 }
 #endif

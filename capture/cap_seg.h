@@ -17,7 +17,8 @@
  *   render: cap_seg_seal(seg, key, A, B, hashes)       after the files are in place
  *   join:   j = cap_join_open(&desc)                    output directory writable?
  *           cap_seg_verify(segs, n, &want, bad, ctx)    every segment, and all together
- *           cap_join_audio(j, sink)                     optional: the whole job's track
+ *           cap_join_audio(j, sink)                     optional: the whole job's track,
+ *        or cap_join_audio_track(j, cap_atrack_encode(sink, out))  the same, encoded ahead
  *           cap_join_copy(j, segs, n, &bad)             stream copy
  *           cap_join_close(j, ok)                       faststart, rename into place
  *
@@ -139,6 +140,20 @@ cap_join *cap_join_open(const cap_join_desc *d, rs_err *err);
  * the track covers the joined ticks, 800 sample frames each), encoded as
  * the video is copied, so the sound is one piece across segment joins. */
 void cap_join_audio(cap_join *j, const cap_sink *audio);
+/* The same track encoded ahead, while there is nothing else to do (a
+ * split render encodes it while its segments draw, job_split.c): every
+ * packet in memory (192 kb/s: 1.4 MiB a minute), for a join into a file
+ * named like `out` (its container decides the stream's header and the
+ * encoder's priming, as in cap_join_audio).  The packets are the ones
+ * cap_join_audio would encode, so the joined file is the same.  NULL
+ * with err filled (the track's read failed, or the encoder). */
+typedef struct cap_atrack cap_atrack;
+cap_atrack *cap_atrack_encode(const cap_sink *audio, const char *out, rs_err *err);
+/* Seconds the encoding took. */
+double cap_atrack_secs(const cap_atrack *t);
+void cap_atrack_free(cap_atrack *t);
+/* cap_join_audio from a track encoded ahead; t is borrowed until close. */
+void cap_join_audio_track(cap_join *j, cap_atrack *t);
 /* Stream-copies the verified segments in order: pts continue from one
  * segment to the next (the video starts at pts 0, as any render does),
  * dts = position - the largest B-frame delay, so they rise by one a
