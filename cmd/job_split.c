@@ -404,6 +404,30 @@ static int join(const job_split_desc *d, const child *cs, int n, const char *key
     return RS_EXIT_OK;
 }
 
+/* The summary line, after the notes the first segment printed (an
+ * encoder fallback) that the caller did not print already. */
+static void summary(const job_split_desc *d, const child *cs, int n, uint64_t total, double secs, double secs_join)
+{
+    /* the notes a segment printed (an encoder fallback), once: the first segment's */
+    const char *p = cs[0].tail;
+    while (*p) {
+        const char *nl = strchr(p, '\n');
+        size_t len = nl ? (size_t)(nl - p) : strlen(p);
+        bool said = d->said && d->said[0] && len == 17 + strlen(d->said) && !strncmp(p + 17, d->said, len - 17);
+        if (len && !said && strncmp(p, "ringside render: wrote ", 23) && strncmp(p, "ringside render: warm-up ", 25) &&
+            strncmp(p, "ringside render: poster ", 24))
+            fprintf(stderr, "%.*s\n", (int)len, p);
+        p += len + (nl != NULL);
+    }
+    char said[300], enc[120];
+    job_audio_describe(d->audio, d->sink, said, sizeof said);
+    summary_part(&cs[0], "ringside render: wrote ", "; encoder", enc, sizeof enc);
+    fprintf(stderr,
+            "ringside render: wrote %s: %" PRIu64 " frames %s in %.1f s, %.1f fps; %d segments at once (--jobs %d), joined in "
+            "%.1f s%s%s\n",
+            d->out, total, d->what, secs, secs > 0 ? (double)total / secs : 0.0, n, n, secs_join, said, enc);
+}
+
 int job_split_run(const job_split_desc *d, rs_err *err)
 {
     int n = d->jobs;
@@ -528,26 +552,8 @@ int job_split_run(const job_split_desc *d, rs_err *err)
         }
     }
     double secs = rs_progress_end(&prog), secs_join = rs_now() - t1;
-    if (!d->quiet) {
-        /* the notes a segment printed (an encoder fallback), once: the first segment's */
-        const char *p = cs[0].tail;
-        while (*p) {
-            const char *nl = strchr(p, '\n');
-            size_t len = nl ? (size_t)(nl - p) : strlen(p);
-            bool said = d->said && d->said[0] && len == 17 + strlen(d->said) && !strncmp(p + 17, d->said, len - 17);
-            if (len && !said && strncmp(p, "ringside render: wrote ", 23) && strncmp(p, "ringside render: warm-up ", 25) &&
-                strncmp(p, "ringside render: poster ", 24))
-                fprintf(stderr, "%.*s\n", (int)len, p);
-            p += len + (nl != NULL);
-        }
-        char said[300], enc[120];
-        job_audio_describe(d->audio, d->sink, said, sizeof said);
-        summary_part(&cs[0], "ringside render: wrote ", "; encoder", enc, sizeof enc);
-        fprintf(stderr,
-                "ringside render: wrote %s: %" PRIu64 " frames %s in %.1f s, %.1f fps; %d segments at once (--jobs %d), joined in "
-                "%.1f s%s%s\n",
-                d->out, total, d->what, secs, secs > 0 ? (double)total / secs : 0.0, n, n, secs_join, said, enc);
-    }
+    if (!d->quiet)
+        summary(d, cs, n, total, secs, secs_join);
     status = RS_EXIT_OK;
 done:
     cap_atrack_free(track);
