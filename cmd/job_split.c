@@ -499,7 +499,7 @@ int job_split_run(const job_split_desc *d, rs_err *err)
     bool drawn = mixed && started == n && !stopped && failed >= started;
     rs_err track_err = {0};
     track = ahead_end(&ah, drawn, &track_err);
-    if (drawn && ah.d && !track && track_err.code) { /* the thread ran and failed: its message */
+    if (track_err.code) { /* the thread ran to the end and failed: its message */
         *err = track_err;
         goto done;
     }

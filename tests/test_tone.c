@@ -7,6 +7,7 @@
 
 #include "../runtime/gl/rgl.h"
 #include "../runtime/platform/plat.h"
+#include "../runtime/render/r_fx_core.h"
 #include "../runtime/render/r_shader.h"
 #include "../runtime/render/r_tone.h"
 #include "t.h"
@@ -295,13 +296,7 @@ static void down_1x1(const char *defines, GLuint src, GLenum dst_fmt, float out[
     rs_err e = {0};
     GLuint prog = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "downsample.frag", .defines = defines}, &e);
     T_ASSERTF(prog, "%s", e.msg);
-    GLuint dst, fbo, vao;
-    gl.GenTextures(1, &dst);
-    gl.BindTexture(GL_TEXTURE_2D, dst);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, dst_fmt, 1, 1, 0, GL_RGBA, GL_FLOAT, NULL);
-    gl.GenFramebuffers(1, &fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, dst, 0);
+    GLuint vao, dst = r_tex2d(dst_fmt, 1, 1, GL_RGBA, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE), fbo = r_fbo_for(dst, 0, 0);
     T_EQ(gl.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
     gl.Viewport(0, 0, 1, 1);
     gl.UseProgram(prog);
@@ -324,17 +319,10 @@ static void down_1x1(const char *defines, GLuint src, GLenum dst_fmt, float out[
     gl.DeleteProgram(prog);
 }
 
+/* a w x h float image as the shaders sample bloom's: nearest, clamped */
 static GLuint tex_of(GLenum fmt, int w, int h, const float *px)
 {
-    GLuint t;
-    gl.GenTextures(1, &t);
-    gl.BindTexture(GL_TEXTURE_2D, t);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, fmt, w, h, 0, GL_RGBA, GL_FLOAT, px);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
+    return r_tex2d(fmt, w, h, GL_RGBA, GL_FLOAT, px, GL_NEAREST, GL_CLAMP_TO_EDGE);
 }
 
 /* The format as docs/renderer.md states it, worked here without the
