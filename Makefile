@@ -3,6 +3,7 @@
 #   make            build (installs missing Debian packages first)
 #   make test       build and run every test; ends with "N passed, N failed, N skipped"
 #   make test-service  the service end to end (PostgreSQL, Chromium; docs/service.md)
+#   make web        hls.js from npm, the dashboard's live-stream player (docs/service.md)
 #   make check-layers  fail if a lower layer includes a higher one, or a function or a
 #                      service file outgrows its size (make test runs it too)
 #   make asan       the suites and cases of tests/asan.tier under AddressSanitizer +
@@ -99,7 +100,7 @@ check-layers:
 	@tools/check-layers.sh
 	@tools/check-length.sh
 
-.PHONY: check-layers all test test-service asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
+.PHONY: check-layers all test test-service web asan asan-all debug demo bench install uninstall clean help deps demo-replays fuzz fuzz-run man
 .DEFAULT_GOAL := all
 # keep test objects (they are intermediates of a pattern chain) between builds
 .SECONDARY:
@@ -184,6 +185,7 @@ FUZZ_SRC_config := service/svc_config.c $(FUZZ_CAPTURE) $(FUZZ_UTIL)
 # the HTTP layer's files and what they call (the queue stores' fallbacks)
 FUZZ_SERVICE := service/svc_http_gate.c service/svc_http_routes.c service/svc_http_reply.c service/svc_http_guard.c \
                 service/svc_http_jobs.c service/svc_http_ops.c service/svc_http_recv.c service/svc_http_stream.c \
+                service/svc_http_events.c \
                 service/svc_auth.c capture/cap_hls.c \
                 service/svc_upload.c service/svc_encode.c service/svc_json.c service/svc_log.c service/svc_store.c \
                 service/svc_store_pg.c service/svc_store_sqlite.c service/svc_files.c service/svc_queue_view.c \
@@ -232,9 +234,18 @@ $(BUILD)/tests/simhash-clang: $(SIM_SRC) $(wildcard runtime/game/*.h runtime/rep
 test: $(STAMPS)/test $(STAMPS)/man $(BUILD)/ringside $(TEST_BIN) $(BUILD)/tests/simhash-O0 $(BUILD)/tests/simhash-O2 $(SIMHASH_CLANG)
 	@$(if $(TIER),RS_TIER=$(TIER) )tests/run.sh $(BUILD) $(T)
 
+# hls.js from npm (service/web/package-lock.json): the dashboard's player of
+# live streams in browsers without HLS of their own; the daemon serves it as
+# /hls.js (docs/service.md, "Dashboard").  Needs the npm registry once.
+HLS_JS := service/web/node_modules/hls.js/dist/hls.min.js
+web: $(HLS_JS)
+$(HLS_JS): service/web/package.json service/web/package-lock.json | $(STAMPS)/service
+	cd service/web && npm ci --no-audit --no-fund --loglevel=error
+	@touch $@
+
 # the service end to end: real HTTP, SQLite, a PostgreSQL server started by
 # the tests, headless Chromium on the dashboard (docs/service.md)
-test-service: $(STAMPS)/test $(STAMPS)/service $(BUILD)/ringside $(BUILD)/tests/test_svc_store $(BUILD)/tests/simhash-O2
+test-service: $(STAMPS)/test $(STAMPS)/service $(BUILD)/ringside $(BUILD)/tests/test_svc_store $(BUILD)/tests/simhash-O2 $(HLS_JS)
 	@RS_SUITE=service tests/run.sh $(BUILD) $(T)
 
 # the sanitizers on what finds our memory bugs (tests/asan.tier, docs/testing.md);
@@ -317,6 +328,9 @@ install: $(BUILD)/ringside man
 	install -m 644 demos/*.rsr $(DATA_DIR)/demos/
 	install -m 644 stages/*.stage $(DATA_DIR)/stages/
 	install -m 644 service/dashboard.html $(DATA_DIR)/service/
+	@if [ -f $(HLS_JS) ]; then echo "install -m 644 $(HLS_JS) $(DATA_DIR)/service/hls.min.js"; \
+	    install -m 644 $(HLS_JS) $(DATA_DIR)/service/hls.min.js; \
+	    else echo "install: no $(HLS_JS) ('make web' fetches it): the dashboard plays live streams only where the browser plays HLS itself"; fi
 	install -m 644 $(BUILD)/man/*.1 $(MAN_DIR)/man1/
 	install -m 644 $(BUILD)/man/*.5 $(MAN_DIR)/man5/
 	install -m 644 $(BUILD)/dist/ringside.bash $(COMPL_DIR)/ringside

@@ -177,7 +177,7 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
     }
     /* epoll: no FD_SETSIZE limit, and thousands of idle connections cost
      * nothing per wake-up; each of the pool's threads has its own */
-    unsigned flags = MHD_USE_EPOLL_INTERNAL_THREAD | MHD_USE_ERROR_LOG;
+    unsigned flags = MHD_USE_EPOLL_INTERNAL_THREAD | MHD_USE_ERROR_LOG | MHD_ALLOW_SUSPEND_RESUME;
     if (ai->ai_family == AF_INET6)
         flags |= MHD_USE_IPv6;
     /* strict: HTTP/1.1 without Host and spaces in the request line are
@@ -196,6 +196,8 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
         rs_fail(err, SVC_ERR_LISTEN, "cannot listen on %s (in use, or not an address of this machine?)", d->cfg.listen);
         return NULL;
     }
+    if (!http_events_start(d))
+        svc_log(SVC_LOG_WARN, -1, "no event thread: GET /jobs/events answers 503");
     if (!http_guard_start(d->net))
         svc_log(SVC_LOG_WARN, -1, "no connection reaper thread: header_timeout and min_body_rate are not enforced");
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(mhd, MHD_DAEMON_INFO_BIND_PORT);
@@ -205,8 +207,10 @@ struct MHD_Daemon *svc_http_start(svc_daemon *d, rs_err *err)
 
 void svc_http_stop(svc_daemon *d, struct MHD_Daemon *h)
 {
+    http_events_end(d); /* a suspended connection would keep libmicrohttpd from stopping */
     if (h)
         MHD_stop_daemon(h); /* reports every connection closed first */
+    http_events_free(d);
     http_guard_free(d->net);
     d->net = NULL;
 }

@@ -99,6 +99,7 @@ enum MHD_Result http_submit(svc_daemon *d, struct MHD_Connection *c, req *q)
         svc_log(SVC_LOG_ERROR, -1, "could not queue an upload: %s", err.msg);
         return http_store_error(c, &err);
     }
+    http_events_poke(d);
     if (j.segments > 0)
         svc_log(SVC_LOG_INFO, j.id, "queued %s (%zu bytes, %" PRId64 " frames, %dx%d %s) as %d segments of %d s",
                 j.name, u->len, j.frames_total, j.width, j.height, j.format, j.segments, d->cfg.segment_seconds);
@@ -152,7 +153,7 @@ enum MHD_Result http_job(svc_daemon *d, struct MHD_Connection *c, req *q)
     }
     svc_view_live(d, &j, units, n);
     svc_job_view v;
-    svc_view_job(d, &qv, &j, &v);
+    svc_view_job(d, &qv, &j, units, n, &v);
     svc_view_free(&qv);
     svc_buf b = {0};
     svc_json_job(&b, &j, d->cfg.max_attempts, units, n, &v);
@@ -162,7 +163,7 @@ enum MHD_Result http_job(svc_daemon *d, struct MHD_Connection *c, req *q)
 }
 
 /* ?limit= and ?before=: false with the answer when one is malformed. */
-static bool list_params(struct MHD_Connection *c, long *limit, int64_t *before, enum MHD_Result *ret)
+bool http_list_params(struct MHD_Connection *c, long *limit, int64_t *before, enum MHD_Result *ret)
 {
     int64_t lim;
     const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "limit");
@@ -180,40 +181,77 @@ static bool list_params(struct MHD_Connection *c, long *limit, int64_t *before, 
     return true;
 }
 
+void http_jobs_page_free(http_jobs_page *p)
+{
+    svc_buf_free(&p->b);
+    free(p->ids);
+    free(p->at);
+    p->ids = NULL;
+    p->at = NULL;
+    p->n = 0;
+}
+
+bool http_jobs_page_make(svc_daemon *d, int64_t token_id, int64_t before, long limit, http_jobs_page *p, rs_err *err)
+{
+    memset(p, 0, sizeof *p);
+    svc_job *jobs = calloc((size_t)limit, sizeof *jobs);
+    p->ids = calloc((size_t)limit, sizeof *p->ids);
+    p->at = calloc((size_t)limit + 1, sizeof *p->at);
+    if (!jobs || !p->ids || !p->at) {
+        free(jobs);
+        http_jobs_page_free(p);
+        return rs_fail(err, SVC_ERR_NOMEM, "out of memory");
+    }
+    int n = d->http_store->ops->list(d->http_store, token_id, before, (int)limit, jobs, err);
+    svc_queue_view qv = {0};
+    if (n < 0 || !svc_view_queue(d, jobs, n, &qv, err)) {
+        free(jobs);
+        svc_view_free(&qv);
+        http_jobs_page_free(p);
+        return false;
+    }
+    svc_buf_add(&p->b, "{\"jobs\":[", 9);
+    for (int i = 0; i < n; i++) {
+        svc_view_live(d, &jobs[i], NULL, 0);
+        if (i)
+            svc_buf_add(&p->b, ",", 1);
+        svc_job_view jv;
+        svc_view_job(d, &qv, &jobs[i], NULL, 0, &jv);
+        p->ids[i] = jobs[i].id;
+        p->at[i] = p->b.len;
+        svc_json_job(&p->b, &jobs[i], d->cfg.max_attempts, NULL, 0, &jv);
+        p->at[i + 1] = p->b.len;
+    }
+    p->n = n;
+    svc_view_free(&qv);
+    if (n == limit && n > 0)
+        svc_buf_printf(&p->b, "],\"next\":\"/jobs?before=%" PRId64 "&limit=%ld\"}", jobs[n - 1].id, limit);
+    else
+        svc_buf_add(&p->b, "],\"next\":null}", 14);
+    free(jobs);
+    if (p->b.oom) {
+        http_jobs_page_free(p);
+        return rs_fail(err, SVC_ERR_NOMEM, "out of memory");
+    }
+    return true;
+}
+
 enum MHD_Result http_list(svc_daemon *d, struct MHD_Connection *c, req *q)
 {
     long limit;
     int64_t before;
     enum MHD_Result answer;
-    if (!list_params(c, &limit, &before, &answer))
+    if (!http_list_params(c, &limit, &before, &answer))
         return answer;
-    svc_job *jobs = calloc((size_t)limit, sizeof *jobs);
-    if (!jobs)
-        return http_error(c, SVC_ERR_NOMEM, NULL, NULL, "out of memory");
+    http_jobs_page p;
     rs_err err = {0};
-    int n = d->http_store->ops->list(d->http_store, q->all ? 0 : q->tok.id, before, (int)limit, jobs, &err);
-    svc_queue_view qv = {0};
-    if (n < 0 || !svc_view_queue(d, jobs, n, &qv, &err)) {
-        free(jobs);
-        svc_view_free(&qv);
-        return http_store_error(c, &err);
-    }
-    svc_buf b = {0};
-    svc_buf_add(&b, "{\"jobs\":[", 9);
-    for (int i = 0; i < n; i++) {
-        svc_view_live(d, &jobs[i], NULL, 0);
-        if (i)
-            svc_buf_add(&b, ",", 1);
-        svc_job_view jv;
-        svc_view_job(d, &qv, &jobs[i], &jv);
-        svc_json_job(&b, &jobs[i], d->cfg.max_attempts, NULL, 0, &jv);
-    }
-    svc_view_free(&qv);
-    if (n == limit && n > 0)
-        svc_buf_printf(&b, "],\"next\":\"/jobs?before=%" PRId64 "&limit=%ld\"}\n", jobs[n - 1].id, limit);
-    else
-        svc_buf_add(&b, "],\"next\":null}\n", 15);
-    free(jobs);
+    if (!http_jobs_page_make(d, q->all ? 0 : q->tok.id, before, limit, &p, &err))
+        return err.code == SVC_ERR_NOMEM ? http_error(c, SVC_ERR_NOMEM, NULL, NULL, "out of memory")
+                                         : http_store_error(c, &err);
+    svc_buf b = p.b;
+    p.b = (svc_buf){0};
+    http_jobs_page_free(&p);
+    svc_buf_add(&b, "\n", 1);
     return http_reply_json(c, 200, &b);
 }
 
@@ -235,6 +273,7 @@ static enum MHD_Result delete_finished(svc_daemon *d, struct MHD_Connection *c, 
         return http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL, "no job %" PRId64, id);
     if (r == 2) /* the store's own check: an over job never runs again */
         return http_error(c, SVC_ERR_CONFLICT, NULL, NULL, "job %" PRId64 " is not over", id);
+    http_events_poke(d);
     svc_log(SVC_LOG_INFO, id, "deleted by a client (%s, %d file%s removed)", svc_state_name(j.state), files,
             files == 1 ? "" : "s");
     char body[128];
@@ -250,7 +289,9 @@ static int on_visible(svc_daemon *d, const req *q, svc_job *j, int (*op)(svc_sto
     int r = d->http_store->ops->get(d->http_store, q->m.id, j, err);
     if (r == 1 && !may_see(q, j))
         r = 0;
-    return r == 1 ? op(d->http_store, q->m.id, err) : r;
+    if (r == 1 && (r = op(d->http_store, q->m.id, err)) == 1)
+        http_events_poke(d); /* the event streams show it now */
+    return r;
 }
 
 enum MHD_Result http_cancel(svc_daemon *d, struct MHD_Connection *c, req *q)

@@ -209,6 +209,20 @@ bool http_auth(svc_daemon *d, struct MHD_Connection *c, req *q, enum MHD_Result 
  * when the queue is down, 404 for a missing job or another token's). */
 bool http_job_visible(svc_daemon *d, struct MHD_Connection *c, const req *q, svc_job *j, enum MHD_Result *ret);
 
+/* A page of the job list as GET /jobs answers it ({"jobs":[...],"next":...},
+ * no newline) in b, job i's object at b.p[at[i]..at[i+1]-1] (id ids[i]);
+ * token_id 0: every job. */
+typedef struct http_jobs_page {
+    svc_buf b;
+    int n;
+    int64_t *ids;
+    size_t *at;
+} http_jobs_page;
+bool http_jobs_page_make(svc_daemon *d, int64_t token_id, int64_t before, long limit, http_jobs_page *p, rs_err *err);
+void http_jobs_page_free(http_jobs_page *p);
+/* ?limit= (1..500, default 50) and ?before= (a job id): false with the answer when one is malformed. */
+bool http_list_params(struct MHD_Connection *c, long *limit, int64_t *before, enum MHD_Result *ret);
+
 enum MHD_Result http_submit(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_list(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_job(svc_daemon *d, struct MHD_Connection *c, req *q);
@@ -223,6 +237,22 @@ enum MHD_Result http_retry(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_health(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_metrics(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_dashboard(svc_daemon *d, struct MHD_Connection *c, req *q);
+enum MHD_Result http_hls_js(svc_daemon *d, struct MHD_Connection *c, req *q);
+
+/* --- the event stream (svc_http_events.c) --- */
+
+/* GET /jobs/events: the jobs' changes as Server-Sent Events. */
+enum MHD_Result http_events(svc_daemon *d, struct MHD_Connection *c, req *q);
+/* Its thread; false: out of memory or no thread (the route answers 503). */
+bool http_events_start(svc_daemon *d);
+/* Ends every stream (resumed, so that libmicrohttpd can stop) and the
+ * thread; http_events_free, after libmicrohttpd stopped, the memory. */
+void http_events_end(svc_daemon *d);
+void http_events_free(svc_daemon *d);
+/* Something changed here (an upload, a cancel): the streams look now, not at their next tick. */
+void http_events_poke(svc_daemon *d);
+/* ringside_event_streams for /metrics. */
+void http_events_metrics(svc_daemon *d, svc_buf *b);
 /* An upload's job parameters the form left to the query string, and its
  * file name (the form's, else ?name=, else X-Filename); false
  * (SVC_ERR_BAD_PARAM) for a value longer than its room. */

@@ -1,10 +1,13 @@
 /* svc_http_ops: the routes for operators and their tools: /healthz (for
  * load balancers and the dashboard's form), /metrics (Prometheus text
- * format) and the dashboard page. */
+ * format), the dashboard page and the HLS player it loads (hls.js). */
+#include <fcntl.h>
 #include <inttypes.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #if defined(RS_HAVE_MHD)
 #include "svc_http_local.h"
@@ -107,6 +110,7 @@ enum MHD_Result http_metrics(svc_daemon *d, struct MHD_Connection *c, req *q)
                    "# TYPE ringside_uploads_rejected_total counter\nringside_uploads_rejected_total %" PRIu64 "\n",
                    frames, fps, d->cfg.workers, busy, done, failed, retried, crashes, wd, rejected);
     http_guard_metrics(d->net, &b);
+    http_events_metrics(d, &b);
     if (b.oom)
         return MHD_NO;
     enum MHD_Result r = http_reply(c, 200, "text/plain; version=0.0.4", b.p, b.len);
@@ -128,6 +132,25 @@ enum MHD_Result http_dashboard(svc_daemon *d, struct MHD_Connection *c, req *q)
     enum MHD_Result r = http_reply(c, 200, "text/html; charset=utf-8", html, len);
     free(html);
     return r;
+}
+
+/* hls.js (npm's, installed by `make web`; docs/service.md, "Dashboard"):
+ * the dashboard loads it to play a live stream where the browser has no
+ * HLS of its own.  Open, as the page is. */
+enum MHD_Result http_hls_js(svc_daemon *d, struct MHD_Connection *c, req *q)
+{
+    (void)q;
+    int fd = d->hls_js[0] ? open(d->hls_js, O_RDONLY | O_CLOEXEC) : -1;
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (fd >= 0)
+            close(fd);
+        return http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL,
+                          "hls.js is not installed with this daemon ('make web' fetches it from npm): the dashboard "
+                          "plays live streams only where the browser plays HLS itself");
+    }
+    const http_file f = {.type = "text/javascript; charset=utf-8", .cache = "max-age=3600"};
+    return http_send_file(c, fd, (uint64_t)st.st_size, &f);
 }
 
 #endif

@@ -254,9 +254,13 @@ void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit
     if (v && v->poster && !j->expired)
         svc_buf_printf(b, ",\"poster\":\"/jobs/%lld/poster\"", (long long)j->id);
     svc_buf_printf(b, ",\"log\":\"/jobs/%lld/log\"", (long long)j->id);
-    /* the live stream's playlist, from the first unit on (it lists nothing until then) */
-    if (!j->expired && j->state != SVC_FAILED && j->state != SVC_CANCELLED && svc_encode_streamable(j->format, j->encode))
+    /* the live stream's playlist, from the first unit on (it lists nothing
+     * until then), and how much of the match it lists */
+    if (!j->expired && j->state != SVC_FAILED && j->state != SVC_CANCELLED && svc_encode_streamable(j->format, j->encode)) {
         svc_buf_printf(b, ",\"stream\":\"/jobs/%lld/stream.m3u8\"", (long long)j->id);
+        if (v && v->stream_s >= 0)
+            svc_buf_printf(b, ",\"stream_s\":%.2f", v->stream_s);
+    }
     svc_buf_add(b, "}", 1);
 }
 

@@ -29,6 +29,7 @@ typedef struct svc_job_view {
     double eta_s;           /* queued or running: seconds until done; < 0: unknown */
     int64_t bytes;          /* done: the video's size; < 0: not there */
     bool poster;            /* the poster image exists */
+    double stream_s;        /* seconds of the match its live stream lists, as the queue knows it; < 0: no stream */
 } svc_job_view;
 
 /* The job object of GET /jobs/N.  max_attempts comes from the config;
@@ -40,7 +41,8 @@ typedef struct svc_job_view {
  * The replay's header (stage, players, winner, rounds) is null for a job
  * queued before it was kept; length_s is the replay's; codec the format's
  * encoder (h264, vp9); render_s a finished job's started..finished.  v
- * adds queue_position, eta_s (also for a queued job), bytes and poster. */
+ * adds queue_position, eta_s (also for a queued job), bytes, poster and
+ * stream_s (beside the stream's URL). */
 void svc_json_job(svc_buf *b, const svc_job *j, int max_attempts, const svc_unit *units, int n, const svc_job_view *v);
 /* {"error":"msg"} */
 void svc_json_error(svc_buf *b, const char *msg);

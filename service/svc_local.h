@@ -43,6 +43,7 @@ typedef struct svc_live {
 } svc_live;
 
 typedef struct svc_net svc_net; /* svc_http_guard.c: connections, deadlines, upload budget */
+typedef struct svc_events svc_events; /* svc_http_events.c: the open event streams */
 
 typedef struct svc_daemon {
     svc_config cfg;
@@ -51,9 +52,11 @@ typedef struct svc_daemon {
     char owner[SVC_OWNER_MAX]; /* "host:pid": who holds our leases */
     char exe[1024];        /* this binary: the workers run `ringside render` */
     char dashboard[1024];  /* service/dashboard.html under the data root ("" if not found) */
+    char hls_js[1024];     /* hls.min.js under the data root ("" if not found) */
     volatile sig_atomic_t stop; /* 1: drain; 2: a second signal, stop now */
     unsigned short port;   /* the port actually bound */
     svc_net *net;          /* the HTTP server's connection table (locks itself) */
+    svc_events *events;    /* GET /jobs/events's streams and their thread (locks itself) */
 
     pthread_mutex_t mu;    /* guards everything below */
     bool draining;         /* POST /jobs answers 503 */
@@ -98,7 +101,8 @@ typedef struct svc_daemon {
     X(SUPERVISOR, 500, "the daemon's supervisor stopped on an error")                          \
     X(SEGMENTS, 500, "a job's segments are not all rendered, so it cannot be joined yet")      \
     X(TOKEN_EXISTS, 409, "an API token with that name exists already")                         \
-    X(TOKEN_UNKNOWN, 404, "no API token with that name or id")
+    X(TOKEN_UNKNOWN, 404, "no API token with that name or id")                                 \
+    X(STREAMS, 503, "the daemon holds as many event streams as it takes")
 
 typedef enum svc_error {
     SVC_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC),

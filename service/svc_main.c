@@ -99,12 +99,22 @@ static bool desc_files(svc_daemon *d, const svc_desc *desc, rs_err *err)
             return rs_fail(err, SVC_ERR_SYSTEM, "cannot find this program's path (/proc/self/exe) to run the renderer");
         d->exe[n] = 0;
     }
+    rs_err derr = {0};
+    const char *root = rs_data_dir(&derr);
+    /* hls.js: installed beside the page (make install), or where npm put it in the source tree (make web) */
+    static const char *const hls[] = {"service/hls.min.js", "service/web/node_modules/hls.js/dist/hls.min.js"};
+    for (size_t i = 0; root && i < sizeof hls / sizeof *hls && !d->hls_js[0]; i++) {
+        rs_data_path(root, hls[i], d->hls_js, sizeof d->hls_js);
+        if (access(d->hls_js, R_OK) != 0)
+            d->hls_js[0] = 0;
+    }
+    if (!d->hls_js[0])
+        svc_log(SVC_LOG_INFO, -1, "hls.js was not found ('make web' fetches it): the dashboard plays live streams "
+                                  "only in browsers that play HLS themselves");
     if (desc->dashboard) {
         snprintf(d->dashboard, sizeof d->dashboard, "%s", desc->dashboard);
         return true;
     }
-    rs_err derr = {0};
-    const char *root = rs_data_dir(&derr);
     if (root)
         rs_data_path(root, "service/dashboard.html", d->dashboard, sizeof d->dashboard);
     if (!root || access(d->dashboard, R_OK) != 0) {

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "svc_encode.h"
 #include "svc_queue_view.h"
 
 /* DESIGN (queue position and ETA of a queued job): the claim hands out
@@ -76,9 +77,43 @@ bool svc_view_queue(svc_daemon *d, const svc_job *jobs, int n, svc_queue_view *q
     return qv->n >= 0 && d->http_store->ops->speed(d->http_store, QUEUE_SPEED_JOBS, &qv->speed, err);
 }
 
-void svc_view_job(svc_daemon *d, const svc_queue_view *qv, const svc_job *j, svc_job_view *v)
+/* How much of the match a job's live stream lists, as the queue knows it:
+ * a running split job's done units from tick 0 up to the first that is not
+ * (the units svc_http_stream.c lists, once their indexes read back there);
+ * a whole job's pieces come when it is done.  < 0: no stream. */
+static double stream_seconds(svc_daemon *d, const svc_job *j, const svc_unit *units, int n)
+{
+    if (j->expired || !svc_encode_streamable(j->format, j->encode))
+        return -1;
+    if (j->state == SVC_DONE)
+        return (double)j->frames_total / 60.0;
+    if (j->state != SVC_RUNNING || j->segments <= 0)
+        return j->state == SVC_QUEUED || j->state == SVC_RUNNING ? 0 : -1;
+    svc_unit *own = NULL;
+    if (!units) {
+        rs_err err = {0};
+        if (!(own = calloc((size_t)j->segments + 1, sizeof *own)))
+            return 0;
+        n = d->http_store->ops->units(d->http_store, j->id, own, j->segments + 1, &err);
+        units = own;
+    }
+    int64_t end = 0;
+    for (int i = 0; i < n; i++) {
+        if (units[i].kind == SVC_UNIT_JOIN)
+            continue;
+        if (units[i].first_tick != end || (units[i].state != SVC_DONE && units[i].renders == 0))
+            break;
+        end = units[i].end_tick;
+    }
+    free(own);
+    return (double)end / 60.0;
+}
+
+void svc_view_job(svc_daemon *d, const svc_queue_view *qv, const svc_job *j, const svc_unit *units, int n,
+                  svc_job_view *v)
 {
     *v = (svc_job_view){.eta_s = -1, .bytes = -1};
+    v->stream_s = stream_seconds(d, j, units, n);
     char path[1100];
     struct stat st;
     if (j->state == SVC_DONE && !j->expired) {

@@ -21,7 +21,9 @@ void svc_view_live(svc_daemon *d, svc_job *j, svc_unit *units, int n);
  * either way. */
 bool svc_view_queue(svc_daemon *d, const svc_job *jobs, int n, svc_queue_view *qv, rs_err *err);
 void svc_view_free(svc_queue_view *qv);
-/* What the API shows of job j beyond its row. */
-void svc_view_job(svc_daemon *d, const svc_queue_view *qv, const svc_job *j, svc_job_view *v);
+/* What the API shows of job j beyond its row (units: its units when the
+ * caller has them, n of them; NULL: looked up when needed). */
+void svc_view_job(svc_daemon *d, const svc_queue_view *qv, const svc_job *j, const svc_unit *units, int n,
+                  svc_job_view *v);
 
 #endif

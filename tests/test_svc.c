@@ -1084,6 +1084,7 @@ static void t_http_status_table(void)
         {SVC_ERR_SYSTEM, 500},   {SVC_ERR_DATA_DIR, 500},  {SVC_ERR_LOCKED, 500},   {SVC_ERR_LISTEN, 500},
         {SVC_ERR_NO_HTTP, 500},  {SVC_ERR_NO_TOKENS, 500}, {SVC_ERR_SUPERVISOR, 500}, {SVC_ERR_SEGMENTS, 500},
         {SVC_ERR_TOKEN_EXISTS, 409}, {SVC_ERR_TOKEN_UNKNOWN, 404},
+        {SVC_ERR_STREAMS, 503}, /* the event streams are full: come back */
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
     /* every id is an error status (its row of SVC_ERRORS has one) */
@@ -1195,6 +1196,13 @@ static void t_route_table(void)
     T_ASSERT(!m.route && m.known && m.open && !strcmp(m.methods, "GET"));
     svc_route_match("/metrics", "GET", &m);
     T_ASSERT(m.route && !m.open && !m.route->params[0]);
+    /* the event stream is a path of its own, not a job id; hls.js is open, as the page is */
+    svc_route_match("/jobs/events", "GET", &m);
+    T_ASSERT(m.route && !m.open && !strcmp(m.route->params, "limit,before"));
+    svc_route_match("/jobs/events", "DELETE", &m);
+    T_ASSERT(!m.route && m.known && !strcmp(m.methods, "GET"));
+    svc_route_match("/hls.js", "GET", &m);
+    T_ASSERT(m.route && m.open);
     /* a stream's playlist and pieces: "TICK.ts", the tick without a leading zero */
     svc_route_match("/jobs/7/stream.m3u8", "GET", &m);
     T_ASSERT(m.route && m.id == 7 && !m.open);

@@ -91,5 +91,66 @@ t_no_stream_answers() {
     svc_stop
 }
 
-t_run ${T_ONLY:-watch_while_it_renders no_stream_answers}
+# GET /jobs/events (docs/service.md, "Events"): the page of jobs, then each
+# change of a job on it, pushed; a token's stream shows its own jobs only;
+# a revoked token's stream ends, the 65th stream is refused, and stopping
+# the daemon ends the rest.
+t_events_pushed() {
+    "$RS_BIN" record --ai --quiet --seconds 2 --seed 3 -o a.rsr || return 1
+    alice=$("$RS_BIN" serve token add alice --data d 2>add.err) || { cat add.err; return 1; }
+    bob=$("$RS_BIN" serve token add bob --data d 2>add.err) || { cat add.err; return 1; }
+    svc_start d $SVC_FAST --workers 1 || return 1
+    [ "$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/events")" = 401 ] || { echo "no token: not 401"; return 1; }
+    [ "$(curl -s -o /dev/null -w '%{http_code}' -H "Authorization: Bearer $alice" "$SVC_URL/jobs/events?limit=0")" = 400 ] ||
+        { echo "limit=0: not 400"; return 1; }
+    curl -sN -H "Authorization: Bearer $alice" "$SVC_URL/jobs/events" >a.ev 2>/dev/null &
+    ca=$!
+    curl -sN -H "Authorization: Bearer $bob" "$SVC_URL/jobs/events?limit=1" >b.ev 2>/dev/null &
+    cb=$!
+    i=0
+    until grep -q '^data: {"jobs":\[\],"next":null}$' a.ev && grep -q '^event: jobs$' b.ev; do
+        sleep 0.1; i=$((i + 1)); [ $i -lt 50 ] || { echo "no first page"; cat a.ev b.ev; return 1; }
+    done
+    submit() { curl -s -X POST --data-binary @a.rsr -H "Authorization: Bearer $1" "$SVC_URL/jobs?name=a.rsr" | json_get id; }
+    ia=$(submit "$alice") && ib=$(submit "$bob") || return 1
+    # alice's job comes onto her page, runs and is done: pushed, never polled
+    i=0
+    until grep -q "^data: {\"id\":$ia,\"state\":\"done\"" a.ev; do
+        sleep 0.2; i=$((i + 1)); [ $i -lt 300 ] || { echo "no done event"; tail -c 2000 a.ev; return 1; }
+    done
+    grep -q "^data: {\"jobs\":\[{\"id\":$ia,\"state\":\"queued\"" a.ev || { echo "the job did not come queued onto the page"; return 1; }
+    grep -q "^data: {\"id\":$ia,\"state\":\"running\",.*\"stream_s\":" a.ev || { echo "no running event with stream_s"; return 1; }
+    ! grep -q "\"id\":$ib," a.ev || { echo "alice's stream shows bob's job"; return 1; }
+    i=0
+    until grep -q "\"id\":$ib,\"state\":\"done\"" b.ev; do
+        sleep 0.2; i=$((i + 1)); [ $i -lt 300 ] || { echo "bob's stream: no done event"; tail -c 2000 b.ev; return 1; }
+    done
+    ! grep -q "\"id\":$ia," b.ev || { echo "bob's stream shows alice's job"; return 1; }
+    curl -s -H "Authorization: Bearer $alice" "$SVC_URL/metrics" | grep -qx 'ringside_event_streams 2' ||
+        { echo "metrics:"; curl -s -H "Authorization: Bearer $alice" "$SVC_URL/metrics" | grep event; return 1; }
+    # a revoked token's stream ends within seconds, saying why
+    "$RS_BIN" serve token revoke alice --data d 2>/dev/null || return 1
+    i=0
+    while kill -0 $ca 2>/dev/null; do
+        sleep 0.2; i=$((i + 1)); [ $i -lt 50 ] || { echo "the revoked token's stream goes on"; return 1; }
+    done
+    tail -2 a.ev | grep -qx 'data: {"reason":"the token was revoked"}' || { tail -3 a.ev; return 1; }
+    # at most 64 streams: the 65th is told to come back
+    for n in $(seq 63); do curl -sN -H "Authorization: Bearer $bob" "$SVC_URL/jobs/events" >/dev/null 2>&1 & done
+    i=0
+    until curl -s -H "Authorization: Bearer $bob" "$SVC_URL/metrics" | grep -qx 'ringside_event_streams 64'; do
+        sleep 0.1; i=$((i + 1)); [ $i -lt 100 ] || { echo "64 streams did not open"; return 1; }
+    done
+    c=$(curl -s -o body.txt -D head.txt -w '%{http_code}' -H "Authorization: Bearer $bob" "$SVC_URL/jobs/events")
+    [ "$c" = 503 ] && grep -qi '^retry-after: 5' head.txt && grep -q '64 event streams are open' body.txt ||
+        { echo "the 65th stream: $c $(cat body.txt)"; return 1; }
+    # stopping the daemon ends every stream, at once
+    t0=$(date +%s)
+    svc_stop
+    [ $(($(date +%s) - t0)) -lt 10 ] || { echo "the daemon took $(($(date +%s) - t0)) s to stop with streams open"; return 1; }
+    wait $cb
+    tail -2 b.ev | grep -qx 'data: {"reason":"the daemon is stopping"}' || { tail -3 b.ev; return 1; }
+}
+
+t_run ${T_ONLY:-watch_while_it_renders no_stream_answers events_pushed}
 t_done
