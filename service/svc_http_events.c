@@ -451,6 +451,24 @@ void http_events_end(svc_daemon *d)
     pthread_cond_signal(&e->wake);
     pthread_mutex_unlock(&e->mu);
     pthread_join(e->thread, NULL);
+    /* libmicrohttpd's stop closes connections without sending what waits:
+     * give the streams up to a second to send their end and close */
+    double until = now_s() + 1.0;
+    pthread_mutex_lock(&e->mu);
+    for (;;) {
+        bool open = false;
+        for (ev_stream *s = e->streams; s && !open; s = s->next)
+            open = !s->gone;
+        if (!open || now_s() >= until)
+            break;
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_nsec += 50000000L;
+        ts.tv_sec += ts.tv_nsec / 1000000000L;
+        ts.tv_nsec %= 1000000000L;
+        pthread_cond_timedwait(&e->wake, &e->mu, &ts);
+    }
+    pthread_mutex_unlock(&e->mu);
 }
 
 /* After libmicrohttpd stopped (every response freed): the memory. */

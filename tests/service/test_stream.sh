@@ -147,6 +147,7 @@ t_events_pushed() {
     # stopping the daemon ends every stream, at once
     t0=$(date +%s)
     svc_stop
+    [ "$SVC_RC" = 0 ] || { echo "the daemon exited $SVC_RC"; tail -20 d.log; return 1; }
     [ $(($(date +%s) - t0)) -lt 10 ] || { echo "the daemon took $(($(date +%s) - t0)) s to stop with streams open"; return 1; }
     wait $cb
     tail -2 b.ev | grep -qx 'data: {"reason":"the daemon is stopping"}' || { tail -3 b.ev; return 1; }
