@@ -25,6 +25,11 @@ t_install_and_uninstall() {
         [ -s "$p/$f" ] || { echo "not installed: $f"; return 1; }
     done
     [ -x "$p/bin/ringside" ] || { echo "bin/ringside is not executable"; return 1; }
+    # the dashboard's live player beside its page, when make web fetched it
+    hls=$SRC/service/web/node_modules/hls.js/dist/hls.min.js
+    if [ -f "$hls" ]; then
+        cmp -s "$hls" "$p/share/ringside/service/hls.min.js" || { echo "not installed: share/ringside/service/hls.min.js"; return 1; }
+    fi
     # every demo, shader, stage and doc; a page for every command
     for d in $(cd "$SRC" && echo demos/*.rsr shaders/* stages/*.stage); do
         cmp -s "$SRC/$d" "$p/share/ringside/$d" || { echo "not installed: share/ringside/$d"; return 1; }

@@ -3,7 +3,7 @@
 //
 //   node tests/service/dashboard.mjs --url http://127.0.0.1:PORT --replay FILE.rsr \
 //        --shot OUT.png [--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH]
-//        [--phone-shot PHONE.png] [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]
+//        [--phone-shot PHONE.png] [--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]] [--live [--live-shot LIVE.png]]
 //
 // Opens the page in headless Chromium, uploads the replay, waits for the job's
 // row to reach data-state="done" (failing fast on "failed"/"cancelled"), checks
@@ -27,6 +27,14 @@
 // that token must then see an empty list (not TOKEN's job) and the upload's
 // 429 message must show as the upload's error.
 //
+// The job list must come by push: once the page has opened GET /jobs/events,
+// it must not poll GET /jobs while the job renders.  With --live (an mp4
+// job, quality standard, on a daemon that splits it with a 2 s first
+// segment), "watch live" must show while the job runs, and the player must
+// play the live stream (hls.js, with the token when there is one) past its
+// first 2 s piece before the job is done (screenshot LIVE.png then); "watch"
+// then plays the finished video.
+//
 // Needs playwright-core (cd tests/service && npm ci) and a Chromium binary
 // (default /usr/bin/chromium, Debian's; or $CHROMIUM / --chromium).  The default
 // format is webm (VP9): every Chromium build plays it, while H.264 mp4 needs a
@@ -37,14 +45,15 @@ import path from 'node:path';
 
 const USAGE = 'usage: node tests/service/dashboard.mjs --url URL --replay FILE --shot OUT.png ' +
   '[--timeout S] [--size WxH] [--format webm|mp4] [--chromium PATH] [--phone-shot PHONE.png] ' +
-  '[--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]]';
+  '[--token TOKEN --form-shot FORM.png [--quota-token TOKEN2]] [--live [--live-shot LIVE.png]]';
 
 function parseArgs(argv) {
   const o = { timeout: 120, size: '320x180', format: 'webm', chromium: process.env.CHROMIUM || '/usr/bin/chromium' };
-  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot', 'quota-token', 'phone-shot']);
+  const keys = new Set(['url', 'replay', 'shot', 'timeout', 'size', 'format', 'chromium', 'token', 'form-shot', 'quota-token', 'phone-shot', 'live-shot']);
   for (let i = 0; i < argv.length; i++) {
     let a = argv[i], v;
     if (a === '-h' || a === '--help') { console.log(USAGE); process.exit(0); }
+    if (a === '--live') { o.live = true; continue; }
     if (!a.startsWith('--')) usage(`unexpected argument '${a}'`);
     a = a.slice(2);
     const eq = a.indexOf('=');
@@ -56,6 +65,7 @@ function parseArgs(argv) {
   for (const k of ['url', 'replay', 'shot']) if (!o[k]) usage(`--${k} is required`);
   if (!o.token !== !o['form-shot']) usage('--token and --form-shot go together');
   if (o['quota-token'] && !o.token) usage('--quota-token needs --token');
+  if (o.live && o.format !== 'mp4') usage('--live needs --format mp4 (the live stream is H.264)');
   o.timeout = Number(o.timeout);
   if (!(o.timeout > 0)) usage('--timeout must be a positive number of seconds');
   if (!/^\d+x\d+$/.test(o.size)) usage('--size must be WxH');
@@ -179,6 +189,31 @@ async function layoutFits(page, rowSel, what) {
   return m;
 }
 
+// while the job runs: "watch live" once it shows, then the player's time
+// past the first piece (2 s) with the row still running
+async function watchLive(page, rowSel, live) {
+  if (!live.clicked) {
+    const btn = page.locator(`${rowSel} button.watch`);
+    if (!(await btn.isVisible()) || (await btn.textContent()) !== 'watch live') return;
+    live.tClick = Date.now();
+    await btn.click();
+    live.clicked = true;
+  }
+  const st = await page.evaluate((sel) => {
+    const v = document.getElementById('player'), cap = document.getElementById('player-caption');
+    return { t: v.currentTime, caption: cap.textContent, error: cap.classList.contains('error'),
+      running: (document.querySelector(sel) || {}).dataset?.state === 'running' };
+  }, rowSel);
+  live.time = st.t;
+  live.caption = st.caption;
+  if (st.error) fail(`the live player says: ${st.caption}`);
+  if (st.t > 2.2 && st.running) {
+    live.played = true;
+    live.tPlayed = Date.now();
+    if (live.shot) await page.screenshot({ path: live.shot, fullPage: true });
+  }
+}
+
 async function main() {
   const opt = parseArgs(process.argv.slice(2));
   if (!fs.existsSync(opt.replay)) fail(`replay ${opt.replay} not found`);
@@ -207,6 +242,13 @@ async function main() {
     const page = await browser.newPage({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
     page.setDefaultTimeout(Math.max(1000, Math.min(30_000, left())));
     page.on('pageerror', (e) => pageErrors.push(String(e && e.message || e)));
+    // the requests the page makes: the list must come by push while the job renders
+    const asked = [];
+    page.on('request', (r) => {
+      const u = new URL(r.url());
+      if (r.method() === 'GET' && (u.pathname === '/jobs' || u.pathname === '/jobs/events')) asked.push({ t: Date.now(), path: u.pathname });
+    });
+
     const checkPageErrors = () => { if (pageErrors.length) fail(`JavaScript error in the page: ${pageErrors[0]}`); };
     const ctx = { checkPageErrors, checkTime };
 
@@ -239,7 +281,9 @@ async function main() {
     await waitFor(page, 'the quality menu set from /healthz', () => page.$eval('#upload-quality',
       (s, def) => s.value === def, health.default_quality), ctx);
     await page.setInputFiles('#upload-file', opt.replay);
-    for (const [sel, val] of [['#upload-size', opt.size], ['#upload-format', opt.format], ['#upload-quality', 'draft']]) {
+    // draft renders fast; a live watch needs a job that takes a while after its first piece
+    const quality = opt.live ? 'standard' : 'draft';
+    for (const [sel, val] of [['#upload-size', opt.size], ['#upload-format', opt.format], ['#upload-quality', quality]]) {
       const vals = await page.$$eval(`${sel} option`, (os) => os.map((o) => o.value));
       if (!vals.includes(val)) fail(`${sel} has no option '${val}' (has ${vals.join(', ')})`);
       await page.selectOption(sel, val);
@@ -267,6 +311,7 @@ async function main() {
       v.addEventListener('loadedmetadata', () => { window.__rsMeta++; });
     });
 
+
     // 3. upload, read the job id
     const tUpload = Date.now();
     await page.click('#upload-button');
@@ -281,7 +326,7 @@ async function main() {
       await sleep(100);
     }
     const job = await (await page.request.get(`${opt.url}/jobs/${id}`, opt.token ? { headers: { Authorization: `Bearer ${opt.token}` } } : {})).json();
-    if (job.quality !== 'draft') fail(`the job was queued with quality ${job.quality}, not the 'draft' the form asked for`);
+    if (job.quality !== quality) fail(`the job was queued with quality ${job.quality}, not the '${quality}' the form asked for`);
     if (job.codec !== enc.codec || !job.encode.includes(`crf=${enc.crf}`) || !job.encode.includes(`preset=${enc.preset}`)) {
       fail(`the job was queued with codec ${job.codec}, encode '${job.encode}': not the form's ${JSON.stringify(enc)}`);
     }
@@ -289,6 +334,7 @@ async function main() {
     // 4. wait for the row to be done, watching its progress bar
     const rowSel = `#jobs tr[data-job-id="${id}"]`;
     let samples = 0, increases = 0, last = null, lastState = null, sawRow = false;
+    const live = { clicked: false, played: false, time: 0, caption: '', tClick: 0, tPlayed: 0, shot: opt['live-shot'] };
     for (;;) {
       checkPageErrors();
       if (left() <= 0) {
@@ -324,7 +370,12 @@ async function main() {
       if (row.state === 'failed' || row.state === 'cancelled') {
         fail(`job ${id} ${row.state}: ${row.error || '(no error text)'} [row: ${row.text}]`);
       }
+      if (opt.live && row.state === 'running' && !live.played) await watchLive(page, rowSel, live);
       if (row.state === 'done') {
+        if (opt.live && !live.played) {
+          fail(`job ${id} was done before its live stream played past its first piece (${live.clicked ? `clicked "watch live", ` +
+            `currentTime ${live.time}, caption '${live.caption}'` : '"watch live" never showed'})`);
+        }
         if (!(row.max > 0 && row.value === row.max) && increases === 0) {
           fail(`job ${id} is done but its progress bar never moved (value ${row.value}, max ${row.max})`);
         }
@@ -333,8 +384,14 @@ async function main() {
       await sleep(250);
     }
     const tDone = Date.now();
+    // pushed, not polled: after the event stream opened, at most one list poll (one in flight as it opened)
+    const opened = asked.find((a) => a.path === '/jobs/events');
+    if (!opened) fail('the page never opened GET /jobs/events');
+    const polls = asked.filter((a) => a.path === '/jobs' && a.t > opened.t && a.t >= tUpload && a.t <= tDone).length;
+    if (polls > 1) fail(`the page polled GET /jobs ${polls} times while job ${id} rendered, with its event stream open`);
 
-    // 5. watch it
+    // 5. watch it (the finished video: the live stream stops)
+    await page.evaluate(() => { window.__rsMeta = 0; });
     await page.click(`${rowSel} button.watch`);
     let meta = null;
     for (;;) {
@@ -374,10 +431,10 @@ async function main() {
     if (opt.token && !row.posterSrc.startsWith('blob:')) fail(`with a token the poster came from ${row.posterSrc}`);
     if (!/^temple · cpu vs cpu · /.test(row.match)) fail(`match cell: '${row.match}'`);
     if (!row.output.includes(opt.size) || !row.output.includes(opt.format + '/' + (opt.format === 'webm' ? 'vp9' : 'h264')) ||
-        !/ kB| MB/.test(row.output) || !/ · draft · /.test(row.output)) fail(`output cell: '${row.output}'`);
+        !/ kB| MB/.test(row.output) || (quality === 'draft') !== / · draft · /.test(row.output)) fail(`output cell: '${row.output}'`);
     await page.click(`${rowSel} details.log summary`);
     await waitFor(page, `job ${id}'s log`, () => page.$eval(`${rowSel} + tr.log-row pre`,
-      (pre) => /== render, attempt 1, process \d+: exit status 0/.test(pre.textContent) &&
+      (pre) => /== (segment 0 \(ticks [0-9-]+\): )?render, attempt 1, process \d+: exit status 0/.test(pre.textContent) &&
         /ringside render: wrote /.test(pre.textContent)), ctx);
 
     // 7. screenshot (the table from its first column: opening the log scrolled it)
@@ -408,6 +465,10 @@ async function main() {
 
     const secs = ((tDone - tUpload) / 1000).toFixed(1);
     const dur = Number.isFinite(meta.d) ? meta.d.toFixed(2) : String(meta.d);
+    if (opt.live) {
+      console.log(`dashboard live: "watch live" clicked ${((live.tClick - tUpload) / 1000).toFixed(1)} s after the upload, ` +
+        `played past ${live.time.toFixed(2)} s at ${((live.tPlayed - tUpload) / 1000).toFixed(1)} s, the job done at ${secs} s`);
+    }
     console.log(`dashboard ok${opt.token ? ' with a token' : ''}: job ${id} done in ${secs} s ` +
       `(total ${((Date.now() - t0) / 1000).toFixed(1)} s), ` +
       `video ${meta.w}x${meta.h} ${opt.format} from ${meta.src.split(':')[0]}:, duration ${dur} s, ` +
