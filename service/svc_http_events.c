@@ -92,6 +92,26 @@ static uint64_t fnv1a(const char *p, size_t n)
     return h;
 }
 
+static void stream_free(ev_stream *s)
+{
+    svc_buf_free(&s->out);
+    free(s->ids);
+    free(s->hash);
+    free(s);
+}
+
+/* An absolute CLOCK_REALTIME time ns from now, for pthread_cond_timedwait. */
+static struct timespec deadline_in(long ns)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    ts.tv_sec += ns / 1000000000L;
+    ts.tv_nsec += ns % 1000000000L;
+    ts.tv_sec += ts.tv_nsec / 1000000000L;
+    ts.tv_nsec %= 1000000000L;
+    return ts;
+}
+
 /* --- the connection's side (libmicrohttpd's threads) --- */
 
 /* What is queued, else the end, else suspend until the thread resumes it. */
@@ -166,11 +186,8 @@ enum MHD_Result http_events(svc_daemon *d, struct MHD_Connection *c, req *q)
     long limit;
     int64_t before;
     enum MHD_Result ret;
-    if (!http_list_params(c, &limit, &before, &ret))
+    if (!http_list_params(c, 20 /* the dashboard's page */, &limit, &before, &ret))
         return ret;
-    const char *lim = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "limit");
-    if (!lim)
-        limit = 20; /* the dashboard's page */
     static const http_header again = {"Retry-After", "5"};
     svc_events *e = d->events;
     if (!e)
@@ -197,10 +214,7 @@ enum MHD_Result http_events(svc_daemon *d, struct MHD_Connection *c, req *q)
     }
     pthread_mutex_unlock(&e->mu);
     if (full) {
-        svc_buf_free(&s->out);
-        free(s->ids);
-        free(s->hash);
-        free(s);
+        stream_free(s);
         return http_error(c, SVC_ERR_STREAMS, &again, NULL, "%d event streams are open, the most this daemon keeps",
                           EVENTS_MAX);
     }
@@ -298,10 +312,7 @@ static int gather(svc_events *e, ev_stream ***list)
         if (s->gone) {
             *pp = s->next;
             e->open--;
-            svc_buf_free(&s->out);
-            free(s->ids);
-            free(s->hash);
-            free(s);
+            stream_free(s);
         } else
             pp = &s->next;
     }
@@ -387,17 +398,12 @@ static void *events_main(void *arg)
             continue;
         }
         if (!e->poked) {
-            struct timespec ts;
-            clock_gettime(CLOCK_REALTIME, &ts);
             /* a round that took long (many pages, a slow queue) waits
              * twice as long: the thread keeps to a third of a core */
             long wait_ns = EVENTS_TICK_MS * 1000000L;
             if (spent * 2e9 > (double)wait_ns)
                 wait_ns = spent * 2e9 > 10e9 ? 10000000000L : (long)(spent * 2e9);
-            ts.tv_sec += wait_ns / 1000000000L;
-            ts.tv_nsec += wait_ns % 1000000000L;
-            ts.tv_sec += ts.tv_nsec / 1000000000L;
-            ts.tv_nsec %= 1000000000L;
+            struct timespec ts = deadline_in(wait_ns);
             pthread_cond_timedwait(&e->wake, &e->mu, &ts);
             if (e->stop)
                 break;
@@ -461,11 +467,7 @@ void http_events_end(svc_daemon *d)
             open = !s->gone;
         if (!open || now_s() >= until)
             break;
-        struct timespec ts;
-        clock_gettime(CLOCK_REALTIME, &ts);
-        ts.tv_nsec += 50000000L;
-        ts.tv_sec += ts.tv_nsec / 1000000000L;
-        ts.tv_nsec %= 1000000000L;
+        struct timespec ts = deadline_in(50000000L);
         pthread_cond_timedwait(&e->wake, &e->mu, &ts);
     }
     pthread_mutex_unlock(&e->mu);
@@ -480,10 +482,7 @@ void http_events_free(svc_daemon *d)
     while (e->streams) {
         ev_stream *s = e->streams;
         e->streams = s->next;
-        svc_buf_free(&s->out);
-        free(s->ids);
-        free(s->hash);
-        free(s);
+        stream_free(s);
     }
     pthread_mutex_destroy(&e->mu);
     pthread_cond_destroy(&e->wake);

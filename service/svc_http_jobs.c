@@ -163,7 +163,7 @@ enum MHD_Result http_job(svc_daemon *d, struct MHD_Connection *c, req *q)
 }
 
 /* ?limit= and ?before=: false with the answer when one is malformed. */
-bool http_list_params(struct MHD_Connection *c, long *limit, int64_t *before, enum MHD_Result *ret)
+bool http_list_params(struct MHD_Connection *c, long default_limit, long *limit, int64_t *before, enum MHD_Result *ret)
 {
     int64_t lim;
     const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "limit");
@@ -171,7 +171,7 @@ bool http_list_params(struct MHD_Connection *c, long *limit, int64_t *before, en
         *ret = http_error(c, SVC_ERR_BAD_PARAM, NULL, NULL, "limit '%s': expected 1..500", v);
         return false;
     }
-    *limit = v ? (long)lim : 50;
+    *limit = v ? (long)lim : default_limit;
     v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "before");
     *before = 0;
     if (v && !http_parse_id(v, strlen(v), before)) {
@@ -241,7 +241,7 @@ enum MHD_Result http_list(svc_daemon *d, struct MHD_Connection *c, req *q)
     long limit;
     int64_t before;
     enum MHD_Result answer;
-    if (!http_list_params(c, &limit, &before, &answer))
+    if (!http_list_params(c, 50, &limit, &before, &answer))
         return answer;
     http_jobs_page p;
     rs_err err = {0};

@@ -220,8 +220,8 @@ typedef struct http_jobs_page {
 } http_jobs_page;
 bool http_jobs_page_make(svc_daemon *d, int64_t token_id, int64_t before, long limit, http_jobs_page *p, rs_err *err);
 void http_jobs_page_free(http_jobs_page *p);
-/* ?limit= (1..500, default 50) and ?before= (a job id): false with the answer when one is malformed. */
-bool http_list_params(struct MHD_Connection *c, long *limit, int64_t *before, enum MHD_Result *ret);
+/* ?limit= (1..500, else default_limit) and ?before= (a job id): false with the answer when one is malformed. */
+bool http_list_params(struct MHD_Connection *c, long default_limit, long *limit, int64_t *before, enum MHD_Result *ret);
 
 enum MHD_Result http_submit(svc_daemon *d, struct MHD_Connection *c, req *q);
 enum MHD_Result http_list(svc_daemon *d, struct MHD_Connection *c, req *q);
