@@ -32,8 +32,9 @@
 // job, quality standard, on a daemon that splits it with a 2 s first
 // segment), "watch live" must show while the job runs, and the player must
 // play the live stream (hls.js, with the token when there is one) past its
-// first 2 s piece before the job is done (screenshot LIVE.png then); "watch"
-// then plays the finished video.
+// first 2 s piece before the job is done (screenshot LIVE.png then); when the
+// job is done the finished video must take over at the second the live
+// stream had reached, and "watch" then plays it.
 //
 // Needs playwright-core (cd tests/service && npm ci) and a Chromium binary
 // (default /usr/bin/chromium, Debian's; or $CHROMIUM / --chromium).  The default
@@ -390,7 +391,20 @@ async function main() {
     const polls = asked.filter((a) => a.path === '/jobs' && a.t > opened.t && a.t >= tUpload && a.t <= tDone).length;
     if (polls > 1) fail(`the page polled GET /jobs ${polls} times while job ${id} rendered, with its event stream open`);
 
-    // 5. watch it (the finished video: the live stream stops)
+    // the live player takes the finished video by itself, at the second it had reached
+    if (opt.live) {
+      let st = null;
+      await waitFor(page, 'the finished video to take over from the live stream', async () => {
+        st = await page.evaluate(() => ({ cap: document.getElementById('player-caption').textContent,
+          t: document.getElementById('player').currentTime, d: document.getElementById('player').duration }));
+        return /· \d+\.\d\d s$/.test(st.cap);
+      }, ctx, () => `caption '${st && st.cap}'`);
+      if (!(st.t >= 2) || Math.abs(st.d - job.length_s) > 0.1) {
+        fail(`the finished video took over at ${st.t} s of ${st.d} s: not where the live stream was (past 2.2 s) in the ${job.length_s} s video`);
+      }
+    }
+
+    // 5. watch it (the finished video)
     await page.evaluate(() => { window.__rsMeta = 0; });
     await page.click(`${rowSel} button.watch`);
     let meta = null;
