@@ -1,7 +1,8 @@
 /* pg-blob-bench: how fast a file's bytes go into PostgreSQL and back, two
  * ways a render farm without a shared disk could keep a finished unit's
- * bytes in its queue's database (issue 36, docs/service.md "Several
- * machines"): bytea rows of CHUNK bytes, and a large object.  Built and
+ * bytes in its queue's database (docs/service.md, "Several
+ * machines"): bytea rows of CHUNK bytes (with and without TOAST compression),
+ * and a large object.  Built and
  * run by tools/pg-blob-bench.sh, which starts a throwaway server.
  *
  *   pg-blob-bench CONNINFO FILE [CHUNK_KIB] [RUNS]

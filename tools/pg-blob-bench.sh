@@ -1,8 +1,8 @@
 #!/bin/sh
 # How fast a finished unit's bytes go into PostgreSQL and back: the two ways
 # a farm of daemons without a shared disk could keep them in the queue's
-# database (bytea rows of CHUNK KiB, or a large object), for issue 36's
-# choice (docs/service.md, "Several machines").
+# database (bytea rows of CHUNK KiB, or a large object), for the
+# choice between them (docs/service.md, "Several machines").
 #
 #   tools/pg-blob-bench.sh [-c CHUNK_KIB] [-r RUNS] FILE...
 #
