@@ -30,6 +30,10 @@ assert t == [[0, 120], [120, 360]], t' || { curl -s "$SVC_URL/jobs/$id"; return 
         sleep 0.1; i=$((i + 1)); [ $i -lt 600 ] || { echo "no piece listed in 60 s"; return 1; }
     done
     ! grep -q ENDLIST live.m3u8 || { echo "a running job's playlist has an end"; cat live.m3u8; return 1; }
+    # the job says how much of it can be watched: the first unit's 2 s (or all 6, if the second just finished)
+    ss=$(svc_field "$id" stream_s)
+    [ "$ss" = 2.0 ] || { [ "$ss" = 6.0 ] && [ "$(svc_field "$id" segments.1.state)" = done ]; } ||
+        { echo "stream_s $ss with the first unit listed"; return 1; }
     head -6 live.m3u8 | grep -qx '#EXT-X-PLAYLIST-TYPE:EVENT' && grep -qx '#EXT-X-TARGETDURATION:2' live.m3u8 ||
         { cat live.m3u8; return 1; }
     grep -qx 'stream/0.ts' live.m3u8 || { echo "the first piece is not tick 0's"; cat live.m3u8; return 1; }
@@ -44,6 +48,7 @@ assert t == [[0, 120], [120, 360]], t' || { curl -s "$SVC_URL/jobs/$id"; return 
     svc_wait_state "$id" done 120 || return 1
     curl -sf -o end.m3u8 "$SVC_URL/jobs/$id/stream.m3u8" || return 1
     tail -1 end.m3u8 | grep -qx '#EXT-X-ENDLIST' || { cat end.m3u8; return 1; }
+    [ "$(svc_field "$id" stream_s)" = 6.0 ] || { echo "a done job's stream_s: $(svc_field "$id" stream_s)"; return 1; }
     # it only grew: what was listed is still listed, in the same place
     head -n "$(wc -l <live.m3u8)" end.m3u8 | cmp -s - live.m3u8 || { echo "the playlist changed what it listed"; return 1; }
     # every frame of the video, none twice, straight from the daemon
