@@ -865,8 +865,9 @@ static int hls_finish(render_run *run, job_hls *h, int status)
         return status == RS_EXIT_OK ? RS_EXIT_FAIL : status;
     }
     if (status == RS_EXIT_OK)
-        cli_debug("render", "HLS pieces of %s in %s: the track %.2f s%s, the cut %.2f s", run->o->out, run->o->hls_dir,
-                  h->track_s, h->track_s ? "" : " (made before)", rs_now() - t0);
+        cli_debug("render", "HLS pieces of %s in %s: the track %.2f s%s (waited for %.2f s after the frames), the cut %.2f s",
+                  run->o->out, run->o->hls_dir, h->track_s, h->track_s ? "" : " (made before)", h->wait_s,
+                  rs_now() - t0 - h->wait_s);
     return status;
 }
 

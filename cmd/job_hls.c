@@ -118,8 +118,10 @@ bool job_hls_finish(job_hls *h, bool ok, rs_err *err)
 {
     if (!ok)
         atomic_store(&h->stop, 1);
+    double t0 = rs_now();
     if (h->running)
         pthread_join(h->thread, NULL);
+    h->wait_s = rs_now() - t0;
     h->running = false;
     if (!ok || !h->d.dir)
         return false;

@@ -51,6 +51,7 @@ typedef struct job_hls {
     bool track_ok;
     rs_err track_err;
     double track_s;             /* what making the track took (0: it was there) */
+    double wait_s;              /* what job_hls_finish waited for it after the frames */
 } job_hls;
 
 bool job_hls_start(job_hls *h, const job_hls_desc *d, rs_err *err);
