@@ -35,6 +35,8 @@
 #if defined(RS_HAVE_MHD)
 #include "svc_http_local.h"
 #include "svc_log.h"
+#include "../runtime/util/rs_hash.h"
+#include "../runtime/util/rs_progress.h"
 
 #define EVENTS_TICK_MS 500
 #define EVENTS_PING_S 15.0
@@ -73,24 +75,8 @@ struct svc_events {
     int open;
     bool stop, poked;
     pthread_t thread;
-    bool started;
     uint64_t sent, cut; /* events sent; streams cut for not reading */
 };
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static uint64_t fnv1a(const char *p, size_t n)
-{
-    uint64_t h = 1469598103934665603ull;
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ (unsigned char)p[i]) * 1099511628211ull;
-    return h;
-}
 
 static void stream_free(ev_stream *s)
 {
@@ -173,12 +159,8 @@ static void ev_end(svc_events *e, ev_stream *s, const char *why)
 {
     char line[256];
     int n = snprintf(line, sizeof line, "event: end\ndata: {\"reason\":\"%s\"}\n\n", why);
-    ev_queue(e, s, line, (size_t)n);
+    ev_queue(e, s, line, (size_t)n); /* resumes the connection when it waits */
     s->ending = true;
-    if (s->suspended) {
-        s->suspended = false;
-        MHD_resume_connection(s->c);
-    }
 }
 
 enum MHD_Result http_events(svc_daemon *d, struct MHD_Connection *c, req *q)
@@ -195,12 +177,11 @@ enum MHD_Result http_events(svc_daemon *d, struct MHD_Connection *c, req *q)
     ev_stream *s = calloc(1, sizeof *s);
     if (!s || !(s->ids = calloc((size_t)limit, sizeof *s->ids)) || !(s->hash = calloc((size_t)limit, sizeof *s->hash))) {
         if (s)
-            free(s->ids);
-        free(s);
+            stream_free(s);
         return http_error(c, SVC_ERR_NOMEM, NULL, NULL, "out of memory");
     }
     *s = (ev_stream){.hub = e, .c = c, .token_id = q->all ? 0 : q->tok.id, .token_less = q->all && q->tok.id == 0,
-                     .before = before, .limit = limit, .ids = s->ids, .hash = s->hash, .last_out = now_s()};
+                     .before = before, .limit = limit, .ids = s->ids, .hash = s->hash, .last_out = rs_now()};
     static const char hello[] = "retry: 2000\n\n";
     svc_buf_add(&s->out, hello, sizeof hello - 1);
     pthread_mutex_lock(&e->mu);
@@ -259,7 +240,7 @@ static void look(svc_daemon *d, ev_look *l)
         rs_fail(&l->err, SVC_ERR_NOMEM, "out of memory");
     }
     for (int i = 0; l->ok && i < l->p.n; i++)
-        l->hash[i] = fnv1a(l->p.b.p + l->p.at[i], l->p.at[i + 1] - l->p.at[i]);
+        l->hash[i] = rs_fnv1a64(l->p.b.p + l->p.at[i], l->p.at[i + 1] - l->p.at[i]);
 }
 
 /* What stream s is sent of look l, appended to out: the whole page when
@@ -339,16 +320,15 @@ static void one_round(svc_events *e, ev_stream **list, int n, bool check_tokens)
             nt = -1; /* more than fit: not judged this round */
     }
     ev_look *looks = calloc((size_t)n + 1, sizeof *looks);
-    int *which = calloc((size_t)n + 1, sizeof *which);
     svc_buf *outs = calloc((size_t)n + 1, sizeof *outs);
     const char **why = calloc((size_t)n + 1, sizeof *why);
-    if (!looks || !which || !outs || !why) {
-        free(looks), free(which), free(outs), free(why);
+    if (!looks || !outs || !why) {
+        free(looks), free(outs), free(why);
         return;
     }
     int nl = 0;
     uint64_t events = 0;
-    double t = now_s();
+    double t = rs_now();
     for (int i = 0; i < n; i++) {
         ev_stream *s = list[i];
         if (check_tokens && (why[i] = refused(s, tokens, nt, active)))
@@ -360,7 +340,6 @@ static void one_round(svc_events *e, ev_stream **list, int n, bool check_tokens)
             looks[nl] = (ev_look){.token_id = s->token_id, .before = s->before, .limit = s->limit};
             look(d, &looks[nl++]);
         }
-        which[i] = k;
         if (looks[k].ok)
             diff(s, &looks[k], &outs[i], &events);
         if (outs[i].len == 0 && t - s->last_out >= EVENTS_PING_S)
@@ -383,7 +362,7 @@ static void one_round(svc_events *e, ev_stream **list, int n, bool check_tokens)
     pthread_mutex_unlock(&e->mu);
     for (int k = 0; k < nl; k++)
         look_free(&looks[k]);
-    free(looks), free(which), free(outs), free(why);
+    free(looks), free(outs), free(why);
 }
 
 static void *events_main(void *arg)
@@ -411,13 +390,13 @@ static void *events_main(void *arg)
         e->poked = false;
         int n = gather(e, &list);
         pthread_mutex_unlock(&e->mu);
-        double t = now_s();
+        double t = rs_now();
         bool check = t - checked >= EVENTS_TOKEN_CHECK_S;
         if (check)
             checked = t;
         if (n > 0)
             one_round(e, list, n, check);
-        spent = now_s() - t;
+        spent = rs_now() - t;
         pthread_mutex_lock(&e->mu);
     }
     pthread_mutex_unlock(&e->mu);
@@ -439,7 +418,6 @@ bool http_events_start(svc_daemon *d)
         free(e);
         return false;
     }
-    e->started = true;
     d->events = e;
     return true;
 }
@@ -459,13 +437,13 @@ void http_events_end(svc_daemon *d)
     pthread_join(e->thread, NULL);
     /* libmicrohttpd's stop closes connections without sending what waits:
      * give the streams up to a second to send their end and close */
-    double until = now_s() + 1.0;
+    double until = rs_now() + 1.0;
     pthread_mutex_lock(&e->mu);
     for (;;) {
         bool open = false;
         for (ev_stream *s = e->streams; s && !open; s = s->next)
             open = !s->gone;
-        if (!open || now_s() >= until)
+        if (!open || rs_now() >= until)
             break;
         struct timespec ts = deadline_in(50000000L);
         pthread_cond_timedwait(&e->wake, &e->mu, &ts);
