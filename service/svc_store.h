@@ -85,6 +85,7 @@ const char *svc_state_name(int st);
     X(QUERY, "a statement failed")                                                         \
     X(CONNECTION, "lost the connection to the database and could not reconnect")           \
     X(TOO_LARGE, "the replay is too large to queue")                                       \
+    X(FILE, "a file to store in the queue, or fetched from it, could not be read or written") \
     X(NOMEM, "out of memory")
 
 typedef enum svc_store_error {
@@ -223,6 +224,23 @@ typedef struct svc_pending {
     int64_t frames_left; /* frames_total - frames_done as of the last heartbeat */
 } svc_pending;
 
+/* Files in the queue (docs/service.md, "Several machines").  Daemons
+ * that share no disk keep what a unit made (a segment and its manifest,
+ * hashes and poster; its stream pieces), the finished video with its
+ * hashes and poster, and the render log in the queue's database beside the
+ * replay, by name:
+ *   seg/sI-aK.FMT, seg/sI-aK.FMT.seg, seg/sI-aK.hashes, seg/sI-aK.png
+ *   stream/track.ts, stream/tTICK.ts, stream/uFIRST.idx
+ *   video.FMT, hashes, poster.png, log
+ * and a daemon that needs one it does not have fetches it (svc_files.c).
+ * A name is written once per claim (segments carry their claim), so its
+ * bytes never change once stored, except by the same bytes again. */
+typedef struct svc_file {
+    const char *name; /* in the queue */
+    const char *path; /* on this machine */
+} svc_file;
+#define SVC_FILE_CHUNK (1 << 20) /* the bytes of one row */
+
 typedef struct svc_store svc_store;
 
 typedef struct svc_store_ops {
@@ -280,7 +298,8 @@ typedef struct svc_store_ops {
      * 2: already over (done, failed or cancelled); -1: error. */
     int (*cancel)(svc_store *s, int64_t id, rs_err *err);
     /* Done jobs finished more than age_s ago (the database's clock), not
-     * yet expired, whose video was made on host (done by "host:..."): up
+     * yet expired, whose video was made on host (done by "host:..."; NULL
+     * or "": on any host, for files kept in the queue): up
      * to max ids into out, oldest first.  Returns the count, or -1. */
     int (*expiring)(svc_store *s, int64_t age_s, const char *host, int64_t *out, int max, rs_err *err);
     /* Done job id's files were removed by retention: it says so from now
@@ -320,6 +339,22 @@ typedef struct svc_store_ops {
     /* Tokens not revoked, or -1. */
     int64_t (*token_active)(svc_store *s, rs_err *err);
     bool (*token_usage)(svc_store *s, int64_t token_id, svc_usage *out, rs_err *err);
+    /* Files in the queue (above).  file_put stores files[0..n-1] of job id
+     * in one transaction, each replacing a file of its name; nothing when
+     * keep names a file the job holds already.  1: stored; 2: kept; 0: no
+     * such job, or one that failed or was cancelled; -1: error (a file that
+     * cannot be read: err names it). */
+    int (*file_put)(svc_store *s, int64_t id, const svc_file *files, int n, const char *keep, rs_err *err);
+    /* Job id's file name into path (written beside it and renamed: a
+     * reader of path never sees half).  1: fetched; 0: not stored; -1. */
+    int (*file_get)(svc_store *s, int64_t id, const char *name, const char *path, rs_err *err);
+    /* len bytes added at the end of job id's file name.  1, 0 (no such job), -1. */
+    int (*file_append)(svc_store *s, int64_t id, const char *name, const void *data, size_t len, rs_err *err);
+    /* Job id's files whose names start with prefix ("": all) removed;
+     * returns the rows removed, or -1. */
+    int64_t (*file_drop)(svc_store *s, int64_t id, const char *prefix, rs_err *err);
+    /* The bytes job id holds in the queue, or -1. */
+    int64_t (*file_bytes)(svc_store *s, int64_t id, rs_err *err);
     void (*close)(svc_store *s);
 } svc_store_ops;
 

@@ -430,7 +430,7 @@ static void scrub(char *msg, const char *conninfo)
  * from before units), 4 the units table, 8 the lost-lease column (a queue
  * from before it: sq_schema_lost), 16 jobs.token_id (a queue from before
  * tokens), 32 the tokens table, 64 the replay header's columns (a queue
- * from before them: sq_schema_meta); -1 on error. */
+ * from before them: sq_schema_meta), 128 the job_files table; -1 on error. */
 static int schema_needs(pg_conn *s, rs_err *err)
 {
     sq_res r;
@@ -442,11 +442,12 @@ static int schema_needs(pg_conn *s, rs_err *err)
                " NOT EXISTS (SELECT 1 FROM information_schema.columns"
                " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'token_id'),"
                " to_regclass('tokens') IS NULL, NOT EXISTS (SELECT 1 FROM information_schema.columns"
-               " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'encode')",
+               " WHERE table_schema = current_schema() AND table_name = 'jobs' AND column_name = 'encode'),"
+               " to_regclass('job_files') IS NULL",
                NULL, 0, &r, err) < 0)
         return -1;
     int need = r.rows == 1 ? (int)(r.v[0].i | r.v[1].i << 1 | r.v[2].i << 2 | r.v[3].i << 3 | r.v[4].i << 4 |
-                                   r.v[5].i << 5 | r.v[6].i << 6)
+                                   r.v[5].i << 5 | r.v[6].i << 6 | r.v[7].i << 7)
                            : -1;
     d_res_free(&r);
     return need;
@@ -487,6 +488,7 @@ static bool create_schema(pg_conn *s, rs_err *err)
              (!(need & 15) || sq_schema_lost(&pg_driver, s, PG_HAS_COLUMN, err)) &&
              (!(need & 48) || sq_schema_tokens(&pg_driver, s, "BIGSERIAL PRIMARY KEY", (need & 16) && !(need & 1), err)) &&
              (!(need & 65) || sq_schema_meta(&pg_driver, s, PG_HAS_COLUMN, err)) &&
+             (!(need & 128) || sq_schema_files(&pg_driver, s, "bytea", true, err)) &&
              d_commit(s, err);
         if (!ok) {
             d_rollback(s);

@@ -219,6 +219,11 @@ static const svc_store_ops sq_ops = {
     .token_find = sq_token_find,
     .token_active = sq_token_active,
     .token_usage = sq_token_usage,
+    .file_put = sq_file_put,
+    .file_get = sq_file_get,
+    .file_append = sq_file_append,
+    .file_drop = sq_file_drop,
+    .file_bytes = sq_file_bytes,
     .close = sq_close,
 };
 

@@ -80,6 +80,10 @@ bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool mi
  * sq_schema_lost does.  Old jobs read stage -1: not known. */
 bool sq_schema_meta(const sq_driver *drv, void *c, const char *has_column, rs_err *err);
 
+/* The job_files table (svc_store.h, "Files in the queue"), its data
+ * column of type blob; external true (PostgreSQL): stored out of line
+ * without a compression attempt (video does not compress). */
+bool sq_schema_files(const sq_driver *drv, void *c, const char *blob, bool external, rs_err *err);
 /* sql with @NOW, @LOCK and @SKIP spelt the driver's way, and with dollar
  * true ?N as $N (PostgreSQL).  False when out is too small. */
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar);

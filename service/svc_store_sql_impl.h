@@ -5,6 +5,7 @@
  *   svc_store_sql_units.c   the units' lifecycle: claim, heartbeat, finish,
  *                           release, reap, rejoin
  *   svc_store_sql_tokens.c  API tokens and their use
+ *   svc_store_sql_files.c   a job's files kept in the queue
  *   svc_store_sql_schema.c  tables, migrations, and spelling a statement
  *
  * A read is one call: sq_query runs the statement under the handle's lock
@@ -140,5 +141,11 @@ int sq_token_revoke(svc_store *bs, const char *which, svc_token *out, rs_err *er
 int sq_token_find(svc_store *bs, const char *hash, svc_token *out, rs_err *err);
 int64_t sq_token_active(svc_store *bs, rs_err *err);
 bool sq_token_usage(svc_store *bs, int64_t token_id, svc_usage *out, rs_err *err);
+
+int sq_file_put(svc_store *bs, int64_t id, const svc_file *files, int n, const char *keep, rs_err *err);
+int sq_file_get(svc_store *bs, int64_t id, const char *name, const char *path, rs_err *err);
+int sq_file_append(svc_store *bs, int64_t id, const char *name, const void *data, size_t len, rs_err *err);
+int64_t sq_file_drop(svc_store *bs, int64_t id, const char *prefix, rs_err *err);
+int64_t sq_file_bytes(svc_store *bs, int64_t id, rs_err *err);
 
 #endif

@@ -159,7 +159,7 @@ int sq_expiring(svc_store *bs, int64_t age_s, const char *host, int64_t *out, in
     if (max <= 0)
         return 0;
     char like[SVC_OWNER_MAX + 4];
-    snprintf(like, sizeof like, "%s:%%", host);
+    snprintf(like, sizeof like, host && host[0] ? "%s:%%" : "%%", host ? host : "");
     /* the WHOLE unit or the join made the video: its done_by names the host */
     return sq_query(S(bs), "find expired videos",
                     "SELECT j.id FROM jobs j WHERE j.state = 2 AND j.expired = 0 AND j.finished < @NOW - ?1"
@@ -181,6 +181,7 @@ static bool remove_job(sq_store *s, int64_t id, int64_t now, rs_err *err)
 {
     (void)now;
     return run(s, "remove the units", "DELETE FROM units WHERE job_id = ?1", ARGS(I(id)), NULL, err) >= 0 &&
+           run(s, "remove the stored files", "DELETE FROM job_files WHERE job_id = ?1", ARGS(I(id)), NULL, err) >= 0 &&
            run(s, "remove the job", "DELETE FROM jobs WHERE id = ?1", ARGS(I(id)), NULL, err) >= 0;
 }
 

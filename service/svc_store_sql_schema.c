@@ -104,6 +104,20 @@ bool sq_schema_tokens(const sq_driver *drv, void *c, const char *serial, bool mi
                      NULL, 0, NULL, err) >= 0;
 }
 
+bool sq_schema_files(const sq_driver *drv, void *c, const char *blob, bool external, rs_err *err)
+{
+    char sql[512];
+    snprintf(sql, sizeof sql,
+             "CREATE TABLE IF NOT EXISTS job_files ("
+             " job_id BIGINT NOT NULL, name TEXT NOT NULL, part INTEGER NOT NULL, data %s,"
+             " PRIMARY KEY (job_id, name, part))",
+             blob);
+    return drv->exec(c, "create the job_files table", sql, NULL, 0, NULL, err) >= 0 &&
+           (!external || drv->exec(c, "store files without compressing them",
+                                   "ALTER TABLE job_files ALTER COLUMN data SET STORAGE EXTERNAL", NULL, 0, NULL,
+                                   err) >= 0);
+}
+
 bool sq_spell(char *out, size_t n, const char *sql, const char *now, const char *lock, const char *skip, bool dollar)
 {
     static const char *const names[] = {"@NOW", "@LOCK", "@SKIP"};

@@ -40,8 +40,11 @@ static int owned_unit(sq_store *s, int64_t id, const char *owner, svc_unit *u, r
  * are cancelled, so their owners' heartbeats answer "not ours". */
 bool sq_end_units(sq_store *s, int64_t id, rs_err *err)
 {
+    /* what its units made goes with them; its render log stays */
     return run(s, "cancel the job's units",
                "UPDATE units SET state = 4, claimed_until = 0, fps = 0 WHERE job_id = ?1 AND state IN (0, 1)",
+               ARGS(I(id)), NULL, err) >= 0 &&
+           run(s, "remove the job's stored files", "DELETE FROM job_files WHERE job_id = ?1 AND name <> 'log'",
                ARGS(I(id)), NULL, err) >= 0;
 }
 

@@ -255,6 +255,7 @@ static bool make_schema(sq_conn *c, rs_err *err)
          sq_schema_lost(&sqlite_driver, c, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2", err) &&
          schema_tokens(c, err) &&
          sq_schema_meta(&sqlite_driver, c, "SELECT COUNT(*) FROM pragma_table_info(?1) WHERE name = ?2", err) &&
+         sq_schema_files(&sqlite_driver, c, "BLOB", false, err) &&
          exec_plain(c, "COMMIT", err);
     if (!ok)
         d_rollback(c);
@@ -281,7 +282,7 @@ svc_store *svc_store_sqlite_open(const char *path, rs_err *err)
     sq_res r = {0};
     if (d_exec(c, "look at the tables",
                "SELECT COUNT(*) FROM sqlite_master WHERE name NOT LIKE 'sqlite_%'"
-               " AND name NOT IN ('jobs', 'jobs_state', 'jobs_token', 'units', 'units_state', 'tokens')",
+               " AND name NOT IN ('jobs', 'jobs_state', 'jobs_token', 'units', 'units_state', 'tokens', 'job_files')",
                NULL, 0, &r, err) < 0)
         goto fail;
     int64_t foreign = r.rows == 1 ? r.v[0].i : -1;

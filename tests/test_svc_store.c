@@ -18,6 +18,7 @@
 #include <sys/socket.h>
 
 #include "../runtime/replay/rp.h"
+#include "../runtime/util/rs_file.h"
 #include "../service/svc_store.h"
 #include "t.h"
 
@@ -201,6 +202,80 @@ static void tokens(const char *spec)
     T_EQ(s->ops->token_active(s, &e), 0);
     T_EQ(s->ops->token_find(s, "hash-a", &got, &e), 1);
     T_ASSERT(got.revoked > 0);
+    s->ops->close(s);
+}
+
+/* Files in the queue: a file of two and a half rows comes back byte for
+ * byte, an empty one too; keep stores nothing when its name is there;
+ * appends add to the end; a prefix drops only its names; a cancelled job
+ * keeps only its log and takes no more files; remove takes every row. */
+static void write_file(const char *path, const uint8_t *p, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    T_ASSERT(f && fwrite(p, 1, n, f) == n && fclose(f) == 0);
+}
+
+static void files(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t id = submit(s, "f.rsr", "f", 1);
+    size_t big = SVC_FILE_CHUNK * 2 + SVC_FILE_CHUNK / 2;
+    uint8_t *data = malloc(big);
+    T_ASSERT(data);
+    fill_random(data, big, 7);
+    char a[1100], b[1100], got[1100];
+    snprintf(a, sizeof a, "%s/a.bin", t_tmpdir());
+    snprintf(b, sizeof b, "%s/empty.bin", t_tmpdir());
+    snprintf(got, sizeof got, "%s/got.bin", t_tmpdir());
+    write_file(a, data, big);
+    write_file(b, data, 0);
+    svc_file two[] = {{"seg/s0-a1.mp4", a}, {"seg/s0-a1.hashes", b}};
+    T_EQ(s->ops->file_put(s, id, two, 2, NULL, &e), 1);
+    T_EQ(s->ops->file_bytes(s, id, &e), (int64_t)big);
+    T_EQ(s->ops->file_get(s, id, "seg/s0-a1.mp4", got, &e), 1);
+    size_t n = 0;
+    rs_err fe = {0};
+    uint8_t *back = (uint8_t *)rs_read_file(got, big + 1, &n, &fe);
+    T_ASSERTF(back && n == big && !memcmp(back, data, big), "%s: %zu bytes back of %zu", got, n, big);
+    free(back);
+    T_EQ(s->ops->file_get(s, id, "seg/s0-a1.hashes", got, &e), 1);
+    back = (uint8_t *)rs_read_file(got, 16, &n, &fe);
+    T_ASSERT(back && n == 0);
+    free(back);
+    T_EQ(s->ops->file_get(s, id, "seg/s9-a1.mp4", got, &e), 0);
+    T_EQ(s->ops->file_get(s, id + 100, "seg/s0-a1.mp4", got, &e), 0);
+    /* keep: the name is there, nothing changes; a job that is not: 0 */
+    svc_file other[] = {{"seg/s0-a1.mp4", b}};
+    T_EQ(s->ops->file_put(s, id, other, 1, "seg/s0-a1.mp4", &e), 2);
+    T_EQ(s->ops->file_bytes(s, id, &e), (int64_t)big);
+    T_EQ(s->ops->file_put(s, id + 100, other, 1, NULL, &e), 0);
+    /* a file that cannot be read: an error naming it, nothing stored */
+    svc_file gone[] = {{"poster.png", b}, {"video.mp4", "/nonexistent/x.mp4"}};
+    T_EQ(s->ops->file_put(s, id, gone, 2, NULL, &e), -1);
+    T_ASSERTF(e.code == SVC_STORE_ERR_FILE && strstr(e.msg, "/nonexistent/x.mp4"), "%s", e.msg);
+    T_EQ(s->ops->file_get(s, id, "poster.png", got, &e), 0);
+    /* appends */
+    T_EQ(s->ops->file_append(s, id, "log", "one\n", 4, &e), 1);
+    T_EQ(s->ops->file_append(s, id, "log", "two\n", 4, &e), 1);
+    T_EQ(s->ops->file_get(s, id, "log", got, &e), 1);
+    back = (uint8_t *)rs_read_file(got, 64, &n, &fe);
+    T_ASSERT(back && n == 8 && !memcmp(back, "one\ntwo\n", 8));
+    free(back);
+    /* a prefix drops its names only */
+    T_EQ(s->ops->file_drop(s, id, "seg/s0-a1.h", &e), 1);
+    T_EQ(s->ops->file_get(s, id, "seg/s0-a1.mp4", got, &e), 1);
+    T_EQ(s->ops->file_get(s, id, "seg/s0-a1.hashes", got, &e), 0);
+    /* cancelled: its files go but the log, and a late put stores nothing */
+    T_EQ(s->ops->cancel(s, id, &e), 1);
+    T_EQ(s->ops->file_get(s, id, "seg/s0-a1.mp4", got, &e), 0);
+    T_EQ(s->ops->file_get(s, id, "log", got, &e), 1);
+    T_EQ(s->ops->file_put(s, id, two, 1, NULL, &e), 0);
+    T_EQ(s->ops->file_bytes(s, id, &e), 8);
+    T_EQ(s->ops->remove(s, id, &e), 1);
+    T_EQ(s->ops->file_bytes(s, id, &e), 0);
+    T_EQ(s->ops->file_get(s, id, "log", got, &e), 0);
+    free(data);
     s->ops->close(s);
 }
 
@@ -1366,6 +1441,7 @@ BOTH(split_reap_resumes)
 BOTH(split_rejoin)
 BOTH(split_concurrent)
 BOTH(tokens)
+BOTH(files)
 
 /* --- what each backend refuses, and how it says so --- */
 
@@ -1503,7 +1579,7 @@ T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), 
        CASES(dead_letter), CASES(give_back), CASES(reap), CASES(list_paging), CASES(counts), CASES(persistence),
        CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), CASES(split_plan), CASES(split_run),
        CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin),
-        CASES(split_concurrent), CASES(tokens), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove),
+        CASES(split_concurrent), CASES(tokens), CASES(files), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove),
         CASES(retry_and_queue),
         {"sqlite_bad_files", t_sqlite_bad_files},
        {"pg_unreachable", t_pg_unreachable}, {"pg_foreign_table", t_pg_foreign_table},
