@@ -188,7 +188,8 @@ FUZZ_SERVICE := service/svc_http_gate.c service/svc_http_routes.c service/svc_ht
                 service/svc_http_events.c \
                 service/svc_auth.c capture/cap_hls.c \
                 service/svc_upload.c service/svc_encode.c service/svc_json.c service/svc_log.c service/svc_store.c \
-                service/svc_store_pg.c service/svc_store_sqlite.c service/svc_files.c service/svc_queue_view.c \
+                service/svc_store_pg.c service/svc_store_sqlite.c service/svc_files.c service/svc_keep.c \
+                service/svc_queue_view.c \
                 service/svc_wire.c runtime/replay/rp.c $(wildcard runtime/game/*.c) runtime/render/r_quality.c \
                 $(FUZZ_CAPTURE) $(FUZZ_UTIL)
 FUZZ_SRC_http := $(FUZZ_SERVICE)

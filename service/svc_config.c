@@ -33,7 +33,11 @@ static const c_row rows[] = {
     {"queue", C_STR, OFF(queue), 0, 0, sizeof((svc_config *)0)->queue - 1, "", NULL,
      "sqlite:PATH or postgres://user@host:port/db (default: sqlite:DATA/queue.db)"},
     {"output", C_STR, OFF(output), 0, 0, sizeof((svc_config *)0)->output - 32, "", NULL,
-     "directory for finished videos (default: DATA/videos; shared by every machine of a PostgreSQL queue)"},
+     "directory for finished videos (default: DATA/videos); with files = queue each machine's own"},
+    {"files", C_CHOICE, OFF(files), 0, 0, 0, "auto", "auto|queue|local",
+     "where what a job's units made is kept for the other daemons: queue (in the queue's database, so daemons on "
+     "machines that share no disk join and serve each other's jobs), local (only in the output directory: one "
+     "machine, or an output directory every machine mounts); auto: queue on a PostgreSQL queue, local on SQLite"},
     {"max_upload", C_BYTES, OFF(max_upload), 0, 1024, 64L << 20, "1M", NULL, "largest replay accepted (K and M suffixes)"},
     {"max_seconds", C_INT, OFF(max_seconds), 0, 1, 7 * 24 * 3600, "1800", NULL,
      "longest replay accepted, in seconds of game time (a render takes about as long on a GPU)"},
@@ -353,6 +357,8 @@ bool svc_config_finish(svc_config *c, rs_err *err)
         snprintf(c->queue, sizeof c->queue, "sqlite:%s/queue.db", c->data);
     if (!c->output[0])
         snprintf(c->output, sizeof c->output, "%s/videos", c->data);
+    if (!strcmp(c->files, "auto"))
+        snprintf(c->files, sizeof c->files, "%s", strncmp(c->queue, "postgres", 8) ? "local" : "queue");
     if (c->width > c->max_width || c->height > c->max_height)
         return rs_fail(err, SVC_CONFIG_ERR_SIZE_LIMIT, "size %dx%d is larger than max_size %dx%d", c->width, c->height,
                        c->max_width, c->max_height);

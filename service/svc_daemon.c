@@ -228,6 +228,9 @@ static bool spawn(svc_daemon *d, worker *w, rs_err *err)
         w->nunits = d->store->ops->units(d->store, j->id, w->units, j->segments + 1, err);
         if (w->nunits < 0)
             return false;
+        /* files = queue: segments other machines rendered come from the queue */
+        if (svc_keep_on(&d->cfg) && !svc_fetch_segments(d->store, j, &w->f, w->units, w->nunits, err))
+            return false;
     }
     /* every unit gets the replay: renders draw it, the join mixes its sound */
     if (!rs_mkdirs_for(w->f.replay, err) || !rs_write_part(w->f.replay, j->replay, j->replay_len, err) ||
@@ -408,17 +411,37 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
         return;
     }
     place_poster(d, w);
-    if (j->unit.kind == SVC_UNIT_WHOLE && !svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why))
+    bool stream = true;
+    if (j->unit.kind == SVC_UNIT_WHOLE && !svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why)) {
         svc_log(SVC_LOG_WARN, j->id, "%s (the video is good: it is kept, the stream is not listed)", why);
+        stream = false;
+    }
+    /* files = queue: stored before the done mark, so done means any daemon can serve it */
+    double kept = now_s();
+    if (svc_keep_on(&d->cfg) &&
+        !((j->unit.kind != SVC_UNIT_WHOLE || !stream || svc_keep_stream(d->store, j->id, w->f.stream, 0, &err)) &&
+          svc_keep_video(d->store, &d->cfg, j, &err))) {
+        snprintf(why, sizeof why, "the %s finished but its files could not be kept in the queue: %s",
+                 j->unit.kind == SVC_UNIT_JOIN ? "join" : "render", err.msg);
+        give_back_local(d, w, why);
+        return;
+    }
     int64_t frames = j->unit.kind == SVC_UNIT_JOIN ? j->frames_total : w->total;
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, frames, &err);
     if (r == 1) {
+        /* the segments are in the video now: the queue keeps them no longer */
+        if (j->unit.kind == SVC_UNIT_JOIN && svc_keep_on(&d->cfg) &&
+            d->store->ops->file_drop(d->store, j->id, "seg/", &err) < 0)
+            svc_log(SVC_LOG_WARN, j->id, "could not remove its segments from the queue: %s", err.msg);
+        char q[64] = "";
+        if (svc_keep_on(&d->cfg))
+            snprintf(q, sizeof q, "; kept in the queue in %.0f ms", (now_s() - kept) * 1000);
         if (j->unit.kind == SVC_UNIT_JOIN)
-            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames from %d segments (joined in %.1f s)", video,
-                    frames, j->segments, secs);
+            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames from %d segments (joined in %.1f s%s)", video,
+                    frames, j->segments, secs, q);
         else
-            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames in %.1f s (%.1f fps)", video, frames, secs,
-                    secs > 0 ? (double)frames / secs : 0.0);
+            svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames in %.1f s (%.1f fps%s)", video, frames, secs,
+                    secs > 0 ? (double)frames / secs : 0.0, q);
         count(d, &d->jobs_done);
     } else if (r == 0) {
         /* cancelled meanwhile: its files go; finished by another daemon
@@ -446,13 +469,26 @@ static bool finished_segment(svc_daemon *d, worker *w, double secs)
         return false; /* retried like a crash */
     }
     char why[SVC_ERROR_MAX];
-    if (!svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why)) /* a viewer never gets a piece that is not whole */
+    bool stream = svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why);
+    if (!stream) /* a viewer never gets a piece that is not whole */
         svc_log(SVC_LOG_WARN, j->id, "%s%s (the segment is good: it is kept, the stream stops before it)", ctx(w), why);
+    /* files = queue: stored before the done mark, so a done segment can be joined anywhere */
+    double kept = now_s();
+    if (svc_keep_on(&d->cfg) &&
+        !(svc_keep_segment(d->store, j, &w->f, &err) &&
+          (!stream || svc_keep_stream(d->store, j->id, w->f.stream, (uint64_t)j->unit.first_tick, &err)))) {
+        snprintf(why, sizeof why, "the segment finished but its files could not be kept in the queue: %s", err.msg);
+        give_back_local(d, w, why);
+        return true;
+    }
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
     if (r == 1) {
         w->keep = true;
-        svc_log(SVC_LOG_INFO, j->id, "%sdone, %" PRId64 " frames in %.1f s (%.1f fps)", ctx(w), w->total, secs,
-                secs > 0 ? (double)w->total / secs : 0.0);
+        char q[64] = "";
+        if (svc_keep_on(&d->cfg))
+            snprintf(q, sizeof q, "; kept in the queue in %.0f ms", (now_s() - kept) * 1000);
+        svc_log(SVC_LOG_INFO, j->id, "%sdone, %" PRId64 " frames in %.1f s (%.1f fps%s)", ctx(w), w->total, secs,
+                secs > 0 ? (double)w->total / secs : 0.0, q);
     } else if (r == 0)
         svc_log(SVC_LOG_WARN, j->id, "%sfinished, but it is no longer ours (cancelled or re-claimed)", ctx(w));
     else
@@ -470,8 +506,13 @@ static void bad_segments(svc_daemon *d, worker *w)
     snprintf(why, sizeof why, "the join found bad segment files: %s", w->bad_why);
     for (int i = 0; i < w->nbad; i++)
         for (int k = 0; k < w->nunits; k++)
-            if (w->units[k].kind == SVC_UNIT_SEGMENT && w->units[k].index == w->bad[i])
+            if (w->units[k].kind == SVC_UNIT_SEGMENT && w->units[k].index == w->bad[i]) {
                 svc_segment_remove(w->f.segdir, w->bad[i], w->units[k].done_attempt);
+                char name[64];
+                snprintf(name, sizeof name, "seg/s%d-a%d.", w->bad[i], w->units[k].done_attempt);
+                if (svc_keep_on(&d->cfg) && d->store->ops->file_drop(d->store, j->id, name, &err) < 0)
+                    svc_log(SVC_LOG_WARN, j->id, "join: could not remove a bad segment from the queue: %s", err.msg);
+            }
     int r = d->store->ops->rejoin(d->store, j->id, w->owner, w->bad, w->nbad, why, d->cfg.max_attempts, &err);
     if (r < 0)
         svc_log(SVC_LOG_ERROR, j->id, "join: could not send the bad segments back: %s", err.msg);
@@ -514,7 +555,13 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
         int k = snprintf(block, sizeof block, "== %s%s, attempt %d, process %d: %s after %.1f s ==\n", ctx(w),
                          kind == SVC_UNIT_JOIN ? "join" : "render", j->unit.claim, (int)w->pid, how, secs);
         size_t len = (size_t)k + log_text(w, block + k, sizeof block - (size_t)k);
-        svc_job_log_append(&d->cfg, j->id, block, len);
+        /* files = queue: in the queue, where any daemon reads it */
+        if (!svc_keep_on(&d->cfg) || d->store->ops->file_append(d->store, j->id, "log", block, len, &err) < 0) {
+            if (err.msg[0])
+                svc_log(SVC_LOG_WARN, j->id, "the render log goes to this machine only: %s", err.msg);
+            svc_job_log_append(&d->cfg, j->id, block, len);
+        }
+        memset(&err, 0, sizeof err);
     }
 
     if (w->killed == K_CANCEL && code != 0) {

@@ -349,8 +349,10 @@ static bool dead_writer(int pid, bool startup)
 }
 
 /* Finished jobs older than retention: their video and hashes go (those
- * this host made: another host's output directory is its own to sweep),
- * and the queue marks them expired. */
+ * this host made: another host's output directory is its own to sweep;
+ * with files = queue, any job's: their bytes are the queue's, and each
+ * host's sweep removes its own copies, sweep_copies), and the queue marks
+ * them expired. */
 static int sweep_retention(svc_daemon *d)
 {
     if (d->cfg.retention <= 0)
@@ -362,7 +364,8 @@ static int sweep_retention(svc_daemon *d)
         *colon = 0;
     int64_t ids[64];
     rs_err err = {0};
-    int n = d->store->ops->expiring(d->store, d->cfg.retention, host, ids, 64, &err), removed = 0;
+    bool keep = svc_keep_on(&d->cfg);
+    int n = d->store->ops->expiring(d->store, d->cfg.retention, keep ? NULL : host, ids, 64, &err), removed = 0;
     if (n < 0)
         svc_log(SVC_LOG_ERROR, -1, "retention: cannot list expired jobs: %s", err.msg);
     for (int i = 0; i < n; i++) {
@@ -370,6 +373,10 @@ static int sweep_retention(svc_daemon *d)
         if (d->store->ops->get(d->store, ids[i], &j, &err) != 1)
             continue;
         removed += svc_remove_job_outputs(&d->cfg, ids[i], j.format);
+        if (keep && d->store->ops->file_drop(d->store, ids[i], "", &err) < 0) {
+            svc_log(SVC_LOG_ERROR, ids[i], "retention: cannot remove its files from the queue: %s", err.msg);
+            continue; /* not marked: the next sweep tries again */
+        }
         if (d->store->ops->expire(d->store, ids[i], &err) < 0)
             svc_log(SVC_LOG_ERROR, ids[i], "retention: removed its files but could not mark it expired: %s", err.msg);
         else
@@ -457,6 +464,45 @@ static int sweep_streams(svc_daemon *d)
     return removed;
 }
 
+/* files = queue: the output directory holds this machine's copies of
+ * what is in the queue (svc_keep.c), so the video, hashes and poster of a
+ * job the queue no longer has or that expired go, and so does the log of
+ * a job it no longer has.  Without files = queue those names are the
+ * only copy, removed by DELETE and retention alone. */
+static int sweep_copies(svc_daemon *d)
+{
+    DIR *dir = opendir(d->cfg.output);
+    struct dirent *e;
+    int removed = 0;
+    while (dir && (e = readdir(dir))) {
+        char *end;
+        long long id = strtoll(e->d_name, &end, 10);
+        if (!(end > e->d_name && e->d_name[0] != '0' && id > 0 && *end == '.'))
+            continue;
+        const char *ext = end + 1;
+        bool log = !strcmp(ext, "log");
+        if (!log && strcmp(ext, "hashes") && strcmp(ext, "png") && strcmp(ext, "mp4") && strcmp(ext, "mkv") &&
+            strcmp(ext, "webm"))
+            continue;
+        svc_job j;
+        rs_err err = {0};
+        int r = d->store->ops->get(d->store, id, &j, &err);
+        if (r < 0)
+            break; /* the queue is down: keep everything */
+        if (r == 1 && !(j.expired && !log))
+            continue;
+        char path[1400];
+        snprintf(path, sizeof path, "%s/%s", d->cfg.output, e->d_name);
+        if (unlink(path) == 0) {
+            removed++;
+            svc_log(SVC_LOG_DEBUG, id, "removed %s (%s)", path, r == 0 ? "no such job in this queue" : "expired");
+        }
+    }
+    if (dir)
+        closedir(dir);
+    return removed;
+}
+
 /* The output directory: what belongs to a job that is over or that this
  * queue never had goes; so does a segment directory named by another key
  * than its job's (an older queue's job of the same id), and, on an SQLite
@@ -509,6 +555,8 @@ void svc_sweep(svc_daemon *d, bool startup)
     if (dir)
         closedir(dir);
     removed += sweep_streams(d);
+    if (svc_keep_on(&d->cfg))
+        removed += sweep_copies(d);
     char work[1100];
     snprintf(work, sizeof work, "%s/work", d->cfg.data);
     dir = opendir(work);

@@ -348,6 +348,15 @@ static int open_regular(const char *path, uint64_t *len)
     return -1;
 }
 
+/* files = queue: a done job's file this machine lacks (another one made
+ * it) is fetched from the queue into its place first (svc_keep.c). */
+static void fetch_copy(svc_daemon *d, int64_t id, const char *name, const char *path)
+{
+    rs_err err = {0};
+    if (svc_keep_on(&d->cfg) && svc_fetch(d->http_store, id, name, path, &err) < 0)
+        svc_log(SVC_LOG_WARN, id, "%s", err.msg);
+}
+
 /* A done job's video or hash list (OUTPUT/N.FORMAT, OUTPUT/N.hashes). */
 static enum MHD_Result send_output(svc_daemon *d, struct MHD_Connection *c, req *q, bool video)
 {
@@ -363,12 +372,15 @@ static enum MHD_Result send_output(svc_daemon *d, struct MHD_Connection *c, req 
         return http_error(c, SVC_ERR_GONE, NULL, NULL,
                           "job %" PRId64 "'s %s was removed by retention (kept %ld s after it finished)", q->m.id, what,
                           d->cfg.retention);
-    char path[1100];
+    char path[1100], name[24];
     svc_job_file(&d->cfg, q->m.id, ext, path, sizeof path);
+    snprintf(name, sizeof name, video ? "video.%s" : "%s", ext);
+    fetch_copy(d, q->m.id, name, path);
     uint64_t len = 0;
     int fd = open_regular(path, &len);
     if (fd < 0) {
-        svc_log(SVC_LOG_WARN, q->m.id, "%s: %s (a shared output directory not mounted here?)", path, strerror(errno));
+        svc_log(SVC_LOG_WARN, q->m.id, "%s: %s (%s)", path, strerror(errno),
+                svc_keep_on(&d->cfg) ? "not in the queue either" : "a shared output directory not mounted here?");
         return http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 " is done but %s is missing on this server", q->m.id,
                           path);
     }
@@ -404,6 +416,8 @@ enum MHD_Result http_poster(svc_daemon *d, struct MHD_Connection *c, req *q)
         return http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 "'s poster was removed by retention", q->m.id);
     char path[1100];
     svc_job_file(&d->cfg, q->m.id, "png", path, sizeof path);
+    if (j.state == SVC_DONE)
+        fetch_copy(d, q->m.id, "poster.png", path);
     uint64_t len = 0;
     int fd = j.state == SVC_DONE ? open_regular(path, &len) : -1;
     if (fd < 0)
@@ -424,11 +438,30 @@ enum MHD_Result http_log(svc_daemon *d, struct MHD_Connection *c, req *q)
     svc_job_file(&d->cfg, q->m.id, "log", path, sizeof path);
     size_t len = 0;
     rs_err ferr = {0};
-    char *text = rs_read_file(path, 4 << 20, &len, &ferr);
+    /* files = queue: the log is the queue's (every machine's units append
+     * there), fetched afresh each time; this machine's copy only where
+     * the queue could not take a block */
+    char *text = NULL, *local;
+    if (svc_keep_on(&d->cfg)) {
+        static unsigned seq;
+        char copy[1200];
+        snprintf(copy, sizeof copy, "%s/work/log%" PRId64 "-%d-%u.txt", d->cfg.data, q->m.id, (int)getpid(),
+                 __atomic_fetch_add(&seq, 1, __ATOMIC_RELAXED));
+        int got = d->http_store->ops->file_get(d->http_store, q->m.id, "log", copy, &ferr);
+        if (got < 0)
+            svc_log(SVC_LOG_WARN, q->m.id, "the render log: %s", ferr.msg);
+        if (got == 1) {
+            text = rs_read_file(copy, 4 << 20, &len, &ferr);
+            unlink(copy);
+        }
+    }
     svc_buf b = {0};
     if (text)
         svc_buf_add(&b, text, len);
     free(text);
+    if ((local = rs_read_file(path, 4 << 20, &len, &ferr)))
+        svc_buf_add(&b, local, len);
+    free(local);
     pthread_mutex_lock(&d->mu);
     for (int i = 0; i < d->cfg.workers; i++) {
         const svc_live *l = &d->live[i];

@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "svc.h"
 
@@ -63,6 +64,14 @@ static bool listed_units(svc_daemon *d, struct MHD_Connection *c, const svc_job 
         if (k < want - 1 || (units[i].state != SVC_DONE && units[i].renders == 0))
             continue; /* after a gap nothing is listed */
         int r = cap_hls_index_read(dir, (uint64_t)units[i].first_tick, &(*ix)[k], &err);
+        if (r == 0 && svc_keep_on(&d->cfg)) {
+            /* files = queue: a unit another machine rendered */
+            char name[64], path[1200];
+            snprintf(name, sizeof name, "stream/u%" PRId64 ".idx", units[i].first_tick);
+            snprintf(path, sizeof path, "%s/u%" PRId64 ".idx", dir, units[i].first_tick);
+            if (svc_fetch(d->http_store, j->id, name, path, &err) == 1)
+                r = cap_hls_index_read(dir, (uint64_t)units[i].first_tick, &(*ix)[k], &err);
+        }
         if (r == 1 && (*ix)[k].end == (uint64_t)units[i].end_tick)
             k++;
         else {
@@ -169,7 +178,20 @@ enum MHD_Result http_piece(svc_daemon *d, struct MHD_Connection *c, req *q)
     }
     uint8_t *data = NULL;
     rs_err err = {0};
+    char name[64], path[1200];
+    snprintf(name, sizeof name, "stream/t%" PRId64 ".ts", q->m.tick);
+    snprintf(path, sizeof path, "%s/t%" PRId64 ".ts", v.dir, q->m.tick);
+    bool keep = svc_keep_on(&d->cfg);
+    if (keep && svc_fetch(d->http_store, v.j.id, name, path, &err) < 0)
+        svc_log(SVC_LOG_WARN, v.j.id, "stream: %s", err.msg);
     bool ok = cap_hls_piece_check(v.dir, p, &data, &err);
+    if (!ok && keep) {
+        /* files = queue: a copy damaged here is fetched again */
+        svc_log(SVC_LOG_WARN, v.j.id, "stream: %s; fetching it again from the queue", err.msg);
+        unlink(path);
+        memset(&err, 0, sizeof err);
+        ok = svc_fetch(d->http_store, v.j.id, name, path, &err) == 1 && cap_hls_piece_check(v.dir, p, &data, &err);
+    }
     uint64_t len = p->bytes;
     free_units(v.ix, v.n);
     if (!ok) {

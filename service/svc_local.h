@@ -102,7 +102,8 @@ typedef struct svc_daemon {
     X(SEGMENTS, 500, "a job's segments are not all rendered, so it cannot be joined yet")      \
     X(TOKEN_EXISTS, 409, "an API token with that name exists already")                         \
     X(TOKEN_UNKNOWN, 404, "no API token with that name or id")                                 \
-    X(STREAMS, 503, "the daemon holds as many event streams as it takes")
+    X(STREAMS, 503, "the daemon holds as many event streams as it takes")                      \
+    X(KEEP, 500, "a unit's files could not be kept in the queue (files = queue)")
 
 typedef enum svc_error {
     SVC_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC),
@@ -192,5 +193,25 @@ int svc_remove_job_stream(const svc_config *cfg, int64_t id);
  * files; finished jobs past retention.  startup: no render of ours runs
  * yet, so files under our own pid are an earlier daemon's. */
 void svc_sweep(svc_daemon *d, bool startup);
+
+/* svc_keep.c: a job's files kept in the queue, for daemons that share no
+ * disk (files = queue; svc_store.h, "Files in the queue"). */
+bool svc_keep_on(const svc_config *cfg);
+/* A finished segment's video, manifest, hashes and poster (if it made
+ * one), stored under "seg/" before its done mark. */
+bool svc_keep_segment(svc_store *st, const svc_job *j, const svc_unit_files *f, rs_err *err);
+/* A unit's stream pieces and index (DIR/uFIRST.idx; none cut: nothing),
+ * unless the queue holds that unit's index already. */
+bool svc_keep_stream(svc_store *st, int64_t id, const char *dir, uint64_t first, rs_err *err);
+/* A finished job's video, hashes and poster, from their places (svc_job_file). */
+bool svc_keep_video(svc_store *st, const svc_config *cfg, const svc_job *j, rs_err *err);
+/* Job id's file name at path: 1 there already or fetched, 0 not in the
+ * queue, -1 error. */
+int svc_fetch(svc_store *st, int64_t id, const char *name, const char *path, rs_err *err);
+/* The files of the segments in u[0..n-1] (as done_attempt made them) that
+ * are missing here, fetched; false on an error of the queue or the disk
+ * (one the queue lacks is left for the join to find). */
+bool svc_fetch_segments(svc_store *st, const svc_job *j, const svc_unit_files *f, const svc_unit *u, int n,
+                        rs_err *err);
 
 #endif

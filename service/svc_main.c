@@ -224,9 +224,10 @@ bool svc_serve(const svc_desc *desc, rs_err *err)
     if (colon)
         snprintf(colon + 1, sizeof shown - (size_t)(colon + 1 - shown), "%u", d.port);
     svc_log(SVC_LOG_INFO, -1,
-            "listening on http://%s/ (queue %s: %lld queued, %lld running; %d worker%s; videos in %s; quality %s, %s)",
+            "listening on http://%s/ (queue %s: %lld queued, %lld running; %d worker%s; videos in %s%s; quality %s, %s)",
             shown, d.store->ops->name, (long long)counts[SVC_QUEUED], (long long)counts[SVC_RUNNING], d.cfg.workers,
-            d.cfg.workers == 1 ? "" : "s", d.cfg.output, d.cfg.quality, rsize);
+            d.cfg.workers == 1 ? "" : "s", d.cfg.output, svc_keep_on(&d.cfg) ? ", kept in the queue" : "",
+            d.cfg.quality, rsize);
     ok = svc_run(&d) == 0;
     if (!ok)
         rs_fail(err, SVC_ERR_SUPERVISOR, "the supervisor stopped on an error (see the log above)");

@@ -2,6 +2,7 @@
 #   . tests/pg.sh
 #   pg_start DIR || exit $?     # 77: PostgreSQL is not installed (a skip)
 #   ... "$PG_URI" ...           # postgresql://postgres@127.0.0.1:PORT/ringside
+#   pg_psql SQL                 # a statement's rows (unaligned, no header)
 #   pg_stop                     # stops the server and removes DIR
 # DIR must not exist yet or be empty; the server owns it (as the postgres
 # user when we run as root: initdb refuses root).  Trust authentication,
@@ -82,6 +83,11 @@ pg_start() {
     echo "pg.sh: the server did not start:" >&2
     tail -5 "$PG_DIR/server.log" >&2
     return 1
+}
+
+# pg_psql SQL: the result's rows, unaligned, no header
+pg_psql() {
+    psql -X -q -A -t -h 127.0.0.1 -p "$PG_PORT" -U postgres -d ringside -c "$1"
 }
 
 pg_stop() {

@@ -55,6 +55,16 @@ static void t_config_data_default(void)
     T_ASSERTF(!strcmp(c.data, "/var/lib/ringside"), "%s", c.data);
     T_ASSERTF(!strcmp(c.queue, "sqlite:/var/lib/ringside/queue.db"), "%s", c.queue);
     T_ASSERTF(!strcmp(c.output, "/var/lib/ringside/videos"), "%s", c.output);
+    /* files: auto keeps them in a PostgreSQL queue (machines share no disk), not in SQLite's */
+    T_ASSERTF(!strcmp(c.files, "local"), "%s", c.files);
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_set(&c, "queue", "postgres://u@h:5432/q", &err) && svc_config_finish(&c, &err));
+    T_ASSERTF(!strcmp(c.files, "queue"), "%s", c.files);
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_set(&c, "queue", "postgres://u@h:5432/q", &err) && svc_config_set(&c, "files", "local", &err) &&
+             svc_config_finish(&c, &err));
+    T_ASSERTF(!strcmp(c.files, "local"), "%s", c.files);
+    T_ASSERT(!svc_config_set(&c, "files", "nfs", &err) && strstr(err.msg, "auto|queue|local"));
     unsetenv("STATE_DIRECTORY");
     svc_config_defaults(&c);
     T_ASSERT(svc_config_finish(&c, &err));
@@ -1085,6 +1095,7 @@ static void t_http_status_table(void)
         {SVC_ERR_NO_HTTP, 500},  {SVC_ERR_NO_TOKENS, 500}, {SVC_ERR_SUPERVISOR, 500}, {SVC_ERR_SEGMENTS, 500},
         {SVC_ERR_TOKEN_EXISTS, 409}, {SVC_ERR_TOKEN_UNKNOWN, 404},
         {SVC_ERR_STREAMS, 503}, /* the event streams are full: come back */
+        {SVC_ERR_KEEP, 500},
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
     /* every id is an error status (its row of SVC_ERRORS has one) */

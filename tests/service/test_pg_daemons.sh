@@ -111,5 +111,68 @@ t_segments_of_one_job_on_both_daemons() {
     svc_stop
 }
 
-t_run two_daemons_share_one_queue lease_of_a_dead_daemon_expires segments_of_one_job_on_both_daemons
+vframes() { ffmpeg -v error -i "$1" -map 0:v -f framemd5 - | grep -v '^#' | cut -d, -f6; }
+
+# Three daemons on one PostgreSQL queue with nothing on disk in common
+# (files = queue, the default there): a split job uploaded to a is rendered
+# by all of them and joined by one, and every daemon serves its video,
+# hashes, poster, render log and stream from the queue.  DELETE takes its
+# bytes out of the queue, and the other daemons' copies go at their sweep.
+t_no_shared_disk() {
+    svc_pg_case || return 1
+    "$RS_BIN" record --ai --quiet --stage dojo --seconds 6 --seed 21 -o six.rsr || return 1
+    "$RS_BIN" render six.rsr -o direct.mp4 --render-size 160x90 --size 160x90 --hashes direct.hashes --quiet || return 1
+    for h in a b c; do
+        # each its own data and output directory (h/videos)
+        svc_start $h $SVC_FAST --queue "$PG_URI" --segment-seconds 1 || return 1
+        eval "url_$h=\$SVC_URL"
+    done
+    grep -q "videos in a/videos, kept in the queue" a.log || { cat a.log; return 1; }
+    SVC_URL=$url_a
+    id=$(svc_submit six.rsr) || return 1
+    svc_wait_state "$id" done 300 || return 1
+    svc_units "$id" >units.txt
+    [ "$(awk '$1 != "join" {sub(/\/[0-9]+$/, "", $5); print $5}' units.txt | sort -u | wc -l)" -ge 2 ] ||
+        { cat units.txt; echo "one daemon rendered every segment"; return 1; }
+    [ "$(awk '$4 != 1' units.txt | wc -l)" = 0 ] || { cat units.txt; echo "a unit was rendered twice"; return 1; }
+    joined=$(grep -l "job $id: done: " a.log b.log c.log | head -1)
+    fetched=$(grep -h "join: [0-9]* segment files* fetched from the queue" a.log b.log c.log)
+    [ -n "$fetched" ] || { echo "the join fetched nothing from the queue"; return 1; }
+    joined=${joined%.log}
+    echo "joined by $joined: $fetched"
+    # the join's machine has the video it made; the others fetch it
+    joined_mp4=$joined/videos/$id.mp4
+    [ -f "$joined_mp4" ] || { echo "no $joined_mp4"; return 1; }
+    bytes=$(pg_psql "SELECT SUM(length(data)) FROM job_files WHERE job_id = $id")
+    echo "bytes in the queue: $bytes"
+    [ -z "$(pg_psql "SELECT name FROM job_files WHERE job_id = $id AND name LIKE 'seg/%'")" ] ||
+        { echo "the segments stayed in the queue after the join"; return 1; }
+    for h in a b c; do
+        eval "u=\$url_$h"
+        curl -sf -o $h.hashes "$u/jobs/$id/hashes" && cmp $h.hashes direct.hashes || { echo "daemon $h: hashes differ"; return 1; }
+        curl -sf -o $h.mp4 "$u/jobs/$id/video" && cmp $h.mp4 "$joined_mp4" || { echo "daemon $h: not the joined video"; return 1; }
+        [ -s video.txt ] || vframes $h.mp4 >video.txt
+        [ "$(wc -l <video.txt)" = 360 ] || { echo "daemon $h: $(wc -l <video.txt) frames"; return 1; }
+        [ "$(curl -s -o $h.png -w '%{http_code}' "$u/jobs/$id/poster")" = 200 ] || { echo "daemon $h: no poster"; return 1; }
+        curl -sf "$u/jobs/$id/log" >$h.txt && [ "$(grep -c '^== ' $h.txt)" = 7 ] ||
+            { echo "daemon $h: the log has not every unit:"; cat $h.txt; return 1; }
+        vframes "$u/jobs/$id/stream.m3u8" | cmp -s - video.txt || { echo "daemon $h: the stream's frames differ"; return 1; }
+    done
+    # a copy damaged here is fetched again, not served
+    piece=$(ls b/videos/$id.stream/*/t0.ts) || return 1
+    printf 'x' | dd of="$piece" bs=1 seek=100 conv=notrunc 2>/dev/null
+    [ "$(curl -s -o piece.ts -w '%{http_code}' "$url_b/jobs/$id/stream/0.ts")" = 200 ] || { echo "a damaged piece was not fetched again"; return 1; }
+    grep -q "fetching it again from the queue" b.log || return 1
+    # DELETE: the queue forgets its bytes; the other daemons' copies go
+    [ "$(curl -s -o /dev/null -w '%{http_code}' -X DELETE "$url_c/jobs/$id")" = 200 ] || return 1
+    [ "$(pg_psql "SELECT COUNT(*) FROM job_files WHERE job_id = $id")" = 0 ] || { echo "its bytes stayed in the queue"; return 1; }
+    i=0
+    while ls a/videos b/videos c/videos | grep -q "^$id\."; do
+        sleep 0.5; i=$((i + 1))
+        [ $i -lt 30 ] || { echo "copies stayed:"; ls a/videos b/videos c/videos; return 1; }
+    done
+    svc_stop
+}
+
+t_run two_daemons_share_one_queue lease_of_a_dead_daemon_expires segments_of_one_job_on_both_daemons no_shared_disk
 t_done
