@@ -176,6 +176,9 @@ fi
 
 # --- the scratch copy -------------------------------------------------------
 scratch=$(mktemp -d "${TMPDIR:-/tmp}/ringside-mutate-XXXXXX") || die "cannot make a scratch folder"
+# searchable by others: the PostgreSQL cases start a server (as the postgres
+# user) in a folder under the scratch's tmp (tests/pg.sh)
+chmod 755 "$scratch"
 src=$scratch/tree logs=$scratch/logs orig=$scratch/orig
 mkdir -p "$src" "$logs" "$orig" "$scratch/cache"
 # shellcheck disable=SC2317 # called by the EXIT trap

@@ -11,7 +11,8 @@
 # GET /jobs/N/stream.m3u8 (time to first frame; "no stream" from a daemon
 # without one), from upload to "done", the video's frames, frames per
 # second, and game seconds per wall second.  It also prints the job's
-# units (segments and join) as GET /jobs/N lists them.  -f sets
+# units (segments and join) as GET /jobs/N lists them, and with
+# --files queue how long storing their files in the queue took.  -f sets
 # first_segment_seconds (default: the daemon's, 2); -1 stops at the first
 # piece and prints only its time.  The daemon is stopped
 # and its directory removed at the end.  docs/service.md ("Throughput",
@@ -98,3 +99,7 @@ for u in j.get("segments") or []:
 if j.get("join"):
     print("  join " + json.dumps(j["join"], sort_keys=True))
 EOF
+# a daemon that keeps the units' files in its queue (files = queue) says how long each store took
+kept=$(sed -n 's/.*kept in the queue in \([0-9]*\) ms.*/\1/p' "$dir/serve.log")
+[ -z "$kept" ] || echo "$kept" | awk '{n++; t+=$1; if ($1 > m) m=$1} END {printf "  kept in the queue: %d units, %d ms in all, at most %d ms\n", n, t, m}'
+
