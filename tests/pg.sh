@@ -18,14 +18,19 @@ pg_bindir() {
     return 1
 }
 
+# PG_LISTEN: the address the server listens on (default 127.0.0.1; any
+# other is trusted for its whole subnet: a test's private network).
+# PG_WRAP: a command every server and client command runs under ("ip
+# netns exec NS": the server inside a test's network namespace).
+
 # pg_as CMD...: CMD as the server's owner, from a directory it can read
 pg_as() {
     if [ "$(id -u)" != 0 ]; then
-        (cd "$PG_DIR" && "$@")
+        (cd "$PG_DIR" && ${PG_WRAP:-} "$@")
     elif command -v runuser >/dev/null 2>&1; then
-        (cd "$PG_DIR" && runuser -u postgres -- "$@")
+        (cd "$PG_DIR" && ${PG_WRAP:-} runuser -u postgres -- "$@")
     else
-        (cd "$PG_DIR" && su postgres -s /bin/sh -c 'exec "$0" "$@"' "$@")
+        (cd "$PG_DIR" && ${PG_WRAP:-} su postgres -s /bin/sh -c 'exec "$0" "$@"' "$@")
     fi
 }
 
@@ -60,6 +65,8 @@ pg_start() {
         tail -5 "$PG_DIR/initdb.log" >&2
         return 1
     fi
+    pg_host=${PG_LISTEN:-127.0.0.1}
+    [ "$pg_host" = 127.0.0.1 ] || echo "host all all samenet trust" >>"$PG_DIR/data/pg_hba.conf"
     # A random port; if another program holds it the server cannot bind
     # and we try the next one (the bind itself is the only reliable check).
     tries=0
@@ -67,9 +74,9 @@ pg_start() {
         tries=$((tries + 1))
         PG_PORT=$((20000 + $(od -An -N2 -tu2 /dev/urandom | tr -d ' ') % 40000))
         if pg_as "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -l "$PG_DIR/server.log" -w -t 60 \
-            -o "-h 127.0.0.1 -p $PG_PORT -k $PG_DIR -c fsync=off -c full_page_writes=off" start >/dev/null 2>&1; then
-            if "$PG_BIN/createdb" -h 127.0.0.1 -p "$PG_PORT" -U postgres ringside >>"$PG_DIR/server.log" 2>&1; then
-                PG_URI="postgresql://postgres@127.0.0.1:$PG_PORT/ringside"
+            -o "-h $pg_host -p $PG_PORT -k $PG_DIR -c fsync=off -c full_page_writes=off" start >/dev/null 2>&1; then
+            if ${PG_WRAP:-} "$PG_BIN/createdb" -h "$pg_host" -p "$PG_PORT" -U postgres ringside >>"$PG_DIR/server.log" 2>&1; then
+                PG_URI="postgresql://postgres@$pg_host:$PG_PORT/ringside"
                 export PG_URI PG_PORT PG_DIR
                 return 0
             fi
@@ -87,14 +94,15 @@ pg_start() {
 
 # pg_psql SQL: the result's rows, unaligned, no header
 pg_psql() {
-    psql -X -q -A -t -h 127.0.0.1 -p "$PG_PORT" -U postgres -d ringside -c "$1"
+    ${PG_WRAP:-} psql -X -q -A -t -h "${PG_LISTEN:-127.0.0.1}" -p "$PG_PORT" -U postgres -d ringside -c "$1"
 }
 
 pg_stop() {
     [ -n "${PG_DIR:-}" ] || return 0
     if [ -f "$PG_DIR/data/postmaster.pid" ]; then
-        pg_as "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m fast -w -t 30 stop >/dev/null 2>&1 ||
-            pg_as "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m immediate -w stop >/dev/null 2>&1
+        # signals, not the network: outside any namespace (which may be gone)
+        PG_WRAP= pg_as "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m fast -w -t 30 stop >/dev/null 2>&1 ||
+            PG_WRAP= pg_as "$PG_BIN/pg_ctl" -D "$PG_DIR/data" -m immediate -w stop >/dev/null 2>&1
     fi
     rm -rf "$PG_DIR"
     PG_DIR= PG_URI=
