@@ -124,31 +124,6 @@ static size_t log_text(const worker *w, char *out, size_t n)
     return k;
 }
 
-/* line into out with the unit's temporary file names replaced by the names
- * the client knows: a whole job's or the join's video, hash list and poster
- * (OUTPUT/N.EXT) instead of OUTPUT/.jobN-PID-aK.EXT.  A segment's files keep
- * their names: they are the segment's own. */
-static void client_names(const svc_daemon *d, const worker *w, const char *line, char *out, size_t n)
-{
-    snprintf(out, n, "%s", line);
-    if (w->job.unit.kind == SVC_UNIT_SEGMENT)
-        return;
-    char video[1100], hashes[1100], poster[1100];
-    svc_job_file(&d->cfg, w->job.id, w->job.format, video, sizeof video);
-    svc_job_file(&d->cfg, w->job.id, "hashes", hashes, sizeof hashes);
-    svc_job_file(&d->cfg, w->job.id, "png", poster, sizeof poster);
-    const char *const from[] = {w->f.out, w->f.hashes, w->f.poster}, *const to[] = {video, hashes, poster};
-    for (int i = 0; i < 3; i++) {
-        size_t k = strlen(from[i]);
-        char *at;
-        if (!k || !(at = strstr(out, from[i])))
-            continue;
-        char tail[SVC_LOG_LINE];
-        snprintf(tail, sizeof tail, "%s", at + k);
-        snprintf(at, n - (size_t)(at - out), "%s%s", to[i], tail);
-    }
-}
-
 /* A stderr line into the ring, and the ring to the HTTP threads. */
 static void log_line(svc_daemon *d, worker *w, const char *line)
 {
@@ -157,7 +132,7 @@ static void log_line(svc_daemon *d, worker *w, const char *line)
         w->log_head = (w->log_head + 1) % SVC_LOG_LINES;
     else
         w->log_n++;
-    client_names(d, w, line, w->log[at], SVC_LOG_LINE);
+    svc_client_names(&d->cfg, &w->job, &w->f, line, w->log[at], SVC_LOG_LINE);
     pthread_mutex_lock(&d->mu);
     log_text(w, d->live[w->slot].log, sizeof d->live[w->slot].log);
     pthread_mutex_unlock(&d->mu);
@@ -416,11 +391,8 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
         svc_log(SVC_LOG_WARN, j->id, "%s (the video is good: it is kept, the stream is not listed)", why);
         stream = false;
     }
-    /* files = queue: stored before the done mark, so done means any daemon can serve it */
-    double kept = now_s();
-    if (svc_keep_on(&d->cfg) &&
-        !((j->unit.kind != SVC_UNIT_WHOLE || !stream || svc_keep_stream(d->store, j->id, w->f.stream, 0, &err)) &&
-          svc_keep_video(d->store, &d->cfg, j, &err))) {
+    char kept[64]; /* files = queue: stored before the done mark, so done means any daemon can serve it */
+    if (!svc_keep_unit(d->store, &d->cfg, j, &w->f, stream, kept, sizeof kept, &err)) {
         snprintf(why, sizeof why, "the %s finished but its files could not be kept in the queue: %s",
                  j->unit.kind == SVC_UNIT_JOIN ? "join" : "render", err.msg);
         give_back_local(d, w, why);
@@ -429,19 +401,13 @@ static void finished_video(svc_daemon *d, worker *w, double secs)
     int64_t frames = j->unit.kind == SVC_UNIT_JOIN ? j->frames_total : w->total;
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, frames, &err);
     if (r == 1) {
-        /* the segments are in the video now: the queue keeps them no longer */
-        if (j->unit.kind == SVC_UNIT_JOIN && svc_keep_on(&d->cfg) &&
-            d->store->ops->file_drop(d->store, j->id, "seg/", &err) < 0)
-            svc_log(SVC_LOG_WARN, j->id, "could not remove its segments from the queue: %s", err.msg);
-        char q[64] = "";
-        if (svc_keep_on(&d->cfg))
-            snprintf(q, sizeof q, "; kept in the queue in %.0f ms", (now_s() - kept) * 1000);
-        if (j->unit.kind == SVC_UNIT_JOIN)
+        if (j->unit.kind == SVC_UNIT_JOIN) {
+            svc_keep_drop(d->store, &d->cfg, j->id, -1, 0); /* the segments are in the video now */
             svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames from %d segments (joined in %.1f s%s)", video,
-                    frames, j->segments, secs, q);
-        else
+                    frames, j->segments, secs, kept);
+        } else
             svc_log(SVC_LOG_INFO, j->id, "done: %s, %" PRId64 " frames in %.1f s (%.1f fps%s)", video, frames, secs,
-                    secs > 0 ? (double)frames / secs : 0.0, q);
+                    secs > 0 ? (double)frames / secs : 0.0, kept);
         count(d, &d->jobs_done);
     } else if (r == 0) {
         /* cancelled meanwhile: its files go; finished by another daemon
@@ -472,11 +438,8 @@ static bool finished_segment(svc_daemon *d, worker *w, double secs)
     bool stream = svc_unit_stream_ok(&w->f, &w->job.unit, why, sizeof why);
     if (!stream) /* a viewer never gets a piece that is not whole */
         svc_log(SVC_LOG_WARN, j->id, "%s%s (the segment is good: it is kept, the stream stops before it)", ctx(w), why);
-    /* files = queue: stored before the done mark, so a done segment can be joined anywhere */
-    double kept = now_s();
-    if (svc_keep_on(&d->cfg) &&
-        !(svc_keep_segment(d->store, j, &w->f, &err) &&
-          (!stream || svc_keep_stream(d->store, j->id, w->f.stream, (uint64_t)j->unit.first_tick, &err)))) {
+    char kept[64]; /* files = queue: stored before the done mark, so a done segment can be joined anywhere */
+    if (!svc_keep_unit(d->store, &d->cfg, j, &w->f, stream, kept, sizeof kept, &err)) {
         snprintf(why, sizeof why, "the segment finished but its files could not be kept in the queue: %s", err.msg);
         give_back_local(d, w, why);
         return true;
@@ -484,11 +447,8 @@ static bool finished_segment(svc_daemon *d, worker *w, double secs)
     int r = d->store->ops->finish(d->store, j->id, w->owner, SVC_DONE, "", -1, w->total, &err);
     if (r == 1) {
         w->keep = true;
-        char q[64] = "";
-        if (svc_keep_on(&d->cfg))
-            snprintf(q, sizeof q, "; kept in the queue in %.0f ms", (now_s() - kept) * 1000);
         svc_log(SVC_LOG_INFO, j->id, "%sdone, %" PRId64 " frames in %.1f s (%.1f fps%s)", ctx(w), w->total, secs,
-                secs > 0 ? (double)w->total / secs : 0.0, q);
+                secs > 0 ? (double)w->total / secs : 0.0, kept);
     } else if (r == 0)
         svc_log(SVC_LOG_WARN, j->id, "%sfinished, but it is no longer ours (cancelled or re-claimed)", ctx(w));
     else
@@ -508,10 +468,7 @@ static void bad_segments(svc_daemon *d, worker *w)
         for (int k = 0; k < w->nunits; k++)
             if (w->units[k].kind == SVC_UNIT_SEGMENT && w->units[k].index == w->bad[i]) {
                 svc_segment_remove(w->f.segdir, w->bad[i], w->units[k].done_attempt);
-                char name[64];
-                snprintf(name, sizeof name, "seg/s%d-a%d.", w->bad[i], w->units[k].done_attempt);
-                if (svc_keep_on(&d->cfg) && d->store->ops->file_drop(d->store, j->id, name, &err) < 0)
-                    svc_log(SVC_LOG_WARN, j->id, "join: could not remove a bad segment from the queue: %s", err.msg);
+                svc_keep_drop(d->store, &d->cfg, j->id, w->bad[i], w->units[k].done_attempt);
             }
     int r = d->store->ops->rejoin(d->store, j->id, w->owner, w->bad, w->nbad, why, d->cfg.max_attempts, &err);
     if (r < 0)
@@ -555,13 +512,7 @@ static void on_exit_status(svc_daemon *d, worker *w, int status)
         int k = snprintf(block, sizeof block, "== %s%s, attempt %d, process %d: %s after %.1f s ==\n", ctx(w),
                          kind == SVC_UNIT_JOIN ? "join" : "render", j->unit.claim, (int)w->pid, how, secs);
         size_t len = (size_t)k + log_text(w, block + k, sizeof block - (size_t)k);
-        /* files = queue: in the queue, where any daemon reads it */
-        if (!svc_keep_on(&d->cfg) || d->store->ops->file_append(d->store, j->id, "log", block, len, &err) < 0) {
-            if (err.msg[0])
-                svc_log(SVC_LOG_WARN, j->id, "the render log goes to this machine only: %s", err.msg);
-            svc_job_log_append(&d->cfg, j->id, block, len);
-        }
-        memset(&err, 0, sizeof err);
+        svc_job_log_append(d->store, &d->cfg, j->id, block, len);
     }
 
     if (w->killed == K_CANCEL && code != 0) {

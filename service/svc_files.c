@@ -98,8 +98,15 @@ void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out,
     snprintf(out, n, "%s/%" PRId64 ".%s", cfg->output, id, ext);
 }
 
-void svc_job_log_append(const svc_config *cfg, int64_t id, const char *block, size_t len)
+void svc_job_log_append(svc_store *st, const svc_config *cfg, int64_t id, const char *block, size_t len)
 {
+    rs_err err = {0};
+    /* files = queue: in the queue, where any daemon reads it (0: the job is gone) */
+    int r = svc_keep_on(cfg) ? st->ops->file_append(st, id, "log", block, len, &err) : -1;
+    if (r >= 0)
+        return;
+    if (err.msg[0])
+        svc_log(SVC_LOG_WARN, id, "the render log goes to this machine only: %s", err.msg);
     char path[1100];
     svc_job_file(cfg, id, "log", path, sizeof path);
     int fd = open(path, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
@@ -111,6 +118,28 @@ void svc_job_log_append(const svc_config *cfg, int64_t id, const char *block, si
     if (w != (ssize_t)len)
         svc_log(SVC_LOG_WARN, id, "%s: the render log was not written whole", path);
     close(fd);
+}
+
+void svc_client_names(const svc_config *cfg, const svc_job *j, const svc_unit_files *f, const char *line, char *out,
+                      size_t n)
+{
+    snprintf(out, n, "%s", line);
+    if (j->unit.kind == SVC_UNIT_SEGMENT)
+        return;
+    char video[1100], hashes[1100], poster[1100];
+    svc_job_file(cfg, j->id, j->format, video, sizeof video);
+    svc_job_file(cfg, j->id, "hashes", hashes, sizeof hashes);
+    svc_job_file(cfg, j->id, "png", poster, sizeof poster);
+    const char *const from[] = {f->out, f->hashes, f->poster}, *const to[] = {video, hashes, poster};
+    for (int i = 0; i < 3; i++) {
+        size_t k = strlen(from[i]);
+        char *at;
+        if (!k || !(at = strstr(out, from[i])))
+            continue;
+        char tail[SVC_LOG_LINE];
+        snprintf(tail, sizeof tail, "%s", at + k);
+        snprintf(at, n - (size_t)(at - out), "%s%s", to[i], tail);
+    }
 }
 
 void svc_segment_path(char *out, size_t n, const char *segdir, int index, int attempt, const char *ext)

@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../capture/cap_hls.h"
@@ -70,7 +71,7 @@ static bool put(svc_store *st, int64_t id, const svc_file *f, int n, const char 
     return r >= 0;
 }
 
-bool svc_keep_stream(svc_store *st, int64_t id, const char *dir, uint64_t first, rs_err *err)
+static bool keep_stream(svc_store *st, int64_t id, const char *dir, uint64_t first, rs_err *err)
 {
     cap_hls_index ix;
     int r = cap_hls_index_read(dir, first, &ix, err);
@@ -104,7 +105,7 @@ bool svc_keep_stream(svc_store *st, int64_t id, const char *dir, uint64_t first,
     return ok;
 }
 
-bool svc_keep_segment(svc_store *st, const svc_job *j, const svc_unit_files *f, rs_err *err)
+static bool keep_segment(svc_store *st, const svc_job *j, const svc_unit_files *f, rs_err *err)
 {
     file_list l = {0};
     char manifest[1200];
@@ -114,7 +115,7 @@ bool svc_keep_segment(svc_store *st, const svc_job *j, const svc_unit_files *f, 
            put(st, j->id, l.f, l.n, NULL, err);
 }
 
-bool svc_keep_video(svc_store *st, const svc_config *cfg, const svc_job *j, rs_err *err)
+static bool keep_video(svc_store *st, const svc_config *cfg, const svc_job *j, rs_err *err)
 {
     char video[1100], hashes[1100], poster[1100], vname[24];
     svc_job_file(cfg, j->id, j->format, video, sizeof video);
@@ -124,6 +125,36 @@ bool svc_keep_video(svc_store *st, const svc_config *cfg, const svc_job *j, rs_e
     svc_file f[3] = {{vname, video}, {"hashes", hashes}, {"poster.png", poster}};
     /* a job without a poster (its render could not write one) is still done */
     return put(st, j->id, f, access(poster, F_OK) == 0 ? 3 : 2, NULL, err);
+}
+
+bool svc_keep_unit(svc_store *st, const svc_config *cfg, const svc_job *j, const svc_unit_files *f, bool stream,
+                   char *note, size_t n, rs_err *err)
+{
+    note[0] = 0;
+    if (!svc_keep_on(cfg))
+        return true;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    bool ok = j->unit.kind == SVC_UNIT_SEGMENT ? keep_segment(st, j, f, err) : keep_video(st, cfg, j, err);
+    if (ok && stream && j->unit.kind != SVC_UNIT_JOIN)
+        ok = keep_stream(st, j->id, f->stream, (uint64_t)j->unit.first_tick, err);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    snprintf(note, n, "; kept in the queue in %.0f ms",
+             (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) / 1e6);
+    return ok;
+}
+
+void svc_keep_drop(svc_store *st, const svc_config *cfg, int64_t id, int index, int attempt)
+{
+    char prefix[64];
+    rs_err err = {0};
+    if (index < 0)
+        snprintf(prefix, sizeof prefix, "seg/");
+    else
+        snprintf(prefix, sizeof prefix, "seg/s%d-a%d.", index, attempt);
+    if (svc_keep_on(cfg) && st->ops->file_drop(st, id, prefix, &err) < 0)
+        svc_log(SVC_LOG_WARN, id, "could not remove %s from the queue: %s",
+                index < 0 ? "its segments" : "a bad segment", err.msg);
 }
 
 int svc_fetch(svc_store *st, int64_t id, const char *name, const char *path, rs_err *err)

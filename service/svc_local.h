@@ -171,9 +171,17 @@ void svc_argv_free(char **argv);
  * (EXT its format), N.hashes, the poster N.png and the render log N.log
  * (the log gathers every unit's attempts, appended as each ends). */
 void svc_job_file(const svc_config *cfg, int64_t id, const char *ext, char *out, size_t n);
-/* Appends one unit attempt's log block to OUTPUT/N.log in one write (units
- * of a split job may end at once, on several daemons). */
-void svc_job_log_append(const svc_config *cfg, int64_t id, const char *block, size_t len);
+/* Appends one unit attempt's log block to the job's log: with files =
+ * queue to the queue's, else (or when the queue fails) to OUTPUT/N.log in
+ * one write (units of a split job may end at once, on several daemons). */
+void svc_job_log_append(svc_store *st, const svc_config *cfg, int64_t id, const char *block, size_t len);
+/* line (a render's message) into out with the unit's temporary file names
+ * replaced by the names the client knows: a whole job's or the join's
+ * video, hash list and poster (OUTPUT/N.EXT) instead of
+ * OUTPUT/.jobN-PID-aK.EXT.  A segment's files keep their names: they are
+ * the segment's own. */
+void svc_client_names(const svc_config *cfg, const svc_job *j, const svc_unit_files *f, const char *line, char *out,
+                      size_t n);
 /* "SEGDIR/sI-aK.ext" */
 void svc_segment_path(char *out, size_t n, const char *segdir, int index, int attempt, const char *ext);
 /* Segment I's files as attempt K wrote them (video, hashes, manifest, temporaries). */
@@ -197,14 +205,19 @@ void svc_sweep(svc_daemon *d, bool startup);
 /* svc_keep.c: a job's files kept in the queue, for daemons that share no
  * disk (files = queue; svc_store.h, "Files in the queue"). */
 bool svc_keep_on(const svc_config *cfg);
-/* A finished segment's video, manifest, hashes and poster (if it made
- * one), stored under "seg/" before its done mark. */
-bool svc_keep_segment(svc_store *st, const svc_job *j, const svc_unit_files *f, rs_err *err);
-/* A unit's stream pieces and index (DIR/uFIRST.idx; none cut: nothing),
- * unless the queue holds that unit's index already. */
-bool svc_keep_stream(svc_store *st, int64_t id, const char *dir, uint64_t first, rs_err *err);
-/* A finished job's video, hashes and poster, from their places (svc_job_file). */
-bool svc_keep_video(svc_store *st, const svc_config *cfg, const svc_job *j, rs_err *err);
+/* What j's unit made, stored before its done mark when files = queue
+ * (else nothing, true): a segment's video, manifest, hashes and poster
+ * (if it made one) under "seg/"; a WHOLE render's or a join's video,
+ * hashes and poster from their places (svc_job_file); a segment's or a
+ * WHOLE render's stream pieces and index when stream is true (unless the
+ * queue holds that unit's index already).  note gets "; kept in the queue
+ * in N ms" ("" when files = local). */
+bool svc_keep_unit(svc_store *st, const svc_config *cfg, const svc_job *j, const svc_unit_files *f, bool stream,
+                   char *note, size_t n, rs_err *err);
+/* files = queue: segment index's files as claim attempt made them leave
+ * the queue (a bad segment), or with index -1 every segment's (the job
+ * is joined); a failure is logged. */
+void svc_keep_drop(svc_store *st, const svc_config *cfg, int64_t id, int index, int attempt);
 /* Job id's file name at path: 1 there already or fetched, 0 not in the
  * queue, -1 error. */
 int svc_fetch(svc_store *st, int64_t id, const char *name, const char *path, rs_err *err);

@@ -163,7 +163,7 @@ static const set_case set_cases[] = {
     {"listen", "host:70000", 0, "listen: 'host:70000': the port must be 0..65535"},
     {"listen", "host:", 0, "the port must be 0..65535"}, {"listen", "host:-1", 0, "the port must be 0..65535"},
     {"listen", "host:80x", 0, "the port must be 0..65535"}, {"listen", "[::1]", 0, "an IPv6 address goes in brackets"},
-    {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, max_upload, "
+    {"workerz", "1", 0, "unknown setting 'workerz' (known: listen, workers, data, queue, output, files, max_upload, "
                         "max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, first_segment_seconds, size, max_size, render_size, quality, format, backend, log_level, allowed_hosts, cors_origins, "
                         "max_connections, max_connections_per_ip, header_timeout, min_body_rate, upload_memory, "
                         "token_max_queued, token_seconds_per_hour, retention, codecs, min_crf, max_bitrate, presets)"},
@@ -292,7 +292,7 @@ static void t_config_load_errors(void)
 {
     LOAD_BAD("# c\n\nworkers = 0\n", ":3: workers: 0 is out of range (expected 1..64)");
     LOAD_BAD("workers = 2\ngarbage here\n", ":2: expected 'name = value', got 'garbage here'");
-    LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, "
+    LOAD_BAD("\n\n\n\nnope = 1\n", ":5: unknown setting 'nope' (known: listen, workers, data, queue, output, files, "
                                    "max_upload, max_seconds, max_attempts, lease, watchdog, grace, segment_seconds, first_segment_seconds, size, max_size, render_size, quality, "
                                    "format, backend, log_level, allowed_hosts, cors_origins, max_connections, "
                                    "max_connections_per_ip, header_timeout, min_body_rate, upload_memory, token_max_queued, "
