@@ -167,10 +167,11 @@ enum MHD_Result http_piece(svc_daemon *d, struct MHD_Connection *c, req *q)
     if (!view_stream(d, c, q, &v, &ret))
         return ret;
     const cap_hls_piece *p = NULL;
+    int unit = -1; /* the listed unit holding it: the segment of that index (listed from 0, without gaps) */
     for (int u = 0; u < v.n && !p; u++)
         for (int i = 0; i < v.ix[u].n && !p; i++)
             if (v.ix[u].p[i].tick == (uint64_t)q->m.tick)
-                p = &v.ix[u].p[i];
+                p = &v.ix[u].p[i], unit = u;
     if (!p) {
         free_units(v.ix, v.n);
         return http_error(c, SVC_ERR_NOT_FOUND, NULL, NULL, "job %" PRId64 " lists no piece from tick %" PRId64 " (yet)",
@@ -196,6 +197,23 @@ enum MHD_Result http_piece(svc_daemon *d, struct MHD_Connection *c, req *q)
     free_units(v.ix, v.n);
     if (!ok) {
         svc_log(SVC_LOG_WARN, v.j.id, "stream: %s", err.msg);
+        /* a split job not done yet renders that segment again (its join
+         * waits for it); a listed piece's bytes never change, so the new
+         * render's pieces are the ones the index names */
+        rs_err rerr = {0};
+        char why[SVC_ERROR_MAX];
+        snprintf(why, sizeof why, "its stream piece from tick %" PRId64 " was missing or damaged", q->m.tick);
+        int r = v.j.segments > 0 ? d->http_store->ops->redo(d->http_store, v.j.id, unit, why, d->cfg.max_attempts, &rerr)
+                                 : 0;
+        if (r < 0)
+            svc_log(SVC_LOG_ERROR, v.j.id, "stream: could not send segment %d back to render: %s", unit, rerr.msg);
+        if (r == 1) {
+            static const http_header later = {"Retry-After", "10"};
+            svc_log(SVC_LOG_WARN, v.j.id, "segment %d: re-queued: %s", unit, why);
+            return http_error(c, SVC_ERR_RERENDER, &later, NULL,
+                              "job %" PRId64 "'s piece from tick %" PRId64 " was damaged on this server: segment %d "
+                              "is being rendered again", v.j.id, q->m.tick, unit);
+        }
         return http_error(c, SVC_ERR_GONE, NULL, NULL, "job %" PRId64 "'s piece from tick %" PRId64
                           " is missing or damaged on this server", v.j.id, q->m.tick);
     }

@@ -103,7 +103,8 @@ typedef struct svc_daemon {
     X(TOKEN_EXISTS, 409, "an API token with that name exists already")                         \
     X(TOKEN_UNKNOWN, 404, "no API token with that name or id")                                 \
     X(STREAMS, 503, "the daemon holds as many event streams as it takes")                      \
-    X(KEEP, 500, "a unit's files could not be kept in the queue (files = queue)")
+    X(KEEP, 500, "a unit's files could not be kept in the queue (files = queue)")               \
+    X(RERENDER, 503, "a damaged stream piece's segment is being rendered again")
 
 typedef enum svc_error {
     SVC_ERR_BASE = RS_ERR_BASE(RS_ERR_MOD_SVC),

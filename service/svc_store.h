@@ -285,6 +285,14 @@ typedef struct svc_store_ops {
      * has used max_attempts.  1: done; 0: not ours (or not a join); -1. */
     int (*rejoin)(svc_store *s, int64_t id, const char *owner, const int *bad, int nbad, const char *why,
                   int max_attempts, rs_err *err);
+    /* A stream piece of job id's segment index is damaged or missing where
+     * a daemon must serve it: the segment, done, goes back to queued (its
+     * claim's files no longer the ones to join; its listed pieces stay
+     * listed) with why, and a join already running goes back to waiting
+     * (its attempt given back; its owner's heartbeat answers "not ours").
+     * 1: re-queued; 0: not (no such segment, not done, the job done or
+     * over, or the segment at max_attempts); -1: error. */
+    int (*redo)(svc_store *s, int64_t id, int index, const char *why, int max_attempts, rs_err *err);
     /* The units of job id by index (segments, then the join; or the one
      * WHOLE unit), up to max into out.  Returns the count, or -1. */
     int (*units)(svc_store *s, int64_t id, svc_unit *out, int max, rs_err *err);

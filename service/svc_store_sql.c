@@ -202,6 +202,7 @@ static const svc_store_ops sq_ops = {
     .release = sq_release,
     .reap = sq_reap,
     .rejoin = sq_rejoin,
+    .redo = sq_redo,
     .units = sq_units,
     .get = sq_get,
     .list = sq_list,

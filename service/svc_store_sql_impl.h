@@ -132,6 +132,7 @@ int sq_finish(svc_store *bs, int64_t id, const char *owner, int state, const cha
 int sq_release(svc_store *bs, int64_t id, const char *owner, const char *why, bool count_attempt, int max_attempts,
                rs_err *err);
 int sq_reap(svc_store *bs, bool all, svc_reaped *out, int max, rs_err *err);
+int sq_redo(svc_store *bs, int64_t id, int index, const char *why, int max_attempts, rs_err *err);
 int sq_rejoin(svc_store *bs, int64_t id, const char *owner, const int *bad, int nbad, const char *why,
               int max_attempts, rs_err *err);
 

@@ -388,3 +388,31 @@ out:
     pthread_mutex_unlock(&s->mu);
     return rc;
 }
+
+int sq_redo(svc_store *bs, int64_t id, int index, const char *why, int max_attempts, rs_err *err)
+{
+    sq_store *s = S(bs);
+    int64_t now;
+    int rc = -1, state = 0;
+    pthread_mutex_lock(&s->mu);
+    if (sq_tx_begin(s, &now, err)) {
+        int l = sq_lock_job(s, id, &state, NULL, err);
+        int64_t n = 0;
+        bool ok = l >= 0;
+        if (l > 0 && (state == SVC_QUEUED || state == SVC_RUNNING))
+            ok = (n = run(s, "re-queue the segment",
+                          "UPDATE units SET state = 0, owner = '', frames_done = 0, fps = 0, claimed_until = 0,"
+                          " done_attempt = 0, error = ?3 WHERE job_id = ?1 AND idx = ?2 AND kind = 1 AND state = 2"
+                          " AND attempts < ?4",
+                          ARGS(I(id), I(index), T(why ? why : ""), I(max_attempts)), NULL, err)) >= 0;
+        if (ok && n > 0)
+            ok = run(s, "the join waits again",
+                     "UPDATE units SET state = 0, attempts = attempts - 1, owner = '', claimed_until = 0, fps = 0,"
+                     " frames_done = 0 WHERE job_id = ?1 AND kind = 2 AND state = 1",
+                     ARGS(I(id)), NULL, err) >= 0 &&
+                 sq_refresh(s, id, err);
+        rc = sq_tx_end(s, ok, n > 0, err);
+    }
+    pthread_mutex_unlock(&s->mu);
+    return rc;
+}

@@ -1095,7 +1095,7 @@ static void t_http_status_table(void)
         {SVC_ERR_NO_HTTP, 500},  {SVC_ERR_NO_TOKENS, 500}, {SVC_ERR_SUPERVISOR, 500}, {SVC_ERR_SEGMENTS, 500},
         {SVC_ERR_TOKEN_EXISTS, 409}, {SVC_ERR_TOKEN_UNKNOWN, 404},
         {SVC_ERR_STREAMS, 503}, /* the event streams are full: come back */
-        {SVC_ERR_KEEP, 500},
+        {SVC_ERR_KEEP, 500},     {SVC_ERR_RERENDER, 503}, /* come back once it is rendered again */
     };
     T_EQ(sizeof want / sizeof want[0], SVC_ERR_END - SVC_ERR_BASE - 1);
     /* every id is an error status (its row of SVC_ERRORS has one) */

@@ -1215,6 +1215,44 @@ static void split_rejoin(const char *spec)
     s->ops->close(s);
 }
 
+/* A damaged stream piece: its done segment back to queued, a running
+ * join back to waiting (its owner's heartbeat says not ours, its attempt
+ * given back); nothing for a segment not done, at the cap, or a done job. */
+static void split_redo(const char *spec)
+{
+    svc_store *s = open_ok(spec);
+    rs_err e = {0};
+    int64_t id = submit_split(s, 180, 60, NULL);
+    claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, 0);
+    T_EQ(s->ops->redo(s, id, 0, "running", 3, &e), 0); /* not done yet */
+    T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+    for (int i = 1; i < 3; i++) {
+        claim_unit(s, "a:1", id, SVC_UNIT_SEGMENT, i);
+        T_EQ(s->ops->finish(s, id, "a:1", SVC_DONE, NULL, -1, 60, &e), 1);
+    }
+    claim_unit(s, "j:1", id, SVC_UNIT_JOIN, 3);
+    T_EQ(s->ops->redo(s, id, 1, "t60.ts damaged", 3, &e), 1);
+    T_EQ(s->ops->redo(s, id, 1, "again", 3, &e), 0); /* queued already */
+    svc_unit u[4];
+    units_of(s, id, u, 4);
+    T_ASSERT(u[1].state == SVC_QUEUED && u[1].done_attempt == 0 && u[1].renders == 1 &&
+             !strcmp(u[1].error, "t60.ts damaged"));
+    T_ASSERT(u[0].state == SVC_DONE && u[2].state == SVC_DONE);
+    T_ASSERT(u[3].state == SVC_QUEUED && u[3].attempts == 0);
+    T_EQ(s->ops->heartbeat(s, id, "j:1", 60, 0, 180, 0, &e), 0);
+    claim_unit(s, "b:2", id, SVC_UNIT_SEGMENT, 1);
+    T_EQ(s->ops->finish(s, id, "b:2", SVC_DONE, NULL, -1, 60, &e), 1);
+    units_of(s, id, u, 4);
+    T_ASSERT(u[1].renders == 2 && u[1].done_attempt == 2);
+    /* at the cap: left alone (the piece answers 410) */
+    T_EQ(s->ops->redo(s, id, 1, "x", 2, &e), 0);
+    claim_unit(s, "j:1", id, SVC_UNIT_JOIN, 3);
+    T_EQ(s->ops->finish(s, id, "j:1", SVC_DONE, NULL, -1, 180, &e), 1);
+    T_EQ(s->ops->redo(s, id, 0, "done", 3, &e), 0);
+    T_EQ(get_ok(s, id).state, SVC_DONE);
+    s->ops->close(s);
+}
+
 /* Four processes (four daemons) render three split jobs: every unit is
  * claimed once, every segment finished once, every join after its
  * segments. */
@@ -1439,6 +1477,7 @@ BOTH(split_retry)
 BOTH(split_cancel_and_desync)
 BOTH(split_reap_resumes)
 BOTH(split_rejoin)
+BOTH(split_redo)
 BOTH(split_concurrent)
 BOTH(tokens)
 BOTH(files)
@@ -1578,7 +1617,7 @@ static void t_pg_reconnect(void)
 T_MAIN(CASES(roundtrip), CASES(claim_order), CASES(attempts), CASES(heartbeat), CASES(finish), CASES(cancel),
        CASES(dead_letter), CASES(give_back), CASES(reap), CASES(list_paging), CASES(counts), CASES(persistence),
        CASES(concurrent_claim), CASES(shared_handle), CASES(open_race), CASES(split_plan), CASES(split_run),
-       CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin),
+       CASES(split_retry), CASES(split_cancel_and_desync), CASES(split_reap_resumes), CASES(split_rejoin), CASES(split_redo),
         CASES(split_concurrent), CASES(tokens), CASES(files), CASES(migrate_v1), CASES(migrate_v2), CASES(expire_and_remove),
         CASES(retry_and_queue),
         {"sqlite_bad_files", t_sqlite_bad_files},

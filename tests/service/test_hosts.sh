@@ -26,7 +26,11 @@ on() { # HOST CMD...: CMD inside HOST's network namespace
 hosts_down() {
     for p in $SVC_PIDS; do kill -KILL "$p" 2>/dev/null; done
     pg_stop
-    for h in a b c pg sw; do ip netns del "$NS$h" 2>/dev/null; done
+    # whatever still runs in a namespace (a render, a client) goes with it
+    for h in a b c pg sw; do
+        for p in $(ip netns pids "$NS$h" 2>/dev/null); do kill -KILL "$p" 2>/dev/null; done
+        ip netns del "$NS$h" 2>/dev/null
+    done
 }
 
 # the bridge in ${NS}sw; host H gets eth0 with NET.N, its peer on the bridge

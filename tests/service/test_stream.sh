@@ -45,7 +45,15 @@ assert t == [[0, 120], [120, 360]], t' || { curl -s "$SVC_URL/jobs/$id"; return 
     # a piece not listed yet is 404 (unless its unit finished meanwhile)
     c=$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/$id/stream/240.ts")
     [ "$c" = 404 ] || [ "$(svc_field "$id" segments.1.state)" = done ] || { echo "an unlisted piece: $c"; return 1; }
+    # a listed piece damaged while the job runs: its segment is rendered again (503 meanwhile)
+    p=$(find "d/videos/$id.stream" -name t0.ts) && [ -n "$p" ] || { echo "no piece 0"; return 1; }
+    printf 'x' | dd of="$p" bs=1 seek=1000 conv=notrunc 2>/dev/null
+    c=$(curl -s -D hdr.txt -o /dev/null -w '%{http_code}' "$SVC_URL/jobs/$id/stream/0.ts")
+    [ "$c" = 503 ] && grep -qi '^retry-after: 10' hdr.txt || { echo "a damaged piece of a running job: $c"; return 1; }
     svc_wait_state "$id" done 120 || return 1
+    [ "$(svc_field "$id" segments.0.renders)" = 2 ] || { echo "segment 0 was not rendered again"; return 1; }
+    # the same bytes as the piece first listed
+    curl -sf -o p0-again.ts "$SVC_URL/jobs/$id/stream/0.ts" && cmp p0.ts p0-again.ts || { echo "piece 0 changed"; return 1; }
     curl -sf -o end.m3u8 "$SVC_URL/jobs/$id/stream.m3u8" || return 1
     tail -1 end.m3u8 | grep -qx '#EXT-X-ENDLIST' || { cat end.m3u8; return 1; }
     [ "$(svc_field "$id" stream_s)" = 6.0 ] || { echo "a done job's stream_s: $(svc_field "$id" stream_s)"; return 1; }
