@@ -439,7 +439,8 @@ static int sweep_other_keys(svc_daemon *d, int64_t id, const char *key)
     struct dirent *e;
     int removed = 0;
     while (dir && (e = readdir(dir))) {
-        if (!strcmp(e->d_name, key) && !strcmp(d->store->ops->name, "sqlite")) {
+        /* a pid says who on one machine: an SQLite queue, or files = queue (each machine its own directory) */
+        if (!strcmp(e->d_name, key) && (!strcmp(d->store->ops->name, "sqlite") || svc_keep_on(&d->cfg))) {
             snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
             DIR *own = opendir(sub);
             struct dirent *f;
@@ -496,7 +497,7 @@ static int sweep_streams(svc_daemon *d)
 /* files = queue: the output directory holds this machine's copies of
  * what is in the queue (svc_keep.c), so the video, hashes and poster of a
  * job the queue no longer has or that expired go, and so does the log of
- * a job it no longer has.  Without files = queue those names are the
+ * a job it no longer has, and a fetch's temporary whose process is gone.  Without files = queue those names are the
  * only copy, removed by DELETE and retention alone. */
 static int sweep_copies(svc_daemon *d)
 {
@@ -505,6 +506,12 @@ static int sweep_copies(svc_daemon *d)
     int removed = 0;
     while (dir && (e = readdir(dir))) {
         char *end;
+        if (e->d_name[0] == '.' && dead_stream_part(e->d_name)) { /* a fetch a dead process left (svc_store_sql_files.c) */
+            char part[1400];
+            snprintf(part, sizeof part, "%s/%s", d->cfg.output, e->d_name);
+            removed += unlink(part) == 0;
+            continue;
+        }
         long long id = strtoll(e->d_name, &end, 10);
         if (!(end > e->d_name && e->d_name[0] != '0' && id > 0 && *end == '.'))
             continue;

@@ -96,9 +96,15 @@ static void chunk_row(void *dst, const sq_res *r, int i)
 int sq_file_get(svc_store *bs, int64_t id, const char *name, const char *path, rs_err *err)
 {
     sq_store *s = S(bs);
-    static unsigned seq; /* two threads fetching the same file write two temporaries */
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s.%d-%u.fetch", path, (int)getpid(), __atomic_fetch_add(&seq, 1, __ATOMIC_RELAXED));
+    /* "DIR/.NAME.SEQ.PID.part": hidden, and named as the stream's
+     * temporaries are, so the sweep knows a dead process's (svc_files.c);
+     * two threads fetching the same file write two */
+    static unsigned seq;
+    char tmp[1300];
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash - path + 1) : 0;
+    snprintf(tmp, sizeof tmp, "%.*s.%s.%u.%d.part", dirlen, path, path + dirlen,
+             __atomic_fetch_add(&seq, 1, __ATOMIC_RELAXED), (int)getpid());
     FILE *out = fopen(tmp, "wb");
     if (!out)
         return rs_fail(err, SVC_STORE_ERR_FILE, "%s: cannot write a file fetched from the queue: %s", tmp,

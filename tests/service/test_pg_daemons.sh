@@ -163,11 +163,15 @@ t_no_shared_disk() {
     printf 'x' | dd of="$piece" bs=1 seek=100 conv=notrunc 2>/dev/null
     [ "$(curl -s -o piece.ts -w '%{http_code}' "$url_b/jobs/$id/stream/0.ts")" = 200 ] || { echo "a damaged piece was not fetched again"; return 1; }
     grep -q "fetching it again from the queue" b.log || return 1
-    # DELETE: the queue forgets its bytes; the other daemons' copies go
+    # DELETE: the queue forgets its bytes; the other daemons' copies go,
+    # and so does a fetch a dead process left half written
+    sh -c 'exit 0' & dead=$!
+    wait $dead
+    touch "b/videos/.$id.mp4.0.$dead.part"
     [ "$(curl -s -o /dev/null -w '%{http_code}' -X DELETE "$url_c/jobs/$id")" = 200 ] || return 1
     [ "$(pg_psql "SELECT COUNT(*) FROM job_files WHERE job_id = $id")" = 0 ] || { echo "its bytes stayed in the queue"; return 1; }
     i=0
-    while ls a/videos b/videos c/videos | grep -q "^$id\."; do
+    while ls -A a/videos b/videos c/videos | grep -q "^\.\{0,1\}$id\."; do
         sleep 0.5; i=$((i + 1))
         [ $i -lt 30 ] || { echo "copies stayed:"; ls a/videos b/videos c/videos; return 1; }
     done
