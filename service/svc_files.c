@@ -497,8 +497,9 @@ static int sweep_streams(svc_daemon *d)
 /* files = queue: the output directory holds this machine's copies of
  * what is in the queue (svc_keep.c), so the video, hashes and poster of a
  * job the queue no longer has or that expired go, and so does the log of
- * a job it no longer has, and a fetch's temporary whose process is gone.  Without files = queue those names are the
- * only copy, removed by DELETE and retention alone. */
+ * a job it no longer has, and a fetch's temporary whose process is gone.
+ * Without files = queue those names are the only copy, removed by DELETE
+ * and retention alone. */
 static int sweep_copies(svc_daemon *d)
 {
     DIR *dir = opendir(d->cfg.output);
