@@ -237,7 +237,10 @@ static int cmd_serve_token(int argc, char **argv)
     const char *sub = n > 0 ? argv[optind] : "";
     bool add = !strcmp(sub, "add"), list = !strcmp(sub, "list"), revoke = !strcmp(sub, "revoke");
     if (!add && !list && !revoke) {
-        cli_error("serve", "token '%s': expected add, list or revoke", sub);
+        if (n == 0)
+            cli_error("serve", "token: which one? add, list or revoke");
+        else
+            cli_error("serve", "token '%s': expected add, list or revoke", sub);
         return cli_usage_error("serve token");
     }
     if (n != (list ? 1 : 2)) {

@@ -357,8 +357,6 @@ bool svc_config_finish(svc_config *c, rs_err *err)
         snprintf(c->queue, sizeof c->queue, "sqlite:%s/queue.db", c->data);
     if (!c->output[0])
         snprintf(c->output, sizeof c->output, "%s/videos", c->data);
-    if (!strcmp(c->files, "auto"))
-        snprintf(c->files, sizeof c->files, "%s", strncmp(c->queue, "postgres", 8) ? "local" : "queue");
     if (c->width > c->max_width || c->height > c->max_height)
         return rs_fail(err, SVC_CONFIG_ERR_SIZE_LIMIT, "size %dx%d is larger than max_size %dx%d", c->width, c->height,
                        c->max_width, c->max_height);

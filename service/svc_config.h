@@ -49,7 +49,8 @@ typedef struct svc_config {
     char data[512];       /* queue database, work files, default output */
     char queue[1024];     /* sqlite:PATH or postgres://...; "" = sqlite:<data>/queue.db */
     char output[512];     /* where videos go; "" = <data>/videos */
-    char files[16];       /* "queue": units' files kept in the queue's database too (svc_store.h); "local" */
+    char files[16];       /* "queue": units' files kept in the queue's database too (svc_store.h); "local";
+                             "auto": queue on PostgreSQL (svc_keep_on) */
     long max_upload;      /* bytes */
     int max_seconds;      /* longest replay accepted (game time) */
     int max_attempts;     /* claims before a job is failed for good */

@@ -428,6 +428,27 @@ static bool dead_stream_part(const char *name)
     return pid > 0 && pid < INT32_MAX && dead_writer((int)pid, false);
 }
 
+/* A fetch's temporary (".NAME.fetch-SEQ-HOST-PID", svc_store_sql_files.c)
+ * that a process of this machine left and that no longer runs: the host
+ * says whose pid it is, since an output directory may still be shared */
+static bool dead_fetch(const char *name)
+{
+    const char *f = strstr(name, ".fetch-"), *dash = strrchr(name, '-');
+    if (!f)
+        return false;
+    char *seq_end, *pid_end;
+    strtoul(f + 7, &seq_end, 10);
+    if (seq_end == f + 7 || *seq_end != '-' || dash <= seq_end)
+        return false;
+    const char *h = seq_end + 1; /* the host, up to the last '-' */
+    char host[256] = "";
+    gethostname(host, sizeof host - 1);
+    size_t hl = (size_t)(dash - h);
+    long pid = strtol(dash + 1, &pid_end, 10);
+    return *pid_end == 0 && pid > 0 && pid < INT32_MAX && hl == strlen(host) && !strncmp(h, host, hl) &&
+           dead_writer((int)pid, false);
+}
+
 /* OUTPUT/N.stream/OTHERKEY: an older queue's job of the same id; and, on
  * an SQLite queue (one machine: a pid says who), the temporaries a killed
  * render left in the job's own stream folder */
@@ -439,8 +460,7 @@ static int sweep_other_keys(svc_daemon *d, int64_t id, const char *key)
     struct dirent *e;
     int removed = 0;
     while (dir && (e = readdir(dir))) {
-        /* a pid says who on one machine: an SQLite queue, or files = queue (each machine its own directory) */
-        if (!strcmp(e->d_name, key) && (!strcmp(d->store->ops->name, "sqlite") || svc_keep_on(&d->cfg))) {
+        if (!strcmp(e->d_name, key) && !strcmp(d->store->ops->name, "sqlite")) {
             snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
             DIR *own = opendir(sub);
             struct dirent *f;
@@ -497,7 +517,8 @@ static int sweep_streams(svc_daemon *d)
 /* files = queue: the output directory holds this machine's copies of
  * what is in the queue (svc_keep.c), so the video, hashes and poster of a
  * job the queue no longer has or that expired go, and so does the log of
- * a job it no longer has, and a fetch's temporary whose process is gone.
+ * a job it no longer has, and a fetch's temporary that a process of this
+ * machine left and that is gone.
  * Without files = queue those names are the only copy, removed by DELETE
  * and retention alone. */
 static int sweep_copies(svc_daemon *d)
@@ -507,7 +528,7 @@ static int sweep_copies(svc_daemon *d)
     int removed = 0;
     while (dir && (e = readdir(dir))) {
         char *end;
-        if (e->d_name[0] == '.' && dead_stream_part(e->d_name)) { /* a fetch a dead process left (svc_store_sql_files.c) */
+        if (e->d_name[0] == '.' && dead_fetch(e->d_name)) {
             char part[1400];
             snprintf(part, sizeof part, "%s/%s", d->cfg.output, e->d_name);
             removed += unlink(part) == 0;

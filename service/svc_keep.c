@@ -34,7 +34,8 @@
 
 bool svc_keep_on(const svc_config *cfg)
 {
-    return !strcmp(cfg->files, "queue");
+    /* auto: daemons of a PostgreSQL queue may be on machines that share no disk */
+    return !strcmp(cfg->files, "queue") || (!strcmp(cfg->files, "auto") && !strncmp(cfg->queue, "postgres", 8));
 }
 
 static const char *base(const char *path)

@@ -96,15 +96,16 @@ static void chunk_row(void *dst, const sq_res *r, int i)
 int sq_file_get(svc_store *bs, int64_t id, const char *name, const char *path, rs_err *err)
 {
     sq_store *s = S(bs);
-    /* "DIR/.NAME.SEQ.PID.part": hidden, and named as the stream's
-     * temporaries are, so the sweep knows a dead process's (svc_files.c);
-     * two threads fetching the same file write two */
+    /* "DIR/.NAME.fetch-SEQ-HOST-PID": hidden, and the sweep knows a dead
+     * process's (svc_files.c: the host says whose pid, as a directory may
+     * be shared); two threads fetching the same file write two */
     static unsigned seq;
-    char tmp[1300];
+    char tmp[1400], host[256] = "";
+    gethostname(host, sizeof host - 1);
     const char *slash = strrchr(path, '/');
     int dirlen = slash ? (int)(slash - path + 1) : 0;
-    snprintf(tmp, sizeof tmp, "%.*s.%s.%u.%d.part", dirlen, path, path + dirlen,
-             __atomic_fetch_add(&seq, 1, __ATOMIC_RELAXED), (int)getpid());
+    snprintf(tmp, sizeof tmp, "%.*s.%s.fetch-%u-%s-%d", dirlen, path, path + dirlen,
+             __atomic_fetch_add(&seq, 1, __ATOMIC_RELAXED), host, (int)getpid());
     FILE *out = fopen(tmp, "wb");
     if (!out)
         return rs_fail(err, SVC_STORE_ERR_FILE, "%s: cannot write a file fetched from the queue: %s", tmp,

@@ -56,14 +56,16 @@ static void t_config_data_default(void)
     T_ASSERTF(!strcmp(c.queue, "sqlite:/var/lib/ringside/queue.db"), "%s", c.queue);
     T_ASSERTF(!strcmp(c.output, "/var/lib/ringside/videos"), "%s", c.output);
     /* files: auto keeps them in a PostgreSQL queue (machines share no disk), not in SQLite's */
-    T_ASSERTF(!strcmp(c.files, "local"), "%s", c.files);
+    T_ASSERTF(!strcmp(c.files, "auto") && !svc_keep_on(&c), "%s", c.files);
     svc_config_defaults(&c);
     T_ASSERT(svc_config_set(&c, "queue", "postgres://u@h:5432/q", &err) && svc_config_finish(&c, &err));
-    T_ASSERTF(!strcmp(c.files, "queue"), "%s", c.files);
+    T_ASSERT(svc_keep_on(&c));
     svc_config_defaults(&c);
     T_ASSERT(svc_config_set(&c, "queue", "postgres://u@h:5432/q", &err) && svc_config_set(&c, "files", "local", &err) &&
              svc_config_finish(&c, &err));
-    T_ASSERTF(!strcmp(c.files, "local"), "%s", c.files);
+    T_ASSERT(!svc_keep_on(&c));
+    svc_config_defaults(&c);
+    T_ASSERT(svc_config_set(&c, "files", "queue", &err) && svc_config_finish(&c, &err) && svc_keep_on(&c));
     T_ASSERT(!svc_config_set(&c, "files", "nfs", &err) && strstr(err.msg, "auto|queue|local"));
     unsetenv("STATE_DIRECTORY");
     svc_config_defaults(&c);

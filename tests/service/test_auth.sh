@@ -33,6 +33,7 @@ t_token_commands() {
     token ops --operator --max-queued 5 >/dev/null || return 1
     expect_fail 1 "exists already" "$RS_BIN" serve token add alice --data d || return 1
     expect_fail 2 "only digits" "$RS_BIN" serve token add 42 --data d || return 1
+    expect_fail 2 "which one\? add, list or revoke" "$RS_BIN" serve token --data d || return 1
     "$RS_BIN" serve token list --data d >list.txt || return 1
     grep -Eq '^1 +alice +no +20 +7200 ' list.txt && grep -Eq '^2 +ops +yes +5 +0 ' list.txt || { cat list.txt; return 1; }
     # the token itself is in no listing and not in the database
