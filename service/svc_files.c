@@ -485,76 +485,59 @@ static int sweep_other_keys(svc_daemon *d, int64_t id, const char *key)
     return removed;
 }
 
-/* OUTPUT/N.stream of a job this queue does not have, or that failed, was
- * cancelled or expired (a done job's stream stays with its video). */
-static int sweep_streams(svc_daemon *d)
+/* A copy's name with files = queue (svc_keep.c): the video, hashes,
+ * poster or log of job N */
+static bool copy_ext(const char *ext)
 {
-    DIR *dir = opendir(d->cfg.output);
-    struct dirent *e;
-    int removed = 0;
-    while (dir && (e = readdir(dir))) {
-        char *end;
-        long long id = strtoll(e->d_name, &end, 10);
-        if (!(end > e->d_name && e->d_name[0] != '0' && id > 0 && !strcmp(end, ".stream")))
-            continue;
-        svc_job j;
-        rs_err err = {0};
-        int r = d->store->ops->get(d->store, id, &j, &err);
-        if (r < 0)
-            break; /* the queue is down: keep everything */
-        if (r == 1 && (j.state == SVC_QUEUED || j.state == SVC_RUNNING || (j.state == SVC_DONE && !j.expired))) {
-            removed += sweep_other_keys(d, id, j.key);
-            continue;
-        }
-        removed += svc_remove_job_stream(&d->cfg, id);
-        svc_log(SVC_LOG_DEBUG, id, "removed its stream (%s)", r == 0 ? "no such job in this queue" : "the job is over");
-    }
-    if (dir)
-        closedir(dir);
-    return removed;
+    static const char *const exts[] = {"mp4", "mkv", "webm", "hashes", "png", "log"};
+    for (size_t i = 0; i < sizeof exts / sizeof *exts; i++)
+        if (!strcmp(ext, exts[i]))
+            return true;
+    return false;
 }
 
-/* files = queue: the output directory holds this machine's copies of
- * what is in the queue (svc_keep.c), so the video, hashes and poster of a
- * job the queue no longer has or that expired go, and so does the log of
- * a job it no longer has, and a fetch's temporary that a process of this
- * machine left and that is gone.
- * Without files = queue those names are the only copy, removed by DELETE
- * and retention alone. */
-static int sweep_copies(svc_daemon *d)
+/* The output directory's numbered names, in one walk:
+ *  - OUTPUT/N.stream of a job this queue does not have, or that failed, was
+ *    cancelled or expired (a done job's stream stays with its video);
+ *  - files = queue: the directory holds this machine's copies of what is in
+ *    the queue (svc_keep.c), so the video, hashes and poster of a job the
+ *    queue no longer has or that expired go, and so does the log of a job
+ *    it no longer has, and a fetch's temporary that a process of this
+ *    machine left and that is gone.  Without files = queue those names are
+ *    the only copy, removed by DELETE and retention alone. */
+static int sweep_numbered(svc_daemon *d)
 {
     DIR *dir = opendir(d->cfg.output);
     struct dirent *e;
     int removed = 0;
+    bool keep = svc_keep_on(&d->cfg);
+    char path[1400];
     while (dir && (e = readdir(dir))) {
-        char *end;
-        if (e->d_name[0] == '.' && dead_fetch(e->d_name)) {
-            char part[1400];
-            snprintf(part, sizeof part, "%s/%s", d->cfg.output, e->d_name);
-            removed += unlink(part) == 0;
+        snprintf(path, sizeof path, "%s/%s", d->cfg.output, e->d_name);
+        if (keep && e->d_name[0] == '.' && dead_fetch(e->d_name)) {
+            removed += unlink(path) == 0;
             continue;
         }
+        char *end;
         long long id = strtoll(e->d_name, &end, 10);
         if (!(end > e->d_name && e->d_name[0] != '0' && id > 0 && *end == '.'))
             continue;
-        const char *ext = end + 1;
-        bool log = !strcmp(ext, "log");
-        if (!log && strcmp(ext, "hashes") && strcmp(ext, "png") && strcmp(ext, "mp4") && strcmp(ext, "mkv") &&
-            strcmp(ext, "webm"))
+        bool stream = !strcmp(end, ".stream"), log = !strcmp(end, ".log");
+        if (!stream && !(keep && copy_ext(end + 1)))
             continue;
         svc_job j;
         rs_err err = {0};
         int r = d->store->ops->get(d->store, id, &j, &err);
         if (r < 0)
             break; /* the queue is down: keep everything */
-        if (r == 1 && !(j.expired && !log))
-            continue;
-        char path[1400];
-        snprintf(path, sizeof path, "%s/%s", d->cfg.output, e->d_name);
-        if (unlink(path) == 0) {
-            removed++;
-            svc_log(SVC_LOG_DEBUG, id, "removed %s (%s)", path, r == 0 ? "no such job in this queue" : "expired");
-        }
+        const char *why = r == 0 ? "no such job in this queue" : stream ? "the job is over" : "expired";
+        if (stream) {
+            if (r == 1 && (j.state == SVC_QUEUED || j.state == SVC_RUNNING || (j.state == SVC_DONE && !j.expired)))
+                removed += sweep_other_keys(d, id, j.key);
+            else if (svc_remove_job_stream(&d->cfg, id))
+                removed++, svc_log(SVC_LOG_DEBUG, id, "removed its stream (%s)", why);
+        } else if ((r == 0 || (j.expired && !log)) && unlink(path) == 0)
+            removed++, svc_log(SVC_LOG_DEBUG, id, "removed %s (%s)", path, why);
     }
     if (dir)
         closedir(dir);
@@ -612,9 +595,7 @@ void svc_sweep(svc_daemon *d, bool startup)
     }
     if (dir)
         closedir(dir);
-    removed += sweep_streams(d);
-    if (svc_keep_on(&d->cfg))
-        removed += sweep_copies(d);
+    removed += sweep_numbered(d);
     char work[1100];
     snprintf(work, sizeof work, "%s/work", d->cfg.data);
     dir = opendir(work);

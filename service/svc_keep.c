@@ -24,11 +24,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../capture/cap_hls.h"
 #include "../runtime/util/rs_file.h"
+#include "../runtime/util/rs_progress.h"
 #include "svc_local.h"
 #include "svc_log.h"
 
@@ -134,14 +134,11 @@ bool svc_keep_unit(svc_store *st, const svc_config *cfg, const svc_job *j, const
     note[0] = 0;
     if (!svc_keep_on(cfg))
         return true;
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = rs_now();
     bool ok = j->unit.kind == SVC_UNIT_SEGMENT ? keep_segment(st, j, f, err) : keep_video(st, cfg, j, err);
     if (ok && stream && j->unit.kind != SVC_UNIT_JOIN)
         ok = keep_stream(st, j->id, f->stream, (uint64_t)j->unit.first_tick, err);
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    snprintf(note, n, "; kept in the queue in %.0f ms",
-             (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) / 1e6);
+    snprintf(note, n, "; kept in the queue in %.0f ms", (rs_now() - t0) * 1e3);
     return ok;
 }
 
@@ -173,18 +170,16 @@ int svc_fetch(svc_store *st, int64_t id, const char *name, const char *path, rs_
 bool svc_fetch_segments(svc_store *st, const svc_job *j, const svc_unit_files *f, const svc_unit *u, int n,
                         rs_err *err)
 {
-    static const char *const exts[] = {"", ".seg", "hashes", "png"};
+    char manifest[16];
+    snprintf(manifest, sizeof manifest, "%s.seg", j->format);
+    const char *const exts[] = {j->format, manifest, "hashes", "png"};
     int fetched = 0;
     for (int i = 0; i < n; i++) {
         if (u[i].kind != SVC_UNIT_SEGMENT || u[i].done_attempt <= 0)
             continue;
         for (int k = 0; k < 4; k++) {
             char path[1200], name[96];
-            if (k < 2) {
-                svc_segment_path(path, sizeof path, f->segdir, u[i].index, u[i].done_attempt, j->format);
-                strncat(path, exts[k], sizeof path - strlen(path) - 1);
-            } else
-                svc_segment_path(path, sizeof path, f->segdir, u[i].index, u[i].done_attempt, exts[k]);
+            svc_segment_path(path, sizeof path, f->segdir, u[i].index, u[i].done_attempt, exts[k]);
             if (access(path, F_OK) == 0)
                 continue;
             snprintf(name, sizeof name, "seg/%s", base(path));
