@@ -198,7 +198,12 @@ static bool drain(cap_aenc *a, const cap_sink *s, AVFormatContext *fmt, rs_err *
             return fail_av(err, CAP_ERR_ENCODER, s->path, "audio encoder", r);
         av_packet_rescale_ts(a->pkt, a->ctx->time_base, a->st->time_base);
         a->pkt->stream_index = a->st->index;
-        if (a->keep) {
+        if (a->put) {
+            bool ok = a->put(a->put_u, a->pkt, err);
+            av_packet_unref(a->pkt);
+            if (!ok)
+                return false;
+        } else if (a->keep) {
             if (!keep(a->keep, a->pkt))
                 return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory for the encoded track", s->path);
         } else if ((r = av_interleaved_write_frame(fmt, a->pkt)) < 0) {

@@ -38,6 +38,10 @@ typedef struct cap_aenc {
     size_t chunk;       /* the encoder's frame size */
     size_t skip;        /* frames of the track's start that stand in for the priming (AAC in MKV, NUT) */
     struct cap_atrack *keep; /* set: packets are kept there (cap_atrack_encode), not written */
+    /* set: each packet (in st's time base) goes to put instead (cap_hls.c's
+     * track parts); put takes the packet's reference or leaves it */
+    bool (*put)(void *u, AVPacket *pkt, rs_err *err);
+    void *put_u;
 } cap_aenc;
 
 /* A track encoded ahead of its container (cap_seg.h): the stream's

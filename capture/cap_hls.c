@@ -6,11 +6,14 @@
  *   120 frames, and a segment's first frame), by stream copy into MPEG-TS:
  *   every piece starts with a keyframe and its parameter sets (the muxer's
  *   own Annex B filter puts them there), so each plays alone.
- * - The sound is one AAC stream for the whole match, encoded once
- *   (track.ts), and a piece takes the track's packets that start in its
- *   time: cut by copy too, so there is no encoder restart, no priming and
- *   no click where pieces or units meet.  A unit's own encoding of its
- *   stretch would restart the AAC encoder at every unit.
+ * - The sound is one AAC stream for the whole match, encoded once, and a
+ *   piece takes the track's packets that start in its time: cut by copy
+ *   too, so there is no encoder restart, no priming and no click where
+ *   pieces or units meet.  A unit's own encoding of its stretch would
+ *   restart the AAC encoder at every unit.  The track is written in parts
+ *   of 10 s (track.K.ts), each put in place when complete, so the first
+ *   unit's pieces wait for the match's loudness and their own 10 s, not
+ *   for the whole match's encoding (10 s of one core for 10 minutes).
  * - Timestamps come from ticks, not from the input's: pts = tick +
  *   CAP_HLS_OFFSET_TICKS, dts = position - CAP_HLS_REORDER, so two pieces
  *   cut by different processes continue each other exactly, as the join's
@@ -28,10 +31,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/file.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../runtime/util/rs_file.h"
 #include "../runtime/util/rs_hash.h"
+#include "../runtime/util/rs_progress.h"
 
 #define INDEX_MAGIC "ringside-hls 1"
 
@@ -49,6 +54,26 @@ static void index_path(const char *dir, uint64_t first, char *out, size_t n)
 static void piece_path(const char *dir, uint64_t tick, char *out, size_t n)
 {
     snprintf(out, n, "%s/t%" PRIu64 ".ts", dir, tick);
+}
+
+#define PART_SAMPLES ((int64_t)CAP_HLS_TRACK_PART_TICKS * 800) /* 800 sample frames a tick */
+
+int cap_hls_track_parts(uint64_t total)
+{
+    uint64_t n = (total + CAP_HLS_TRACK_PART_TICKS - 1) / CAP_HLS_TRACK_PART_TICKS;
+    return n < 1 ? 1 : n > INT32_MAX ? INT32_MAX : (int)n;
+}
+
+void cap_hls_track_path(const char *dir, int k, char *out, size_t n)
+{
+    snprintf(out, n, "%s/track.%d.ts", dir, k);
+}
+
+bool cap_hls_track_whole(const char *dir, uint64_t total)
+{
+    char path[1100];
+    cap_hls_track_path(dir, cap_hls_track_parts(total) - 1, path, sizeof path);
+    return access(path, F_OK) == 0;
 }
 
 int cap_hls_index_format(const cap_hls_index *ix, char *out, size_t n)
@@ -319,47 +344,124 @@ static AVDictionary *ts_opts(void)
     return o;
 }
 
-bool cap_hls_track(const char *dir, const cap_sink *audio, rs_err *err)
+/* The track's packets into their parts, as the encoder gives them */
+typedef struct part_writer {
+    const char *dir;
+    int nparts;
+    int k;                    /* the part being written (or skipped); -1: none yet */
+    bool skip;                /* part k was there: its packets are dropped */
+    int64_t first_pts;        /* the first packet's (sample 0); AV_NOPTS_VALUE: none yet */
+    AVRational tb;            /* the packets' time base */
+    const AVCodecParameters *par;
+    int frame_size;
+    AVFormatContext *out;
+    char path[1100], tmp[1200];
+} part_writer;
+
+static bool part_open(part_writer *w, int k, rs_err *err)
 {
-    char path[1100], part[1200];
-    snprintf(path, sizeof path, "%s/track.ts", dir);
-    if (access(path, F_OK) == 0)
+    w->k = k;
+    cap_hls_track_path(w->dir, k, w->path, sizeof w->path);
+    w->skip = access(w->path, F_OK) == 0;
+    if (w->skip)
         return true;
-    snprintf(part, sizeof part, "%s/.track.ts.%d.part", dir, (int)getpid());
-    cap_av_log_level();
-    AVFormatContext *fmt = ts_open(part, err);
-    if (!fmt)
+    snprintf(w->tmp, sizeof w->tmp, "%s/.track.%d.ts.%d.part", w->dir, k, (int)getpid());
+    if (!(w->out = ts_open(w->tmp, err)))
         return false;
+    AVStream *st = avformat_new_stream(w->out, NULL);
+    if (!st)
+        return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", w->tmp);
+    int r = avcodec_parameters_copy(st->codecpar, w->par);
+    if (r < 0)
+        return fail_av(err, CAP_ERR_NOMEM, w->tmp, "codec parameters", r);
+    st->codecpar->frame_size = w->frame_size;
+    st->time_base = w->tb;
+    AVDictionary *o = ts_opts();
+    r = avformat_write_header(w->out, &o);
+    av_dict_free(&o);
+    return r >= 0 || fail_av(err, CAP_ERR_WRITE, w->tmp, "cannot write the header", r);
+}
+
+/* The part being written: closed, synced, linked into place (a part a
+ * racing maker put there first stays). */
+static bool part_close(part_writer *w, bool ok, rs_err *err)
+{
+    if (w->skip || !w->out)
+        return ok;
+    ok = ts_close(w->out, w->tmp, ok, err);
+    w->out = NULL;
+    if (ok && link(w->tmp, w->path) != 0 && errno != EEXIST)
+        ok = rs_fail(err, CAP_ERR_WRITE, "%s: cannot link %s into place: %s", w->path, w->tmp, strerror(errno));
+    unlink(w->tmp);
+    return ok;
+}
+
+static bool part_put(void *u, AVPacket *pkt, rs_err *err)
+{
+    part_writer *w = u;
+    if (w->first_pts == AV_NOPTS_VALUE)
+        w->first_pts = pkt->pts;
+    int64_t sample = av_rescale_q(pkt->pts - w->first_pts, w->tb, (AVRational){1, 48000});
+    int64_t k = sample / PART_SAMPLES;
+    if (k >= w->nparts) /* the encoder's last packets: the last part's */
+        k = w->nparts - 1;
+    while (w->k < k) {
+        if (!part_close(w, true, err) || !part_open(w, w->k + 1, err))
+            return false;
+    }
+    if (w->skip)
+        return true;
+    AVStream *st = w->out->streams[0];
+    av_packet_rescale_ts(pkt, w->tb, st->time_base);
+    pkt->stream_index = 0;
+    int r = av_interleaved_write_frame(w->out, pkt); /* takes the reference */
+    return r >= 0 || fail_av(err, CAP_ERR_WRITE, w->tmp, "write failed", r);
+}
+
+bool cap_hls_track(const char *dir, const cap_sink *audio, uint64_t total, rs_err *err)
+{
+    if (cap_hls_track_whole(dir, total))
+        return true;
+    cap_av_log_level();
+    /* the encoder's stream lives in a container without a file: the
+     * packets go to the parts */
+    AVFormatContext *fmt = NULL;
+    int r = avformat_alloc_output_context2(&fmt, NULL, "mpegts", NULL);
+    if (r < 0)
+        return fail_av(err, CAP_ERR_NOT_BUILT, dir, "this FFmpeg cannot write MPEG-TS", r);
     cap_sink s = *audio;
     if (!s.audio_bitrate)
         s.audio_bitrate = 192000; /* the default of .mp4 renders (cap_audio.c) */
     snprintf(s.audio_codec, sizeof s.audio_codec, "aac"); /* what every HLS player plays */
-    s.audio_fast = true; /* a 3-minute match in 2.3 s instead of 9.5: the first piece waits for it */
-    snprintf(s.path, sizeof s.path, "%s", path);
+    s.audio_fast = true; /* a 3-minute match in 2.3 s instead of 9.5 */
+    snprintf(s.path, sizeof s.path, "%s/track.ts", dir);
+    part_writer w = {.dir = dir, .nparts = cap_hls_track_parts(total), .k = -1, .first_pts = AV_NOPTS_VALUE};
     cap_aenc a = {0};
-    AVDictionary *o = ts_opts();
-    int r;
     bool ok = cap_aenc_open(&a, &s, fmt, err);
-    if (ok)
-        a.st->codecpar->frame_size = a.ctx->frame_size;
-    if (ok && (r = avformat_write_header(fmt, &o)) < 0)
-        ok = fail_av(err, CAP_ERR_WRITE, part, "cannot write the header", r);
-    av_dict_free(&o);
-    ok = ok && cap_aenc_finish(&a, &s, fmt, err);
+    if (ok) {
+        w.tb = a.st->time_base;
+        w.par = a.st->codecpar;
+        w.frame_size = a.ctx->frame_size;
+        a.put = part_put, a.put_u = &w;
+        ok = part_open(&w, 0, err) && cap_aenc_finish(&a, &s, fmt, err);
+    }
+    /* the parts no packet started in (a last part shorter than a packet) */
+    while (ok && w.k < w.nparts - 1)
+        ok = part_close(&w, true, err) && part_open(&w, w.k + 1, err);
+    ok = part_close(&w, ok, err);
     cap_aenc_close(&a);
-    ok = ts_close(fmt, part, ok, err);
-    /* link, not rename: a track another process put there first stays */
-    if (ok && link(part, path) != 0 && errno != EEXIST)
-        ok = rs_fail(err, CAP_ERR_WRITE, "%s: cannot link %s into place: %s", path, part, strerror(errno));
-    unlink(part);
+    avformat_free_context(fmt);
     return ok;
 }
 
 typedef struct cutter {
     const cap_hls_cut_desc *d;
-    AVFormatContext *vin, *ain;
+    AVFormatContext *vin, *ain; /* ain: the track's part being read, or NULL */
     int vi;                   /* the video stream of vin */
     AVPacket *pkt, *apkt;     /* apkt: the track's next packet, read ahead (empty: none left) */
+    AVCodecParameters *apar;  /* the track's stream (NULL: silent pieces) */
+    AVRational atb;           /* its time base */
+    int apart, nparts;        /* the track's next part to read (ain: the one being read), of */
     int64_t a0;               /* the track's first pts: sample 0 */
     bool a_eof;
     AVFormatContext *out;     /* the piece being written */
@@ -386,11 +488,11 @@ static bool piece_open(cutter *c, uint64_t tick, rs_err *err)
     if (!(c->out = ts_open(c->part, err)))
         return false;
     AVStream *in = c->vin->streams[c->vi];
-    if (!(c->ost = avformat_new_stream(c->out, NULL)) || (c->ain && !(c->oast = avformat_new_stream(c->out, NULL))))
+    if (!(c->ost = avformat_new_stream(c->out, NULL)) || (c->apar && !(c->oast = avformat_new_stream(c->out, NULL))))
         return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", c->part);
     int r;
     if ((r = avcodec_parameters_copy(c->ost->codecpar, in->codecpar)) < 0 ||
-        (c->ain && (r = avcodec_parameters_copy(c->oast->codecpar, c->ain->streams[0]->codecpar)) < 0))
+        (c->apar && (r = avcodec_parameters_copy(c->oast->codecpar, c->apar)) < 0))
         return fail_av(err, CAP_ERR_NOMEM, c->part, "codec parameters", r);
     c->ost->codecpar->codec_tag = 0;
     c->ost->time_base = (AVRational){1, 90000};
@@ -408,6 +510,69 @@ static bool piece_open(cutter *c, uint64_t tick, rs_err *err)
     return true;
 }
 
+/* Part k of the track open in c->ain: waited for while a maker is at
+ * work (cap_hls_cut_desc.track_alive), checked to be one AAC stream. */
+static bool part_read_open(cutter *c, int k, rs_err *err)
+{
+    const cap_hls_cut_desc *d = c->d;
+    char path[1100];
+    cap_hls_track_path(d->dir, k, path, sizeof path);
+    double t0 = rs_now();
+    for (int gone = 0; access(path, F_OK) != 0;) {
+        /* no maker twice in a row, 100 ms apart: one maker may be handing
+         * the lock to another that waited for it */
+        if (d->track_alive && d->track_alive(d->track_u))
+            gone = 0;
+        else if (++gone == 2)
+            return rs_fail(err, CAP_ERR_SEG_MISSING, "%s: missing, and no process is making the match's sound", path);
+        nanosleep(&(struct timespec){0, gone ? 100000000 : 20000000}, NULL);
+    }
+    if (d->waited)
+        *d->waited += rs_now() - t0;
+    int r = avformat_open_input(&c->ain, path, NULL, NULL);
+    if (r < 0)
+        return fail_av(err, CAP_ERR_SEG_MISSING, path, "cannot open the match's sound", r);
+    if (c->ain->nb_streams != 1 || c->ain->streams[0]->codecpar->codec_id != AV_CODEC_ID_AAC)
+        return rs_fail(err, CAP_ERR_SEG_MEDIA, "%s: not one AAC stream", path);
+    c->atb = c->ain->streams[0]->time_base;
+    return true;
+}
+
+/* The track's next packet into c->apkt, from the parts in turn: 1; 0
+ * when there is none for a piece ending at tick upto (the part it would
+ * come from starts there or later: not waited for yet) or none at all
+ * (a_eof); -1 with err. */
+static int track_next(cutter *c, uint64_t upto, rs_err *err)
+{
+    for (;;) {
+        if (!c->ain) {
+            if (c->apart >= c->nparts) {
+                c->a_eof = true;
+                return 0;
+            }
+            if (upto < c->d->total && (int64_t)c->apart * PART_SAMPLES >= (int64_t)upto * 800)
+                return 0;
+            if (!part_read_open(c, c->apart, err))
+                return -1;
+        }
+        int r = av_read_frame(c->ain, c->apkt);
+        if (r == AVERROR_EOF) {
+            avformat_close_input(&c->ain);
+            c->apart++;
+            continue;
+        }
+        if (r < 0) {
+            char path[1100];
+            cap_hls_track_path(c->d->dir, c->apart, path, sizeof path);
+            fail_av(err, CAP_ERR_SEG_MEDIA, path, "read error", r);
+            return -1;
+        }
+        if (c->a0 == AV_NOPTS_VALUE)
+            c->a0 = c->apkt->pts;
+        return 1;
+    }
+}
+
 /* The track's packets that start before tick `upto` (all of them when
  * upto is the match's end), then the piece is closed. */
 static bool piece_close(cutter *c, uint64_t upto, rs_err *err)
@@ -415,27 +580,23 @@ static bool piece_close(cutter *c, uint64_t upto, rs_err *err)
     bool ok = true;
     int r;
     uint64_t from = c->ix.p[c->ix.n - 1].tick;
-    while (ok && c->ain && !c->a_eof) {
+    while (ok && c->apar && !c->a_eof) {
         if (!c->apkt->data) {
-            r = av_read_frame(c->ain, c->apkt);
-            if (r == AVERROR_EOF) {
-                c->a_eof = true;
-                break;
-            }
+            r = track_next(c, upto, err);
             if (r < 0)
-                return fail_av(err, CAP_ERR_SEG_MEDIA, c->d->dir, "reading track.ts", r);
-            if (c->a0 == AV_NOPTS_VALUE)
-                c->a0 = c->apkt->pts;
+                return false;
+            if (r == 0)
+                break;
         }
         /* its first sample, in 1/48000 from the match's start; 800 a tick */
-        int64_t sample = av_rescale_q(c->apkt->pts - c->a0, c->ain->streams[0]->time_base, (AVRational){1, 48000});
+        int64_t sample = av_rescale_q(c->apkt->pts - c->a0, c->atb, (AVRational){1, 48000});
         if (upto < c->d->total && sample >= (int64_t)upto * 800)
             break;
         if (sample < (int64_t)from * 800) { /* before this unit: another piece's */
             av_packet_unref(c->apkt);
             continue;
         }
-        int64_t ts = av_rescale_q(c->apkt->pts - c->a0, c->ain->streams[0]->time_base, c->oast->time_base) +
+        int64_t ts = av_rescale_q(c->apkt->pts - c->a0, c->atb, c->oast->time_base) +
                      (int64_t)CAP_HLS_OFFSET_TICKS * 1500;
         c->apkt->pts = c->apkt->dts = ts;
         c->apkt->stream_index = c->oast->index;
@@ -474,7 +635,6 @@ static void remove_parts(cutter *c)
 static bool open_inputs(cutter *c, rs_err *err)
 {
     const cap_hls_cut_desc *d = c->d;
-    char track[1100];
     int r = avformat_open_input(&c->vin, d->video, NULL, NULL);
     if (r < 0)
         return fail_av(err, d->seg ? CAP_ERR_SEG_MEDIA : CAP_ERR_ENCODER, d->video, "cannot open", r);
@@ -489,12 +649,21 @@ static bool open_inputs(cutter *c, rs_err *err)
                        d->video, avcodec_get_name(id));
     if (d->silent)
         return true;
-    snprintf(track, sizeof track, "%s/track.ts", d->dir);
-    if ((r = avformat_open_input(&c->ain, track, NULL, NULL)) < 0)
-        return fail_av(err, CAP_ERR_SEG_MISSING, track, "cannot open the match's sound", r);
-    if ((r = avformat_find_stream_info(c->ain, NULL)) < 0 || c->ain->nb_streams != 1 ||
-        c->ain->streams[0]->codecpar->codec_id != AV_CODEC_ID_AAC)
-        return rs_fail(err, CAP_ERR_SEG_MEDIA, "%s: not one AAC stream", track);
+    /* part 0 first, for the track's stream and its first pts (sample 0) */
+    c->nparts = cap_hls_track_parts(d->total);
+    if (!part_read_open(c, 0, err))
+        return false;
+    r = avformat_find_stream_info(c->ain, NULL);
+    if (r < 0 || (r = av_read_frame(c->ain, c->apkt)) < 0)
+        return fail_av(err, CAP_ERR_SEG_MEDIA, c->ain->url, "cannot read the match's sound", r);
+    c->a0 = c->apkt->pts;
+    av_packet_unref(c->apkt);
+    if (!(c->apar = avcodec_parameters_alloc()) || avcodec_parameters_copy(c->apar, c->ain->streams[0]->codecpar) < 0)
+        return rs_fail(err, CAP_ERR_NOMEM, "%s: out of memory", d->video);
+    avformat_close_input(&c->ain);
+    /* then from the part of the unit's first sample */
+    int64_t k = (int64_t)d->first * 800 / PART_SAMPLES;
+    c->apart = k < c->nparts ? (int)k : c->nparts - 1;
     return true;
 }
 
@@ -641,14 +810,15 @@ static bool cut_locked(const cap_hls_cut_desc *d, rs_err *err)
     av_packet_free(&c.apkt);
     avformat_close_input(&c.vin);
     avformat_close_input(&c.ain);
+    avcodec_parameters_free(&c.apar);
     free(c.ix.p);
     return ok;
 }
 
 #else /* no FFmpeg: nothing to cut with */
-bool cap_hls_track(const char *dir, const cap_sink *audio, rs_err *err)
+bool cap_hls_track(const char *dir, const cap_sink *audio, uint64_t total, rs_err *err)
 {
-    (void)audio;
+    (void)audio, (void)total;
     return rs_fail(err, CAP_ERR_NOT_BUILT, "%s: this build has no FFmpeg libraries, so no HLS pieces", dir);
 }
 

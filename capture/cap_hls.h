@@ -3,9 +3,14 @@
  * (docs/service.md, "Watching while it renders").
  *
  * One folder per job holds:
- *   track.ts      the whole match's sound, AAC in MPEG-TS, made once
- *                 (cap_hls_track) by whichever render needs it first: the
- *                 track is deterministic, so two makers make the same one;
+ *   track.K.ts    the whole match's sound, AAC in MPEG-TS, in parts of
+ *                 CAP_HLS_TRACK_PART_TICKS (10 s): part K has the packets
+ *                 that start in its time (the last part the rest).  One
+ *                 encoding of the whole match (cap_hls_track), by whichever
+ *                 render needs it first, a part linked into place as soon
+ *                 as it is complete, so a piece waits only for the parts of
+ *                 its own time; the track is deterministic, so two makers
+ *                 make the same parts;
  *   tTICK.ts      a piece: the video from its keyframe at TICK up to the
  *                 next keyframe (or the unit's end), stream-copied (nothing
  *                 decoded or encoded again), and the track's packets of the
@@ -20,7 +25,7 @@
  * piece, so pieces cut by different processes (and machines) play as one
  * stream; decode times trail the frames' positions by CAP_HLS_REORDER.
  *
- *   render:  cap_hls_track(dir, sink)      the sound, unless it is there
+ *   render:  cap_hls_track(dir, sink, total)  the sound, the parts not there
  *            cap_hls_cut(&cut)             pieces, then the index
  *   serve:   cap_hls_index_read(dir, first, &ix)
  *            cap_hls_playlist(units, n, ended, prefix)
@@ -60,14 +65,24 @@ typedef struct cap_hls_index {
 
 void cap_hls_index_free(cap_hls_index *ix);
 
-/* Makes DIR/track.ts from audio's track (cap_sink_audio filled its
- * audio, audio_u, audio_frames and bitrate; the track starts at tick 0)
- * unless it exists.  Written as a temporary of this process and linked
- * into place: a racing maker's track is kept, never half-replaced. */
-bool cap_hls_track(const char *dir, const cap_sink *audio, rs_err *err);
+#define CAP_HLS_TRACK_PART_TICKS 600
+
+/* The track's parts for a match of total ticks, and part k's path. */
+int cap_hls_track_parts(uint64_t total);
+void cap_hls_track_path(const char *dir, int k, char *out, size_t n);
+/* Every part of the track is in DIR (the last is written last). */
+bool cap_hls_track_whole(const char *dir, uint64_t total);
+
+/* Makes DIR/track.K.ts from audio's track (cap_sink_audio filled its
+ * audio, audio_u, audio_frames and bitrate; the track starts at tick 0 and
+ * is total ticks long), encoding the whole match once and writing each
+ * part that is not there yet.  A part is written as a temporary of this
+ * process and linked into place: a racing maker's part is kept, never
+ * half-replaced. */
+bool cap_hls_track(const char *dir, const cap_sink *audio, uint64_t total, rs_err *err);
 
 typedef struct cap_hls_cut_desc {
-    const char *dir;     /* the job's folder; must exist and hold track.ts unless !sound */
+    const char *dir;     /* the job's folder; must exist; its track's parts are read as they come */
     const char *video;   /* a segment (pts = tick), or a render's output (pts from 0 at tick first) */
     const cap_seg *seg;  /* the segment as cap_seg_verify filled it, or NULL (a whole render):
                             its packets must match its manifest (count, CRC-32), as the join checks */
@@ -75,6 +90,12 @@ typedef struct cap_hls_cut_desc {
     uint64_t total;      /* the match's last tick + 1: the last piece takes the track's rest */
     bool silent;         /* pieces without sound (a job asked for none): no track needed */
     bool *kept;          /* optional: set when a good index was there already */
+    /* a part of the track not there yet is waited for while track_alive
+     * says a maker is at work (NULL: it must be there); the seconds spent
+     * waiting are added to *waited (optional) */
+    bool (*track_alive)(void *u);
+    void *track_u;
+    double *waited;
 } cap_hls_cut_desc;
 
 /* Cuts the video at its keyframes into pieces and writes the unit's

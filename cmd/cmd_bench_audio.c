@@ -166,7 +166,7 @@ int bench_audio(int argc, char **argv)
         goto fail;
     rows[2] = per_tick("mix, busy", us, busy_n);
     t0 = rs_now();
-    if (!au_replay_track(&rp, replay, 0, 0, NULL, &t, &err))
+    if (!au_replay_track(&rp, replay, 0, 0, &(au_replay_opts){.before_peak = true}, &t, &err))
         goto fail;
     double track_s = rs_now() - t0;
     rows[3] = (row){"whole track", NAN, NAN, track_s, rp.ticks / (double)G_HZ / track_s};

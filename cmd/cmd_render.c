@@ -113,9 +113,11 @@ static void help(void)
            "                     at most 64) names the job and attempt; --hashes, if given, must\n"
            "                     be OUT with its extension replaced by .hashes (docs/segments.md)\n"
            "  --hls-dir DIR      also cut the video (.mp4 or .mkv, H.264 or HEVC) at its keyframes\n"
-           "                     into HLS pieces in DIR, with the whole match's sound (DIR/track.ts,\n"
-           "                     made once): what 'ringside serve' streams while a job renders\n"
-           "                     (docs/service.md, Watching while it renders)\n"
+           "                     into HLS pieces in DIR, with the whole match's sound (DIR/track.K.ts,\n"
+           "                     made once by a process of its own, 10 s a part): what 'ringside\n"
+           "                     serve' streams while a job renders (docs/service.md, Watching\n"
+           "                     while it renders).  With --segment the render ends when its\n"
+           "                     pieces are cut and leaves the rest of the track to that process\n"
            "  --progress-fd N    also report progress on file descriptor N, for programs\n"
            "                     (ringside serve): 'frames DONE TOTAL' lines, 'desync TICK'\n"
            "                     if the replay's state hashes stop matching, and 'hls-failed'\n"
@@ -865,9 +867,8 @@ static int hls_finish(render_run *run, job_hls *h, int status)
         return status == RS_EXIT_OK ? RS_EXIT_FAIL : status;
     }
     if (status == RS_EXIT_OK)
-        cli_debug("render", "HLS pieces of %s in %s: the track %.2f s%s (waited for %.2f s after the frames), the cut %.2f s",
-                  run->o->out, run->o->hls_dir, h->track_s, h->track_s ? "" : " (made before)", h->wait_s,
-                  rs_now() - t0 - h->wait_s);
+        cli_debug("render", "HLS pieces of %s in %s: waited %.2f s for the match's sound, the cut %.2f s in all",
+                  run->o->out, run->o->hls_dir, h->wait_s, rs_now() - t0);
     return status;
 }
 

@@ -209,7 +209,7 @@ static int sound(const char *path, const char *out, uint64_t first, uint64_t end
     if (!read_for_sound(path, end, &rp))
         return RS_EXIT_FAIL;
     rs_err err = {0};
-    au_replay_opts o = {.target_lufs = lufs};
+    au_replay_opts o = {.target_lufs = lufs, .before_peak = true}; /* its message reports it */
     int status = RS_EXIT_FAIL;
     /* streamed: the match mixed again as the WAV is written, never held whole */
     au_replay_stream *st = au_replay_open(&rp, path, first, end, &o, &err);

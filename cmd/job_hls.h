@@ -4,28 +4,37 @@
  *
  *   job_hls h;
  *   job_hls_start(&h, &desc, err)   before the first frame: DIR made, and
- *                                   the match's sound (DIR/track.ts) made
- *                                   on a thread of its own unless another
- *                                   render made it or is making it (a lock
- *                                   file: one maker at a time)
+ *                                   a process started that makes the
+ *                                   match's sound (DIR/track.K.ts, 10 s a
+ *                                   part) unless it is whole; makers take
+ *                                   turns under a lock file, and the
+ *                                   second finds the parts made
  *   ... render; the video (and a segment's manifest) in place ...
- *   job_hls_finish(&h, ok, err)     ok: waits for the track, checks the
- *                                   video (a segment as the join checks
- *                                   it: manifest, key, ticks, hash list),
- *                                   cuts it at its keyframes, the unit's
- *                                   index last; a whole render also gets
- *                                   DIR/stream.m3u8.  !ok: stops the track.
+ *   job_hls_finish(&h, ok, err)     ok: checks the video (a segment as
+ *                                   the join checks it: manifest, key,
+ *                                   ticks, hash list), cuts it at its
+ *                                   keyframes (each piece waits for the
+ *                                   track's parts of its time while a
+ *                                   maker is at work), the unit's index
+ *                                   last.  A segment then leaves the rest
+ *                                   of the track to its maker, which ends
+ *                                   when the track is whole: the next
+ *                                   units need it, and the service lists
+ *                                   this unit's pieces when the render
+ *                                   exits.  Anything else waits for the
+ *                                   whole track and gets DIR/stream.m3u8.
+ *                                   !ok: stops the maker.
  *
- * The track takes about 2.3 s of one core for a 3-minute match; drawing
- * the first unit's frames meanwhile is what keeps it off the time to the
- * first piece. */
+ * The track costs the match's loudness (two passes over the whole match:
+ * au_norm_plan) and its encoding (AAC, about 1/60 of real time on one
+ * core); a unit's pieces wait only for the first and the parts of their
+ * own time, and drawing the unit's frames meanwhile hides most of it. */
 #ifndef JOB_HLS_H
 #define JOB_HLS_H
 
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
+#include <sys/types.h>
 
 #include "../runtime/replay/rp.h"
 #include "../runtime/util/rs_err.h"
@@ -45,13 +54,9 @@ typedef struct job_hls_desc {
 
 typedef struct job_hls {
     job_hls_desc d;
-    pthread_t thread;
-    bool running;
-    atomic_int stop;            /* set (by the render's thread): the track maker gives up */
-    bool track_ok;
-    rs_err track_err;
-    double track_s;             /* what making the track took (0: it was there) */
-    double wait_s;              /* what job_hls_finish waited for it after the frames */
+    pid_t maker;                /* this render's track maker while it runs; 0: none */
+    int maker_status;           /* its wait status once it ended (0: none was needed) */
+    double wait_s;              /* what the cut waited for the track's parts */
 } job_hls;
 
 bool job_hls_start(job_hls *h, const job_hls_desc *d, rs_err *err);

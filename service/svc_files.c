@@ -11,7 +11,7 @@
  *   .jobN-PID-aK.fmt/.hashes/.png   an unsplit job's render, claim K, by daemon PID
  *   .jobN-PID-jK.fmt / .hashes      a split job's join, claim K
  *   N.stream/jobN-NONCE/            the job's live stream, kept with its video
- *       track.ts, tTICK.ts, uA.idx  (capture/cap_hls.h): written by the renders
+ *       track.K.ts, tTICK.ts, uA.idx (capture/cap_hls.h): written by the renders
  *                                   (render --hls-dir), served as HLS
  *   .jobN-NONCE/                    a split job's segments: the directory is
  *                                   named by the job's key (svc_store.h), so a

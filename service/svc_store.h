@@ -230,7 +230,7 @@ typedef struct svc_pending {
  * hashes and poster, and the render log in the queue's database beside the
  * replay, by name:
  *   seg/sI-aK.FMT, seg/sI-aK.FMT.seg, seg/sI-aK.hashes, seg/sI-aK.png
- *   stream/track.ts, stream/tTICK.ts, stream/uFIRST.idx
+ *   stream/tTICK.ts, stream/uFIRST.idx (each machine makes its own track)
  *   video.FMT, hashes, poster.png, log
  * and a daemon that needs one it does not have fetches it (svc_files.c).
  * A name is written once per claim (segments carry their claim), so its

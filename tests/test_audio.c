@@ -493,6 +493,15 @@ static void t_loudness_stream_any_pieces(void)
     T_ASSERTF(au_norm_plan(&src, -16, -1, &plan, &err), "%s", err.msg);
     T_ASSERT(plan.on && plan.after.integrated == a.integrated && plan.after.true_peak == a.true_peak);
     T_ASSERTF(plan.gain > 1.5f, "gain %.3f: the limiter must have work to do", plan.gain);
+    /* without the track's own true peak (what a render asks): the same plan */
+    au_norm quick;
+    T_ASSERTF(au_norm_plan_peak(&src, -16, -1, false, &quick, &err), "%s", err.msg);
+    T_ASSERTF(quick.gain == plan.gain && quick.ceiling == plan.ceiling && quick.after.true_peak == plan.after.true_peak &&
+                  quick.before.integrated == plan.before.integrated,
+              "a plan without the first peak differs: gain %.6f / %.6f, ceiling %.6f / %.6f", quick.gain, plan.gain,
+              quick.ceiling, plan.ceiling);
+    T_ASSERTF(isnan(quick.before.true_peak) && isfinite(plan.before.true_peak), "before's true peak %.2f / %.2f",
+              quick.before.true_peak, plan.before.true_peak);
     au_norm_stream *st = au_norm_stream_new(&src, &plan, &err);
     T_ASSERT(st != NULL);
     static const size_t pieces[] = {1, 97, 800, 48001};

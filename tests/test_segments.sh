@@ -243,7 +243,7 @@ t_hls_pieces() {
     # pieces at the keyframes: 0 and 120 in the first unit (every 120 frames), 150 in the second
     [ "$(grep -h '^piece' hls/u0.idx hls/u150.idx | cut -d' ' -f2,3 | tr '\n' ' ')" = "0 120 120 30 150 90 " ] ||
         { cat hls/u0.idx hls/u150.idx; return 1; }
-    [ -s hls/track.ts ] || { echo "no track"; return 1; }
+    [ -s hls/track.0.ts ] && [ ! -e hls/track.1.ts ] || { echo "not one part of track"; ls hls; return 1; }
     "$RS_BIN" join --segment job7 -y -q -o joined.mp4 --replay m.rsr s0.mp4 s150.mp4 || return 1
     hls_playlist hls 0 150 >live.m3u8
     [ "$(vframes joined.mp4 | wc -l)" = 240 ] && [ "$(vframes joined.mp4 | md5sum)" = "$(vframes live.m3u8 | md5sum)" ] ||
@@ -252,7 +252,7 @@ t_hls_pieces() {
     n=$(ffprobe -v error -count_packets -select_streams a -show_entries stream=nb_read_packets -of csv=p=0 live.m3u8 | grep -m1 .)
     [ "$n" -ge 186 ] && [ "$n" -le 190 ] || { echo "$n audio packets for 4 s (about 188)"; return 1; }
     for p in hls/t*.ts; do
-        [ "$p" = hls/track.ts ] && continue
+        case $p in hls/track.*) continue ;; esac
         ffprobe -v error -show_entries stream=codec_name -of csv=p=0 "$p" | tr '\n' ' ' | grep -q "h264 aac" ||
             { echo "$p: not H.264 and AAC"; return 1; }
     done
@@ -271,13 +271,48 @@ t_hls_pieces() {
     grep -q '^#EXT-X-ENDLIST' w/stream.m3u8 && [ "$(grep -c '^t' w/stream.m3u8)" = 2 ] && grep -q '^t180.ts' w/stream.m3u8 ||
         { cat w/stream.m3u8; return 1; }
     [ "$(vframes whole.mp4 | md5sum)" = "$(vframes w/stream.m3u8 | md5sum)" ] || { echo "the whole render's stream is not its frames"; return 1; }
-    [ ! -e w/track.ts ] && [ -z "$(ffprobe -v error -select_streams a -show_entries stream=codec_name -of csv=p=0 w/t60.ts)" ] ||
+    [ ! -e w/track.0.ts ] && [ -z "$(ffprobe -v error -select_streams a -show_entries stream=codec_name -of csv=p=0 w/t60.ts)" ] ||
         { echo "--audio off made a track or sound"; return 1; }
     # what has no HLS pieces is refused before any work
     for o in "x.webm" "x.mkv --codec vp9" "x.y4m"; do
         "$RS_BIN" render m.rsr --ticks 0:10 $TINY -q -o $o --hls-dir h2 2>err.txt
         [ $? = 2 ] && grep -q "HLS pieces are H.264 or HEVC" err.txt && [ ! -e h2 ] || { echo "-o $o"; cat err.txt; return 1; }
     done
+}
+
+# The track in parts of 10 s: a unit's pieces wait for the parts of their
+# own time, and a segment's render ends then, leaving the rest of the track
+# to its maker; a piece across two parts has the sound of both; a render
+# whose maker died says so instead of waiting.
+aac_packets() { ffprobe -v error -count_packets -select_streams a -show_entries stream=nb_read_packets -of csv=p=0 "$1" | grep -m1 .; }
+t_hls_track_parts() {
+    "$RS_BIN" record --ai --quiet --seconds 120 --seed 8 -o m.rsr || return 1
+    "$RS_BIN" render m.rsr --ticks 0:60 $TINY -q --segment j --hls-dir h -o s0.mp4 || return 1
+    # 12 parts; the encoding of the other 110 s goes on after the render
+    [ -s h/track.0.ts ] && [ ! -e h/track.11.ts ] || { echo "the render waited for the whole track"; ls h; return 1; }
+    n=$(aac_packets h/t0.ts)
+    [ "$n" -ge 46 ] && [ "$n" -le 48 ] || { echo "$n audio packets in 1 s (about 47)"; return 1; }
+    # ticks 570..689 take the end of part 0 and the start of part 1
+    "$RS_BIN" render m.rsr --ticks 570:690 $TINY -q --segment j --hls-dir h -o s570.mp4 || return 1
+    n=$(aac_packets h/t570.ts)
+    [ "$n" -ge 92 ] && [ "$n" -le 95 ] || { echo "$n audio packets in 2 s across two parts (about 94)"; return 1; }
+    i=0
+    while [ ! -e h/track.11.ts ] && [ $i -lt 300 ]; do sleep 0.1; i=$((i + 1)); done
+    [ -e h/track.11.ts ] && [ ! -e h/track.12.ts ] || { echo "the track was not finished in the background"; ls h; return 1; }
+    sleep 0.2
+    [ -z "$(find h -name '.track.*.part')" ] || { echo "temporaries left:"; ls -a h; return 1; }
+    # a maker killed before the frames are done: the cut says so and exits 1
+    ( export ASAN_OPTIONS=detect_leaks=0; exec "$RS_BIN" render m.rsr --ticks 0:60 $TINY -q --segment j --hls-dir h2 -o k.mp4 ) 2>err.txt &
+    rpid=$!
+    t0=$(date +%s)
+    i=0
+    while [ -z "$(pgrep -P $rpid)" ] && [ $i -lt 100 ]; do sleep 0.02; i=$((i + 1)); done
+    kill -9 $(pgrep -P $rpid) 2>/dev/null
+    wait $rpid
+    st=$?
+    [ $(($(date +%s) - t0)) -le 15 ] || { echo "the render waited $(($(date +%s) - t0)) s for a dead maker"; return 1; }
+    [ $st = 1 ] && grep -q "h2/track.0.ts: missing, and no process is making the match's sound" err.txt ||
+        { echo "exit $st with the maker killed"; cat err.txt; return 1; }
 }
 
 t_help() {
@@ -290,5 +325,5 @@ t_help() {
 }
 
 t_run mp4_segments_join_to_the_single_render mkv_and_webm bad_segments_exit_3 output_failures_exit_1 segment_render_rules \
-    hls_pieces help
+    hls_pieces hls_track_parts help
 t_done

@@ -42,19 +42,27 @@
 
 struct au_meter {
     ebur128_state *st;
+    bool peak; /* the true peak measured too: most of libebur128's work */
 };
 
-au_meter *au_meter_new(rs_err *err)
+static au_meter *meter_new(bool peak, rs_err *err)
 {
     au_meter *m = calloc(1, sizeof *m);
-    if (m)
-        m->st = ebur128_init(AU_CHANNELS, AU_RATE, EBUR128_MODE_I | EBUR128_MODE_LRA | EBUR128_MODE_TRUE_PEAK);
+    if (m) {
+        m->peak = peak;
+        m->st = ebur128_init(AU_CHANNELS, AU_RATE, EBUR128_MODE_I | EBUR128_MODE_LRA | (peak ? EBUR128_MODE_TRUE_PEAK : 0));
+    }
     if (!m || !m->st) {
         free(m);
         rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 could not start (out of memory)");
         return NULL;
     }
     return m;
+}
+
+au_meter *au_meter_new(rs_err *err)
+{
+    return meter_new(true, err);
 }
 
 bool au_meter_add(au_meter *m, const float *pcm, size_t frames, rs_err *err)
@@ -72,7 +80,7 @@ bool au_meter_result(au_meter *m, au_loudness *out, rs_err *err)
 {
     double I = -HUGE_VAL, lra = 0, tp = 0;
     bool ok = true;
-    for (unsigned c = 0; c < AU_CHANNELS && ok; c++) {
+    for (unsigned c = 0; c < AU_CHANNELS && ok && m->peak; c++) {
         double p;
         ok = ebur128_true_peak(m->st, c, &p) == EBUR128_SUCCESS;
         tp = ok && p > tp ? p : tp;
@@ -83,7 +91,7 @@ bool au_meter_result(au_meter *m, au_loudness *out, rs_err *err)
         return rs_fail(err, AU_ERR_LOUDNESS, "loudness: libebur128 failed to measure the track");
     out->integrated = isfinite(I) ? I : -HUGE_VAL;
     out->range = isfinite(lra) ? lra : 0;
-    out->true_peak = tp > 0 ? 20 * log10(tp) : -HUGE_VAL;
+    out->true_peak = !m->peak ? NAN : tp > 0 ? 20 * log10(tp) : -HUGE_VAL;
     return true;
 }
 
@@ -368,13 +376,13 @@ void au_norm_stream_free(au_norm_stream *s)
 }
 
 /* One read of the source from its start through the plan's gain and
- * limiter (the stream that gives the result) into the meter; limited: the
- * limiter had anything to do. */
-static bool measure_pass(const au_source *src, const au_norm *p, au_loudness *a, bool *limited, rs_err *err)
+ * limiter (the stream that gives the result) into the meter, with the
+ * true peak or without (NAN); limited: the limiter had anything to do. */
+static bool measure_pass(const au_source *src, const au_norm *p, bool peak, au_loudness *a, bool *limited, rs_err *err)
 {
     float *buf = malloc(SPIECE * 2 * sizeof *buf);
     au_norm_stream *s = buf ? au_norm_stream_new(src, p, err) : NULL;
-    au_meter *m = s ? au_meter_new(err) : NULL;
+    au_meter *m = s ? meter_new(peak, err) : NULL;
     if (!buf)
         rs_fail(err, AU_ERR_NOMEM, "loudness: out of memory");
     bool ok = m != NULL;
@@ -394,13 +402,19 @@ static bool measure_pass(const au_source *src, const au_norm *p, au_loudness *a,
 
 bool au_norm_plan(const au_source *src, double target_lufs, double peak_dbtp, au_norm *plan, rs_err *err)
 {
+    return au_norm_plan_peak(src, target_lufs, peak_dbtp, true, plan, err);
+}
+
+bool au_norm_plan_peak(const au_source *src, double target_lufs, double peak_dbtp, bool before_peak, au_norm *plan,
+                       rs_err *err)
+{
     memset(plan, 0, sizeof *plan);
     if (!isfinite(target_lufs) || target_lufs < -70 || target_lufs > 0 || !isfinite(peak_dbtp) || peak_dbtp > 0 ||
         peak_dbtp < -30)
         return rs_fail(err, AU_ERR_ARG, "loudness: target %.1f LUFS, ceiling %.1f dBTP (expected -70..0 and -30..0)",
                        target_lufs, peak_dbtp);
     au_loudness b, a;
-    if (!measure_pass(src, &(au_norm){.on = false}, &b, NULL, err))
+    if (!measure_pass(src, &(au_norm){.on = false}, before_peak, &b, NULL, err))
         return false;
     plan->before = b;
     a = b;
@@ -410,7 +424,7 @@ bool au_norm_plan(const au_source *src, double target_lufs, double peak_dbtp, au
             float g = (float)pow(10.0, gain_db / 20.0);
             double c = pow(10.0, ceiling_db / 20.0);
             bool limited;
-            if (!measure_pass(src, &(au_norm){.on = true, .gain = g, .ceiling = c}, &a, &limited, err))
+            if (!measure_pass(src, &(au_norm){.on = true, .gain = g, .ceiling = c}, true, &a, &limited, err))
                 return false;
             plan->on = true, plan->gain = g, plan->ceiling = c;
             /* the limiter took loudness away: make it up (a few times at

@@ -134,7 +134,7 @@ au_replay_stream *au_replay_open(const rp_replay *rp, const char *name, uint64_t
     bool ok;
     if (normalize) {
         au_norm plan;
-        ok = au_norm_plan(&s->src, target, peak, &plan, err) && (s->norm = au_norm_stream_new(&s->src, &plan, err));
+        ok = au_norm_plan_peak(&s->src, target, peak, opt.before_peak, &plan, err) && (s->norm = au_norm_stream_new(&s->src, &plan, err));
         if (!ok)
             rs_err_prefix(err, "%s", name);
         s->info.lufs_before = plan.before.integrated;
