@@ -16,6 +16,7 @@
 #include "../runtime/util/rs_log.h"
 #include "job_audio.h"
 #include "job_hls.h"
+#include "../runtime/audio/au.h"
 #include "job_poster.h"
 #include "job_out.h"
 #include "job_render.h"
@@ -851,6 +852,10 @@ static int render_here(render_run *run)
 static bool hls_start(render_run *run, job_hls *h)
 {
     const render_opts *o = run->o;
+    /* the sound bank (0.3 s) built before the track's maker is forked,
+     * when this render mixes the match too: then both have it */
+    if (!o->audio_off && (o->audio.mode == JOB_AUDIO_ON || o->audio.wav))
+        au_bank_get(0);
     job_hls_desc d = {.dir = o->hls_dir, .video = o->out, .segment = o->segment, .hashes = o->hashes != NULL,
                       .rp = &run->rp, .name = o->replay, .lufs = o->audio.lufs, .bitrate = o->audio.bitrate,
                       .silent = o->audio_off, .first = run->first, .end = run->end};
