@@ -6,8 +6,10 @@ here=$(cd "$(dirname "$0")" && pwd)
 SRC=$(cd "$here/.." && pwd)
 SIZES="--render-size 320x180 --size 160x90"
 
-short_replay() { # 120 ticks: the intro (more frames than any ring or queue below)
-    "$RS_BIN" record --ai --quiet --seconds 2 --seed 21 -o short.rsr 2>/dev/null
+# short_replay [SECONDS]: 2 s, 120 ticks: the intro (more frames than any
+# ring or queue below); 1 s where a case needs only some frames of each kind
+short_replay() {
+    "$RS_BIN" record --ai --quiet --seconds "${1:-2}" --seed 21 -o short.rsr 2>/dev/null
 }
 
 probe() { # file -> "frames rate duration"
@@ -36,20 +38,23 @@ t_y4m_plays() {
     head -c 80 v.y4m | grep -q "^YUV4MPEG2 W160 H90 F60:1 Ip A1:1 C420jpeg XCOLORRANGE=LIMITED" || return 1
 }
 
+# the MP4 says 60/1, has a frame a tick and lasts the replay's time to the
+# microsecond; the MKV has every frame too.  1 s, 60 frames, is well past
+# x264's delay (veryfast: 10 frames of lookahead, 3 B-frames)
 t_mp4_exact_timing() {
     command -v ffprobe >/dev/null || t_skip_install "ffprobe not installed"
     "$RS_BIN" render --help | grep -q "\.mp4" || t_skip_install "this build has no FFmpeg"
-    short_replay || return 1
+    short_replay 1 || return 1
     "$RS_BIN" render short.rsr -o v.mp4 $SIZES --quiet 2>e.txt || { cat e.txt; return 1; }
     [ ! -s e.txt ] || { echo "noise on stderr with --quiet:"; cat e.txt; return 1; }
     set -- $(probe v.mp4)
-    [ "$1" = "60/1" ] && [ "$2" = 120 ] || { echo "mp4: rate $1 frames $2"; return 1; }
-    [ "$3" = "2.000000" ] || { echo "mp4: duration $3, want 2.000000"; return 1; }
+    [ "$1" = "60/1" ] && [ "$2" = 60 ] || { echo "mp4: rate $1 frames $2"; return 1; }
+    [ "$3" = "1.000000" ] || { echo "mp4: duration $3, want 1.000000"; return 1; }
     ffprobe -v error -show_entries stream=codec_name,color_range,color_space -of csv=p=0 v.mp4 | grep -q "h264,tv,bt709" ||
         { ffprobe -v error -show_entries stream=codec_name,color_range,color_space -of csv=p=0 v.mp4; return 1; }
     "$RS_BIN" render short.rsr -o v.mkv $SIZES --quiet || return 1
     set -- $(probe v.mkv)
-    [ "$2" = 120 ] || { echo "mkv frames $2"; return 1; }
+    [ "$2" = 60 ] || { echo "mkv frames $2"; return 1; }
 }
 
 t_disk_full() {
@@ -117,7 +122,9 @@ t_queue_cap_in_report() {
     # a reader that waits until the render stands still (the writer blocked on
     # the full pipe, the game thread on a full queue), the queue fills to it;
     # the writer holds one frame, so the high-water is 119 or 120
-    "$RS_BIN" record --ai --quiet --seconds 4 --seed 21 -o long.rsr 2>/dev/null || return 1
+    # (3 s, 180 frames: more than the 120 queued and the about 21 past the
+    # queue, in the pipe's 64 KiB, the writer and the PBOs; 2 s stops short)
+    "$RS_BIN" record --ai --quiet --seconds 3 --seed 21 -o long.rsr 2>/dev/null || return 1
     sh -c 'echo $$ >render.pid; exec "$0" render long.rsr -o - --size 64x36 --render-size 64x36 --quality draft \
         --progress off 2>d.txt' "$RS_BIN" | { wait_still render.pid; cat >/dev/null; }
     hw=$(sed -n 's/.*high-water \([0-9]*\).*/\1/p' d.txt)
@@ -138,8 +145,10 @@ wait_still() {
     done
 }
 
+# the bench's rows, ratios, CSV and chart: small sizes (with a downscale),
+# as no rate is checked, only the table's shape
 t_bench_capture_small() {
-    "$RS_BIN" bench capture --frames 10 --runs 1 --render-size 320x180 --size 160x90 --sink y4m --csv b.csv --chart b.png \
+    "$RS_BIN" bench capture --frames 10 --runs 1 --render-size 128x72 --size 64x36 --sink y4m --csv b.csv --chart b.png \
         >b.txt 2>&1 || { cat b.txt; return 1; }
     for row in render-only writer-only sequential "async pbo1 q0" "async pbo2 q120" "async pbo3 q8"; do
         grep -q "^$row " b.txt || { echo "no row $row"; cat b.txt; return 1; }
@@ -151,7 +160,7 @@ t_bench_capture_small() {
     [ ! -e out/bench-capture-scratch.y4m ] || { echo "scratch output left"; return 1; }
     # the null sink has no writer stage: its writer-only row has no rate
     # (it printed frames / 0 s: 571432139.7 fps)
-    "$RS_BIN" bench capture --frames 10 --runs 1 --render-size 160x90 --size 160x90 --sink null --csv n.csv --chart '' \
+    "$RS_BIN" bench capture --frames 10 --runs 1 --render-size 64x36 --size 64x36 --sink null --csv n.csv --chart '' \
         >n.txt 2>&1 || { cat n.txt; return 1; }
     grep -q '^writer-only *- ' n.txt || { echo "writer-only with the null sink:"; cat n.txt; return 1; }
     grep -q '^writer-only,,' n.csv || { cat n.csv; return 1; }
@@ -224,15 +233,17 @@ t_bench_accuracy_small() {
 
 t_image_sequences() {
     "$RS_BIN" render --help | grep -q "%06d.png" || t_skip_install "this build has no OpenImageIO"
-    short_replay || return 1
-    mkdir png exr && "$RS_BIN" render short.rsr -o png/f%04d.png $SIZES --quiet || return 1
-    [ "$(ls png | wc -l)" = 120 ] && [ -s png/f0000.png ] && [ -s png/f0119.png ] || { ls png | head; return 1; }
+    # 30 frames a sequence (more than the PBO ring); the 1 s replay bounds
+    # what the cut one draws before its frame 5 fails
+    short_replay 1 || return 1
+    mkdir png exr && "$RS_BIN" render short.rsr --ticks 0:30 -o png/f%04d.png $SIZES --quiet || return 1
+    [ "$(ls png | wc -l)" = 30 ] && [ -s png/f0000.png ] && [ -s png/f0029.png ] || { ls png | head; return 1; }
     ! ls png | grep -q part || { echo "part files left"; return 1; }
     if command -v ffprobe >/dev/null; then
-        ffprobe -v error -show_entries stream=width,height -of csv=p=0 png/f0060.png | grep -q "^160,90" || return 1
+        ffprobe -v error -show_entries stream=width,height -of csv=p=0 png/f0015.png | grep -q "^160,90" || return 1
     fi
-    "$RS_BIN" render short.rsr -o exr/f%03d.exr --render-size 320x180 --size 161x91 --quiet || return 1
-    [ "$(ls exr | wc -l)" = 120 ] || return 1
+    "$RS_BIN" render short.rsr --ticks 0:30 -o exr/f%03d.exr --render-size 320x180 --size 161x91 --quiet || return 1
+    [ "$(ls exr | wc -l)" = 30 ] || return 1
     # a failure part way removes the frames already written (frame 5's
     # temporary name is taken by a directory, so frame 5 cannot be written;
     # a frame name that exists is refused before the render: test_cli_conv)

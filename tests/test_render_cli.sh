@@ -173,8 +173,24 @@ t_quality_and_sizes() {
     expect_fail 2 "--quality 'ultra'" "$RS_BIN" play --headless --quality ultra || return 1
 }
 
+# in_pairs CMD ITEM...: `CMD ITEM N` for each ITEM, N counting from 1, two at
+# a time in the background: its exit status goes to rc.N, its stderr to err.N.
+# For renders that fail early: each is mostly its start-up, one busy thread,
+# so two fill the two cores that one leaves half idle.
+in_pairs() {
+    cmd=$1
+    shift
+    n=0
+    for item; do
+        n=$((n + 1))
+        ("$cmd" "$item" $n 2>"err.$n"; echo $? >"rc.$n") &
+        [ $((n % 2)) = 1 ] || wait
+    done
+    wait
+}
+
 # An output that cannot be written fails the render and leaves nothing: an
-# image sequence on a full filesystem (a 160 KiB tmpfs, all but about 16 KiB
+# image sequence on a full filesystem (a 160 KiB tmpfs, all but about 8 KiB
 # filled: less than one frame of any sequence, half of any video here),
 # in a read-only folder and in a missing one, the video beside it for
 # comparison.  What was there before stays as it was.
@@ -183,9 +199,9 @@ t_outputs_on_a_full_disk() {
     mkdir -p full && mount -t tmpfs -o size=160k tmpfs full 2>mount.err ||
         { t_skip_env "cannot mount a tmpfs here ($(head -c 120 mount.err))"; return 0; }
     echo keep >full/keep.txt
-    head -c 140k /dev/zero >full/filler # about 16 KiB left; 60 frames at 320x180 are 33-36 KiB in any container
+    head -c 148k /dev/zero >full/filler # about 8 KiB left; 20 frames at 320x180 are 13-17 KiB in any container
     for out in full/f%04d.png full/f%04d.exr full/f%04d.tif full/v.mp4 full/v.y4m full/v.webm full/v.mkv full/v.nut; do
-        "$RS_BIN" render short.rsr --ticks 0:60 --size 320x180 -q -o "$out" 2>err.txt
+        "$RS_BIN" render short.rsr --ticks 0:20 --size 320x180 -q -o "$out" 2>err.txt
         rc=$?
         left=$(ls -A full | grep -Ev '^(keep.txt|filler)$' | tr '\n' ' ')
         if [ $rc = 0 ] || [ -n "$left" ] || [ "$(cat full/keep.txt)" != keep ]; then
@@ -195,56 +211,70 @@ t_outputs_on_a_full_disk() {
             { echo "$out:"; cat err.txt; umount full; return 1; } ;; esac
     done
     # the stream: a full disk behind standard output is a write error on it
-    "$RS_BIN" render short.rsr --ticks 0:60 --size 320x180 -q -o - >full/stream.y4m 2>err.txt
+    "$RS_BIN" render short.rsr --ticks 0:20 --size 320x180 -q -o - >full/stream.y4m 2>err.txt
     rc=$?
     rm -f full/stream.y4m # the shell's file, not ours
     [ $rc = 1 ] && grep -q "^ringside render: standard output: .*No space left on device" err.txt ||
         { echo "-o - on a full disk: exit $rc"; cat err.txt; umount full; return 1; }
-    # the join: segments made elsewhere, joined onto the full disk
-    for r in 0:60 60:120; do
+    # the join: segments made elsewhere, joined onto the full disk (12 KiB)
+    for r in 0:30 30:60; do
         "$RS_BIN" render short.rsr --ticks "$r" --size 320x180 -q --segment fulljob -y -o "s${r%:*}.mp4" 2>err.txt ||
             { cat err.txt; umount full; return 1; }
     done
-    "$RS_BIN" join --segment fulljob -q -o full/j.mp4 s0.mp4 s60.mp4 2>err.txt
+    "$RS_BIN" join --segment fulljob -q -o full/j.mp4 s0.mp4 s30.mp4 2>err.txt
     rc=$?
     left=$(ls -A full | grep -Ev '^(keep.txt|filler)$' | tr '\n' ' ')
     [ $rc = 1 ] && [ -z "$left" ] && grep -q "^ringside join: full/j.mp4: .*No space left on device" err.txt ||
         { echo "join on a full disk: exit $rc, left: '$left'"; cat err.txt; umount full; return 1; }
-    # a side output that cannot be written takes the video with it
+    # a side output that cannot be written takes the video with it (the
+    # video N is vN.mp4)
     : >full/filler2
     head -c 200k /dev/zero >>full/filler2 2>/dev/null # now nothing is left
-    for side in "--hashes full/h.txt" "--wav full/a.wav" "--poster full/p.png"; do # the poster is tick 150
-        rm -f v.mp4
-        "$RS_BIN" render short.rsr --ticks 140:160 --size 160x90 -q -o v.mp4 $side 2>err.txt && { echo "$side: exit 0"; umount full; return 1; }
+    with_side() { "$RS_BIN" render short.rsr --ticks 148:152 --size 160x90 -q -o "v$2.mp4" $1; } # the poster is tick 150
+    set -- "--hashes full/h.txt" "--wav full/a.wav" "--poster full/p.png"
+    in_pairs with_side "$@"
+    n=0
+    for side; do
+        n=$((n + 1))
+        [ "$(cat rc.$n)" != 0 ] || { echo "$side: exit 0"; umount full; return 1; }
         name=${side#* }
-        [ ! -e v.mp4 ] && [ -z "$(ls -A full | grep -Ev '^(keep.txt|filler2?)$')" ] ||
-            { echo "$side left: $(ls v.mp4 full 2>&1)"; umount full; return 1; }
-        grep -q "^ringside render: $name: .*No space left on device" err.txt ||
-            { echo "$side:"; cat err.txt; umount full; return 1; }
+        [ ! -e v$n.mp4 ] && [ -z "$(ls -A full | grep -Ev '^(keep.txt|filler2?)$')" ] ||
+            { echo "$side left: $(ls v$n.mp4 full 2>&1)"; umount full; return 1; }
+        grep -q "^ringside render: $name: .*No space left on device" err.$n ||
+            { echo "$side:"; cat err.$n; umount full; return 1; }
     done
     umount full
     # read-only for root too: a read-only mount, not a mode
     mkdir ro && mount -t tmpfs -o ro,size=16k tmpfs ro || { echo "cannot mount a read-only tmpfs"; return 1; }
     # the error names what the user wrote (the frame's name for a sequence) and the system's reason
-    for out in ro/f%04d.png ro/f%04d.exr ro/f%04d.tif ro/x.mp4 ro/x.y4m ro/x.webm ro/x.mkv ro/x.nut \
-        nowhere/f%04d.png nowhere/x.mp4 nowhere/x.webm nowhere/x.nut; do
-        "$RS_BIN" render short.rsr --ticks 0:4 --size 160x90 -q -o "$out" 2>err.txt && { echo "$out: exit 0"; return 1; }
-        [ -z "$(ls -A ro)" ] || { echo "$out left: $(ls -A ro)"; umount ro; return 1; }
+    render_to() { "$RS_BIN" render short.rsr --ticks 0:4 --size 160x90 -q -o "$1"; }
+    set -- ro/f%04d.png ro/f%04d.exr ro/f%04d.tif ro/x.mp4 ro/x.y4m ro/x.webm ro/x.mkv ro/x.nut \
+        nowhere/f%04d.png nowhere/x.mp4 nowhere/x.webm nowhere/x.nut
+    in_pairs render_to "$@"
+    n=0
+    for out; do
+        n=$((n + 1))
+        [ "$(cat rc.$n)" != 0 ] || { echo "$out: exit 0"; umount ro; return 1; }
         name=$(printf '%s' "$out" | sed 's/%04d/0000/')
         case $out in
         ro/*) want="^ringside render: $name: cannot \(create\|write frame 0\).*: Read-only file system" ;;
         *) want="^ringside render: $name: folder nowhere does not exist" ;;
         esac
-        grep -q "$want" err.txt || { echo "$out: want '$want':"; cat err.txt; umount ro; return 1; }
+        grep -q "$want" err.$n || { echo "$out: want '$want':"; cat err.$n; umount ro; return 1; }
     done
+    [ -z "$(ls -A ro)" ] || { echo "left in ro: $(ls -A ro)"; umount ro; return 1; }
     # the side outputs, read-only or in no folder: the video goes with them
-    for side in "--hashes ro/h.txt" "--wav ro/a.wav" "--poster ro/p.png" "--hashes nowhere/h.txt" "--wav nowhere/a.wav"; do
-        rm -f v.mp4
-        "$RS_BIN" render short.rsr --ticks 140:160 --size 160x90 -q -o v.mp4 $side 2>err.txt && { echo "$side: exit 0"; umount ro; return 1; }
+    rm -f v*.mp4
+    set -- "--hashes ro/h.txt" "--wav ro/a.wav" "--poster ro/p.png" "--hashes nowhere/h.txt" "--wav nowhere/a.wav"
+    in_pairs with_side "$@"
+    n=0
+    for side; do
+        n=$((n + 1))
+        [ "$(cat rc.$n)" != 0 ] || { echo "$side: exit 0"; umount ro; return 1; }
         name=${side#* }
-        [ ! -e v.mp4 ] && [ -z "$(ls -A ro)" ] || { echo "$side left: $(ls v.mp4 ro 2>&1)"; umount ro; return 1; }
-        grep -q "^ringside render: $name: .*\(Read-only file system\|folder nowhere does not exist\)" err.txt ||
-            { echo "$side:"; cat err.txt; umount ro; return 1; }
+        [ ! -e v$n.mp4 ] && [ -z "$(ls -A ro)" ] || { echo "$side left: $(ls v$n.mp4 ro 2>&1)"; umount ro; return 1; }
+        grep -q "^ringside render: $name: .*\(Read-only file system\|folder nowhere does not exist\)" err.$n ||
+            { echo "$side:"; cat err.$n; umount ro; return 1; }
     done
     umount ro
 }
