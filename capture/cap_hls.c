@@ -434,7 +434,7 @@ bool cap_hls_track(const char *dir, const cap_sink *audio, uint64_t total, rs_er
         s.audio_bitrate = 192000; /* the default of .mp4 renders (cap_audio.c) */
     snprintf(s.audio_codec, sizeof s.audio_codec, "aac"); /* what every HLS player plays */
     s.audio_fast = true; /* a 3-minute match in 2.3 s instead of 9.5 */
-    snprintf(s.path, sizeof s.path, "%s/track.ts", dir);
+    snprintf(s.path, sizeof s.path, "%s/track.K.ts", dir); /* for messages: the parts */
     part_writer w = {.dir = dir, .nparts = cap_hls_track_parts(total), .k = -1, .first_pts = AV_NOPTS_VALUE};
     cap_aenc a = {0};
     bool ok = cap_aenc_open(&a, &s, fmt, err);
