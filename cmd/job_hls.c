@@ -24,6 +24,12 @@ static bool read_track(void *u, float *dst, size_t frames, rs_err *err)
     return au_replay_read(u, dst, frames, err);
 }
 
+/* DIR/.track.lock: held by the maker at work */
+static void lock_path(const char *dir, char *out, size_t n)
+{
+    snprintf(out, n, "%s/.track.lock", dir);
+}
+
 /* In the maker's process: DIR/track.K.ts from the whole match, under
  * DIR/.track.lock (flock, waited for), so renders starting together make
  * it once: a maker that finds the track whole does nothing, and one that
@@ -32,7 +38,7 @@ static bool read_track(void *u, float *dst, size_t frames, rs_err *err)
 static bool make_track(const job_hls_desc *d, rs_err *err)
 {
     char lock[1100];
-    snprintf(lock, sizeof lock, "%s/.track.lock", d->dir);
+    lock_path(d->dir, lock, sizeof lock);
     int fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0)
         return rs_fail(err, CAP_ERR_CREATE, "%s: %s", lock, strerror(errno));
@@ -106,7 +112,7 @@ static bool track_alive(void *u)
         h->maker = 0;
     }
     char lock[1100];
-    snprintf(lock, sizeof lock, "%s/.track.lock", h->d.dir);
+    lock_path(h->d.dir, lock, sizeof lock);
     int fd = open(lock, O_RDONLY | O_CLOEXEC);
     if (fd < 0)
         return false;
