@@ -14,7 +14,8 @@
  *   2. the particles (and the copies of those that cross the map's edge:
  *      the mist wraps round) are drawn additively into an R16F map of
  *      size x size texels over x, z in +-half metres, normalised so that
- *      its mean is 1;
+ *      its mean is 1: as instanced sprites on a GPU, in plain C and one
+ *      upload on a software rasteriser (splat_cpu);
  *   3. optionally a blur.
  * fog_bind (its r_fx_module bind hook) then hands the map and the fog's light to the scene's
  * programs (scene.vert/.frag and lens.frag include fog_common.glsl). */
@@ -59,6 +60,8 @@ struct fx_fog_state {
     int cap;              /* sprites inst and vbo have room for */
     int size;             /* the map's edge now */
     GLuint tex, fbo;      /* the fog map */
+    bool cpu;             /* splat on the CPU (a software rasteriser; a test hook may set it) */
+    float *map;           /* size x size: splat_cpu's sums */
     GLuint tmp_tex, tmp_fbo; /* the blur's half-way image */
 };
 
@@ -70,6 +73,8 @@ static void free_map(struct fx_fog_state *fg)
     gl.DeleteTextures(2, tex);
     gl.DeleteFramebuffers(2, fbo);
     fg->tex = fg->tmp_tex = fg->fbo = fg->tmp_fbo = 0;
+    free(fg->map);
+    fg->map = NULL;
     fg->size = 0;
 }
 
@@ -92,7 +97,53 @@ static bool make_map(struct fx_fog_state *fg, int size, rs_err *err)
         free_map(fg);
         return rs_fail(err, R_ERR_TARGET, "fog map: %dx%d R16F target incomplete (%s)", size, size, rgl_enum_name(st));
     }
+    if (!(fg->map = malloc((size_t)size * (size_t)size * sizeof *fg->map))) {
+        free_map(fg);
+        return rs_fail(err, R_ERR_NOMEM, "fog map: out of memory for a %dx%d map", size, size);
+    }
     return true;
+}
+
+/* Step 2 in plain C: what the sprites of fog_splat.vert/.frag give, summed
+ * in float at the same texel centres ((i + 0.5, j + 0.5) in the map's
+ * texels; a sprite's centre at (x + half) x size / (2 half)), then one
+ * upload.  On llvmpipe the 3,000 instanced quads into the R16F map, about
+ * 130 blended fragments each, cost 4-7 ms of a 640x360 frame on one
+ * core; this sum about 1.5 ms and the upload 0.3.  The sums are float where
+ * the blend rounds each to half float, so the two differ by about fp16's
+ * rounding (test_fx_fog/map_cpu_matches_sprites). */
+static void splat_cpu(struct fx_fog_state *fg, int n, float h, float R, float amp)
+{
+    const int S = fg->size;
+    float *m = fg->map, scale = (float)S / (2 * h), rad = R * scale, inv = 1 / rad;
+    memset(m, 0, (size_t)S * (size_t)S * sizeof *m);
+    for (int k = 0; k < n; k++) {
+        const float *q = fg->inst + 3 * (size_t)k;
+        float cx = (q[0] + h) * scale, cz = (q[1] + h) * scale, w = q[2] * amp;
+        /* the texels whose centres lie within the sprite's square */
+        int i0 = (int)ceilf(cx - rad - 0.5f), i1 = (int)floorf(cx + rad - 0.5f);
+        int j0 = (int)ceilf(cz - rad - 0.5f), j1 = (int)floorf(cz + rad - 0.5f);
+        i0 = i0 < 0 ? 0 : i0, j0 = j0 < 0 ? 0 : j0, i1 = i1 > S - 1 ? S - 1 : i1, j1 = j1 > S - 1 ? S - 1 : j1;
+        for (int j = j0; j <= j1; j++) {
+            float dz = ((float)j + 0.5f - cz) * inv, dz2 = dz * dz, *row = m + (size_t)j * S;
+            if (dz2 >= 1)
+                continue;
+            /* this row's chord of the disc: t > 0 inside it (a texel its
+             * rounding takes in or leaves out gets t^2 ~ 1e-12: nothing) */
+            float half_w = rad * sqrtf(1 - dz2);
+            int a = (int)ceilf(cx - half_w - 0.5f), b = (int)floorf(cx + half_w - 0.5f);
+            a = a < i0 ? i0 : a, b = b > i1 ? i1 : b;
+            float room = 1 - dz2, dx = ((float)a + 0.5f - cx) * inv;
+            for (int i = a; i <= b; i++, dx += inv) {
+                float t = room - dx * dx;
+                row[i] += w * t * t;
+            }
+        }
+    }
+    gl.BindTexture(GL_TEXTURE_2D, fg->tex);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, S, S, GL_RED, GL_FLOAT, m);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
 }
 
 /* Step 2: the particles as sprites into the map; returns the sprites drawn. */
@@ -123,13 +174,17 @@ static int draw_map(r_game *r, struct fx_fog_state *fg)
     float amp = sum > 0 ? 4 * h * h * 3 / (3.14159265f * R * R * sum) : 0;
     if (amp * sum > 60000.0f)
         amp = 60000.0f / sum;
-    gl.BindFramebuffer(GL_FRAMEBUFFER, fg->fbo);
-    gl.Viewport(0, 0, fg->size, fg->size);
-    gl.Disable(GL_DEPTH_TEST);
-    gl.Disable(GL_CULL_FACE);
-    gl.ClearColor(0, 0, 0, 0);
-    gl.Clear(GL_COLOR_BUFFER_BIT);
-    if (n > 0) {
+    if (fg->cpu)
+        splat_cpu(fg, n, h, R, amp);
+    else {
+        gl.BindFramebuffer(GL_FRAMEBUFFER, fg->fbo);
+        gl.Viewport(0, 0, fg->size, fg->size);
+        gl.Disable(GL_DEPTH_TEST);
+        gl.Disable(GL_CULL_FACE);
+        gl.ClearColor(0, 0, 0, 0);
+        gl.Clear(GL_COLOR_BUFFER_BIT);
+    }
+    if (n > 0 && !fg->cpu) {
         gl.Enable(GL_BLEND);
         gl.BlendFunc(GL_ONE, GL_ONE);
         gl.UseProgram(fg->prog);
@@ -293,6 +348,7 @@ static bool fog_create(r_game *r, rs_err *err)
         return rs_fail(err, R_ERR_NOMEM, "fog: out of memory");
     r_fx_set_state(r, &fx_fog_module, fg);
     fg->look = default_look;
+    fg->cpu = rgl_is_software();
     if (!fx_fog_sim_init(&fg->sim, NULL)) {
         fog_destroy(r);
         return rs_fail(err, R_ERR_NOMEM, "fog: out of memory for the mist");
@@ -346,6 +402,14 @@ const r_fx_module fx_fog_module = {
 fx_fog_sim *fx_fog_get_sim(r_game *r)
 {
     return FOG(r) ? &FOG(r)->sim : NULL;
+}
+
+bool fx_fog_set_cpu(r_game *r, bool cpu)
+{
+    struct fx_fog_state *fg = FOG(r);
+    if (fg)
+        fg->cpu = cpu;
+    return fg != NULL;
 }
 
 bool fx_fog_read_map(r_game *r, float *out, int *size, float *half)

@@ -49,6 +49,12 @@ bool rgl_has_extension(const char *name)
     return false;
 }
 
+bool rgl_is_software(void)
+{
+    const char *r = (const char *)gl.GetString(GL_RENDERER);
+    return r && (strstr(r, "llvmpipe") || strstr(r, "softpipe"));
+}
+
 static void APIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
                               const GLchar *msg, const void *user)
 {

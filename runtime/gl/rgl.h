@@ -55,6 +55,11 @@ bool rgl_load(rgl_getproc getproc, void *user, int min_major, int min_minor, boo
 
 bool rgl_has_extension(const char *name);
 
+/* The current context draws on the CPU (Mesa's llvmpipe or softpipe):
+ * every fragment and triangle costs a core's time, so some work is
+ * cheaper done in plain C, and passes are timed with glFinish. */
+bool rgl_is_software(void);
+
 /* GL errors seen by the debug callback or rgl_check since the last reset. */
 unsigned rgl_error_count(void);
 void rgl_error_reset(void);

@@ -67,8 +67,7 @@ void r_graph_timing(r_graph *g, r_graph_frame_fn fn, void *user)
      * as the absolute clock (hours), and timestamps also need no nesting
      * rules should a pass ever time itself. */
     g->gpu_timer = gl.GenQueries && gl.GetQueryObjectui64v && gl.QueryCounter;
-    const char *renderer = (const char *)gl.GetString(GL_RENDERER);
-    g->serial = renderer && (strstr(renderer, "llvmpipe") || strstr(renderer, "softpipe"));
+    g->serial = rgl_is_software();
     if (g->gpu_timer)
         gl.GenQueries(R_GRAPH_LAG * R_GRAPH_MAX * 2, &g->query[0][0][0]);
 }
