@@ -166,5 +166,103 @@ static void t_thirty_holes_and_extremes(void)
     plat_destroy(p);
 }
 
-T_MAIN({"holes_cut_the_ring_only_there", t_holes_cut_the_ring_only_there},
+/* Is (x, y) inside the convex polygon of n points (either winding)? */
+static bool in_polygon(const float (*pt)[2], int n, float x, float y)
+{
+    int pos = 0, neg = 0;
+    for (int k = 0; k < n; k++) {
+        const float *a = pt[k], *b = pt[(k + 1) % n];
+        float c = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+        pos += c > 0, neg += c < 0;
+    }
+    return pos == 0 || neg == 0;
+}
+
+enum { RIM_W = 640, RIM_H = 360, RIM_PTS = 96 };
+
+/* Which rims' projected circles hold pixel (x, y) (bottom-up, centre at
+ * +0.5) and all 8 points 1.5 pixels round it (1), none of them (-1), or
+ * some (0: too near a rim to say). */
+static int rim_side(const float (*rim)[RIM_PTS][2], const float (*box)[4], int nholes, int x, int y)
+{
+    static const float d[9][2] = {{0, 0}, {1.5f, 0}, {-1.5f, 0}, {0, 1.5f}, {0, -1.5f},
+                                  {1.06f, 1.06f}, {1.06f, -1.06f}, {-1.06f, 1.06f}, {-1.06f, -1.06f}};
+    float cx = (float)x + 0.5f, cy = (float)y + 0.5f;
+    int in = 0;
+    for (int k = 0; k < 9; k++)
+        for (int i = 0; i < nholes; i++) {
+            float px = cx + d[k][0], py = cy + d[k][1];
+            if (px >= box[i][0] && px <= box[i][2] && py >= box[i][1] && py <= box[i][3] &&
+                in_polygon(rim[i], RIM_PTS, px, py)) {
+                in++;
+                break;
+            }
+        }
+    return in == 9 ? 1 : in == 0 ? -1 : 0;
+}
+
+/* The crater's rim is the sphere's circle on the floor, radius
+ * sqrt(1 - 0.4^2) r: the sphere's mesh has a row of vertices on it at both
+ * levels of detail (the coarse one below 540 rows drawn, the fine one the
+ * options ask for).  At 640x360, every ring-top pixel 1.5 pixels or more
+ * inside a rim's projected circle is cut (deeper than without the holes),
+ * and none 1.5 pixels or more outside every rim. */
+static void t_rims_are_circles(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, RIM_W, RIM_H);
+    r_stage st = quarry();
+    g_state prev, cur;
+    t_state_at("quarry", TICK, &prev, &cur);
+    static float rim[G_MAX_HOLES][RIM_PTS][2], box[G_MAX_HOLES][4];
+    r_mat4 vp = r_game_camera(&cur, RIM_W, RIM_H, NULL);
+    for (int i = 0; i < cur.nholes; i++) {
+        const g_hole *h = &cur.holes[i];
+        float rr = sqrtf(1 - 0.4f * 0.4f) * fx_to_float(h->r);
+        for (int k = 0; k < RIM_PTS; k++) {
+            float a = (float)k * 6.2831853f / RIM_PTS;
+            r_vec3 q = r_v3(fx_to_float(h->x) + rr * cosf(a), 0, fx_to_float(h->z) + rr * sinf(a));
+            T_ASSERTF(r_project(vp, q, RIM_W, RIM_H, &rim[i][k][0], &rim[i][k][1]), "hole %d behind the eye", i);
+        }
+        box[i][0] = box[i][1] = 1e9f, box[i][2] = box[i][3] = -1e9f;
+        for (int k = 0; k < RIM_PTS; k++)
+            for (int a = 0; a < 2; a++)
+                box[i][a] = fminf(box[i][a], rim[i][k][a]), box[i][a + 2] = fmaxf(box[i][a + 2], rim[i][k][a]);
+    }
+    for (int fine = 0; fine < 2; fine++) {
+        r_game *r = t_game_opts(&(r_game_opts){.mask = true, .fine_mesh = fine == 1});
+        g_state p0 = prev, c0 = cur;
+        p0.nholes = c0.nholes = 0;
+        t_draw_read(r, &f, &p0, &c0, RIM_W, RIM_H, NULL, false);
+        float *doff = t_read(r, "depth", 1, RIM_W, RIM_H), *hoff = t_read(r, "hdr", 4, RIM_W, RIM_H);
+        rs_err e = {0};
+        T_ASSERTF(r_game_set_stage(r, &st, &e), "%s", e.msg);
+        t_draw_read(r, &f, &prev, &cur, RIM_W, RIM_H, NULL, false);
+        T_EQ(fx_holes_drawn(r), cur.nholes);
+        float *don = t_read(r, "depth", 1, RIM_W, RIM_H);
+        int inside = 0, missed = 0, outside = 0, stray = 0;
+        for (int y = 0; y < RIM_H; y++)
+            for (int x = 0; x < RIM_W; x++) {
+                size_t i = (size_t)y * RIM_W + x;
+                if (hoff[4 * i + 3] != 0) /* a fighter in front */
+                    continue;
+                int side = rim_side((const float(*)[RIM_PTS][2])rim, (const float(*)[4])box, cur.nholes, x, y);
+                bool cut = don[i] > doff[i];
+                inside += side == 1, missed += side == 1 && !cut;
+                outside += side == -1, stray += side == -1 && cut;
+            }
+        fprintf(stderr, "    %s mesh: %d pixels surely inside a rim, %d of them not cut; %d surely outside, %d cut\n",
+                fine ? "fine" : "coarse", inside, missed, outside, stray);
+        T_ASSERTF(inside > 5000, "only %d pixels inside the rims", inside);
+        T_ASSERTF(missed == 0 && stray == 0, "%s mesh: %d pixels inside a rim not cut, %d outside cut",
+                  fine ? "fine" : "coarse", missed, stray);
+        free(doff), free(hoff), free(don);
+        r_game_destroy(r);
+    }
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+T_MAIN({"holes_cut_the_ring_only_there", t_holes_cut_the_ring_only_there}, {"rims_are_circles", t_rims_are_circles},
        {"thirty_holes_and_extremes", t_thirty_holes_and_extremes})

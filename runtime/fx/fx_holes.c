@@ -35,14 +35,26 @@
 extern const r_fx_module fx_holes_module;
 #define HOLES(r) ((struct fx_holes *)r_fx_state((r), &fx_holes_module))
 
-#define SPHERE_SEG 32
-#define SPHERE_RINGS 8
 #define LIFT 0.4f /* the sphere's centre stands 0.4 r above the floor */
+/* The crater's sphere (crater_mesh), in two levels of detail chosen as
+ * the fighters' mesh is (r_fx_coarse_mesh: below 540 rows drawn).  Round
+ * the vertical axis, SEG segments; below the floor, where its inside is
+ * seen, BELOW bands from the bottom pole to a row exactly on the floor, so
+ * the rim is a polygon on the true circle; above the floor, where it only
+ * closes the stencil's volume and is never drawn in colour, ABOVE bands.
+ * The sphere they replaced was a capsule round the x axis, 32 segments
+ * and 8 rings a cap: 1,088 triangles, where the fine level has 512 and
+ * the coarse 240; on llvmpipe each of a crater's three draws pays per
+ * triangle.  At 640x360 the coarse crater's 24-gon rim is within 0.7
+ * pixels of the circle on the largest craters. */
+static const struct crater_lod {
+    int seg, below, above;
+} crater_lod[2] = {{24, 4, 1}, {32, 6, 2}}; /* coarse, fine */
 #define STENCIL_HOLES 0x7F
 
 struct fx_holes {
-    GLuint vao, vbo, ibo;
-    GLsizei count;
+    GLuint vao[2], vbo[2], ibo[2]; /* crater_lod's levels */
+    GLsizei count[2];
     int drawn; /* holes drawn in the frame drawn last */
 };
 
@@ -114,7 +126,9 @@ static void run_holes(void *u)
     GLuint ps = r_stage_program(r, R_MAT_HOLE); /* the crater's inside */
     gl.Enable(GL_STENCIL_TEST);
     gl.StencilMask(STENCIL_HOLES);
-    gl.BindVertexArray(hs->vao);
+    int lod = r_fx_coarse_mesh(r) ? 0 : 1;
+    GLsizei count = hs->count[lod];
+    gl.BindVertexArray(hs->vao[lod]);
     for (int k = 0; k < n; k++) {
         float m[16];
         model(&st->holes[o[k].i], m);
@@ -127,10 +141,10 @@ static void run_holes(void *u)
         gl.UniformMatrix4fv(r_loc(pd, "u_bones"), 1, GL_FALSE, m);
         gl.CullFace(GL_BACK);
         gl.StencilOp(GL_KEEP, GL_KEEP, GL_INCR_WRAP);
-        gl.DrawElements(GL_TRIANGLES, hs->count, GL_UNSIGNED_INT, NULL);
+        gl.DrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, NULL);
         gl.CullFace(GL_FRONT);
         gl.StencilOp(GL_KEEP, GL_KEEP, GL_DECR_WRAP);
-        gl.DrawElements(GL_TRIANGLES, hs->count, GL_UNSIGNED_INT, NULL);
+        gl.DrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, NULL);
         /* 3: the inside, under the floor, depth forced; stencil back to 0 */
         gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         gl.DepthMask(GL_TRUE);
@@ -139,7 +153,7 @@ static void run_holes(void *u)
         gl.StencilOp(GL_KEEP, GL_ZERO, GL_ZERO);
         gl.UseProgram(ps);
         gl.UniformMatrix4fv(r_loc(ps, "u_bones"), 1, GL_FALSE, m);
-        gl.DrawElements(GL_TRIANGLES, hs->count, GL_UNSIGNED_INT, NULL); /* back faces: the inner surface */
+        gl.DrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, NULL); /* back faces: the inner surface */
     }
     hs->drawn = n;
     gl.Disable(GL_STENCIL_TEST);
@@ -155,12 +169,27 @@ static const r_pass holes_passes[] = {
     {"holes", RES_ENV, RES_HDR | RES_DEPTH, need_holes, run_holes, RES_MASK | RES_SIL | RES_FOGMAP | RES_LSPSM},
 };
 
+/* The unit sphere's rows at one of crater_lod's levels: the floor,
+ * y = -LIFT, at the polar angle acos(LIFT) from the bottom pole. */
+static int crater_mesh(r_mesh_data *m, const struct crater_lod *l)
+{
+    const float pi = 3.14159265f, floor_phi = acosf(LIFT);
+    float phi[16];
+    int n = 0;
+    for (int k = 0; k <= l->below; k++)
+        phi[n++] = floor_phi * (float)k / (float)l->below;
+    for (int k = 1; k <= l->above; k++)
+        phi[n++] = floor_phi + (pi - floor_phi) * (float)k / (float)l->above;
+    return r_mesh_sphere_rows(m, 0, l->seg, phi, n);
+}
+
 static void holes_destroy(r_game *r)
 {
     struct fx_holes *hs = HOLES(r);
     if (!hs)
         return;
-    r_free_mesh(&hs->vao, &hs->vbo, &hs->ibo);
+    for (int k = 0; k < 2; k++)
+        r_free_mesh(&hs->vao[k], &hs->vbo[k], &hs->ibo[k]);
     free(hs);
     r_fx_set_state(r, &fx_holes_module, NULL);
 }
@@ -171,16 +200,18 @@ static bool holes_create(r_game *r, rs_err *err)
     if (!hs)
         return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     r_fx_set_state(r, &fx_holes_module, hs);
-    /* the unit sphere (a capsule of length 0) on bone 0: u_bones[0] places it */
-    r_mesh_data m = {0};
-    if (!r_mesh_capsule(&m, 0.0f, 1.0f, 0, SPHERE_SEG, SPHERE_RINGS)) {
+    /* the unit sphere on bone 0: u_bones[0] places it */
+    for (int k = 0; k < 2; k++) {
+        r_mesh_data m = {0};
+        if (!crater_mesh(&m, &crater_lod[k])) {
+            r_mesh_free(&m);
+            holes_destroy(r);
+            return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
+        }
+        r_upload_mesh(&m, &hs->vao[k], &hs->vbo[k], &hs->ibo[k]);
+        hs->count[k] = (GLsizei)m.ni;
         r_mesh_free(&m);
-        holes_destroy(r);
-        return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     }
-    r_upload_mesh(&m, &hs->vao, &hs->vbo, &hs->ibo);
-    hs->count = (GLsizei)m.ni;
-    r_mesh_free(&m);
     RGL_CHECK("holes create");
     return true;
 }

@@ -56,6 +56,11 @@ const r_quality *r_fx_quality(const r_game *r)
     return &r->opts.q;
 }
 
+bool r_fx_coarse_mesh(const r_game *r)
+{
+    return r->fighter == &r->fighter_lod[R_FIGHTER_COARSE];
+}
+
 r_fx_gl r_fx_core_gl(const r_game *r)
 {
     r_fx_gl g = {

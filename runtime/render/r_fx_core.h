@@ -84,6 +84,10 @@ int r_fx_stage_game(const r_game *r);
 const float *r_fx_key_dir(const r_game *r);
 /* The quality knobs r_game_create_opts was given (range checked there). */
 const r_quality *r_fx_quality(const r_game *r);
+/* This frame draws the fighters' coarse mesh (drawn below
+ * R_FIGHTER_COARSE_ROWS rows, unless the options ask for the fine one):
+ * an effect's own meshes may follow the same choice. */
+bool r_fx_coarse_mesh(const r_game *r);
 
 /* The core's GL objects an effect draws with or reads.  The screen
  * targets are remade when the render size changes: ask again each frame. */

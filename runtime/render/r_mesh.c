@@ -74,6 +74,38 @@ int r_mesh_capsule(r_mesh_data *m, float length, float r, int bone, int seg, int
     return 1;
 }
 
+int r_mesh_sphere_rows(r_mesh_data *m, int bone, int seg, const float *phi, int rows)
+{
+    /* the capsule's rows turned from the x axis to y ((x, y, z) -> (y, z, x)):
+     * a rotation, so the same index pattern faces outwards */
+    if (rows < 2 || !reserve(m, (size_t)(rows * (seg + 1)), (size_t)((rows - 1) * seg * 6)))
+        return 0;
+    size_t base = m->nv;
+    const float pi = 3.14159265f;
+    for (int row = 0; row < rows; row++) {
+        float ay = -cosf(phi[row]), rad = sinf(phi[row]);
+        for (int s = 0; s <= seg; s++) {
+            float th = 2 * pi * s / seg, cy = cosf(th), sz = sinf(th);
+            r_vertex *v = &m->v[m->nv++];
+            memset(v, 0, sizeof *v);
+            v->normal[0] = rad * sz, v->normal[1] = ay, v->normal[2] = rad * cy;
+            memcpy(v->pos, v->normal, sizeof v->pos);
+            v->tangent[0] = cy, v->tangent[1] = 0, v->tangent[2] = -sz, v->tangent[3] = 1;
+            v->uv[0] = (float)s / seg;
+            v->uv[1] = phi[row] / pi;
+            v->bone = (float)bone;
+        }
+    }
+    for (int row = 0; row + 1 < rows; row++)
+        for (int s = 0; s < seg; s++) {
+            unsigned a = (unsigned)(base + (size_t)row * (seg + 1) + s), b = a + (unsigned)seg + 1;
+            unsigned q[6] = {a, a + 1, b, a + 1, b + 1, b};
+            memcpy(m->idx + m->ni, q, sizeof q);
+            m->ni += 6;
+        }
+    return 1;
+}
+
 int r_mesh_box(r_mesh_data *m, const float lo[3], const float hi[3])
 {
     if (!reserve(m, 24, 36))

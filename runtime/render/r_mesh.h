@@ -25,6 +25,12 @@ typedef struct r_mesh_data {
 
 /* A capsule along +x from 0 to `length`, radius r, for bone `bone`. */
 int r_mesh_capsule(r_mesh_data *m, float length, float r, int bone, int segments, int rings);
+/* A unit sphere round the y axis for bone `bone`: rows of seg + 1
+ * vertices at the polar angles phi[0..rows-1], from the -y pole (0) to the
+ * +y pole (pi), ascending; the same vertex layout and winding as a
+ * capsule's (outward faces counter-clockwise), so a caller places the
+ * rows where its picture needs them. */
+int r_mesh_sphere_rows(r_mesh_data *m, int bone, int seg, const float *phi, int rows);
 /* An axis-aligned box from lo to hi (bone index -1: world space). */
 int r_mesh_box(r_mesh_data *m, const float lo[3], const float hi[3]);
 /* The whole fighter: one capsule per bone of g_bones, at a level of
