@@ -43,17 +43,21 @@ extern const r_fx_module fx_snow_module;
 #define SNOW(r) ((struct fx_snow_state *)r_fx_state((r), &fx_snow_module))
 
 #define SNOW_LIGHT 256              /* texture-space lighting texels per side: r_quality.snow_light overrides it */
-/* The surface grid: a vertex on every SNOW_COL_STRIDE-th map texel along
- * x; along z on every texel row within SNOW_BAND rows of the fight line
- * (z = 0: about +-0.5 m on a 4 m ring), where the fighters' bones reach
- * and prints need the detail, and on every SNOW_FAR_STRIDE-th row beyond,
- * where the snow stays untouched drifts (their fine ripples come from the
- * texture-space lighting, not the geometry).  16.5k triangles where a
- * uniform grid of every other texel has 34k: on llvmpipe the triangles
- * cost more than the pixels. */
-#define SNOW_COL_STRIDE 2
-#define SNOW_BAND 16
-#define SNOW_FAR_STRIDE 8
+/* The surface grid: a vertex on every `col`-th map texel along x; along z
+ * on every texel row within `band` rows of the fight line (z = 0: about
+ * +-0.5 m on a 4 m ring), where the fighters' bones reach and prints need
+ * the detail, and on every `far`-th row beyond, where the snow stays
+ * untouched drifts (their fine ripples come from the texture-space
+ * lighting, not the geometry).  Two levels, chosen as the fighters' mesh
+ * is (r_fx_coarse_mesh: below 540 rows drawn): the fine grid, 16.5k
+ * triangles where a uniform grid of every other texel has 34k, and the
+ * coarse one with every 4th column, 8.4k: on llvmpipe the triangles cost
+ * more than the pixels (snow_surface 10.4-11.8 -> 8.3 ms a frame
+ * single-threaded at 640x360), and at 640x360 its frames are 53 dB from
+ * the fine grid's. */
+static const struct snow_grid_lod {
+    int col, band, far;
+} snow_grid_lod[2] = {{4, 16, 8}, {2, 16, 8}}; /* coarse, fine */
 #define MAX_STAMPS (4 * G_BONES)    /* both fighters, this tick and the one before */
 #define COLOR_TILE 0.8f             /* metres per repeat of the colour textures */
 #define DETAIL_TILE 2.0f            /* metres per repeat of the crust normal map: lumps of ~8 cm, which
@@ -70,8 +74,9 @@ struct fx_snow_state {
     int light_size;                       /* their side: r_quality.snow_light or SNOW_LIGHT */
     GLuint key_tex, key_fbo;              /* 1x1: the key light's colour (snow_key.frag) */
     GLuint color_tex, detail_tex;
-    GLuint grid_vao, grid_vbo, grid_ibo;
-    GLsizei grid_count;
+    GLuint grid_vao[2], grid_vbo[2], grid_ibo[2]; /* snow_grid_lod's levels */
+    GLsizei grid_count[2];
+    int grid_drawn;                       /* triangles of the grid the last frame drew */
     r_fx_capsule stamp[MAX_STAMPS];       /* this frame's contacts (need_map) */
     int nstamp;
 };
@@ -97,14 +102,13 @@ static GLuint color_tex(void (*make)(uint8_t *, int), uint8_t *px, GLenum ifmt, 
 /* One axis of the grid: map texel indices, with the ring's edge (-1 and
  * R_SNOW_MAP: the edge texel's height) and the skirt's foot (-2 and
  * R_SNOW_MAP + 1: the ring top) at the ends.  Returns the count. */
-static int grid_axis(short *out, bool rows)
+static int grid_axis(short *out, bool rows, const struct snow_grid_lod *l)
 {
     int n = 0;
     out[n++] = -2, out[n++] = -1;
     for (int k = 0; k < R_SNOW_MAP; k++) {
         int from_centre = abs(2 * k + 1 - R_SNOW_MAP) / 2; /* texels from the map's middle line */
-        bool keep = rows ? from_centre < SNOW_BAND || k % SNOW_FAR_STRIDE == SNOW_FAR_STRIDE / 2
-                         : k % SNOW_COL_STRIDE == SNOW_COL_STRIDE / 2;
+        bool keep = rows ? from_centre < l->band || k % l->far == l->far / 2 : k % l->col == l->col / 2;
         if (keep)
             out[n++] = (short)k;
     }
@@ -114,10 +118,10 @@ static int grid_axis(short *out, bool rows)
 
 /* The grid over the ring top: one vertex attribute, the (column, row)
  * codes of grid_axis; snow_surface.vert makes positions from the map. */
-static bool build_grid(struct fx_snow_state *s)
+static bool build_grid(struct fx_snow_state *s, int lod)
 {
     short cols[R_SNOW_MAP + 4], rows[R_SNOW_MAP + 4];
-    int nc = grid_axis(cols, false), nr = grid_axis(rows, true);
+    int nc = grid_axis(cols, false, &snow_grid_lod[lod]), nr = grid_axis(rows, true, &snow_grid_lod[lod]);
     size_t count = (size_t)(nc - 1) * (size_t)(nr - 1) * 6;
     short *v = malloc((size_t)nc * (size_t)nr * 2 * sizeof *v);
     unsigned *idx = malloc(count * sizeof *idx), *o = idx;
@@ -136,20 +140,20 @@ static bool build_grid(struct fx_snow_state *s)
             memcpy(o, q, sizeof q);
             o += 6;
         }
-    gl.GenVertexArrays(1, &s->grid_vao);
-    gl.BindVertexArray(s->grid_vao);
-    gl.GenBuffers(1, &s->grid_vbo);
-    gl.BindBuffer(GL_ARRAY_BUFFER, s->grid_vbo);
+    gl.GenVertexArrays(1, &s->grid_vao[lod]);
+    gl.BindVertexArray(s->grid_vao[lod]);
+    gl.GenBuffers(1, &s->grid_vbo[lod]);
+    gl.BindBuffer(GL_ARRAY_BUFFER, s->grid_vbo[lod]);
     gl.BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)nc * nr * 2 * sizeof *v), v, GL_STATIC_DRAW);
     gl.EnableVertexAttribArray(0);
     gl.VertexAttribIPointer(0, 2, GL_SHORT, 0, NULL);
-    gl.GenBuffers(1, &s->grid_ibo);
-    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->grid_ibo);
+    gl.GenBuffers(1, &s->grid_ibo[lod]);
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, s->grid_ibo[lod]);
     gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(count * sizeof *idx), idx, GL_STATIC_DRAW);
     gl.BindVertexArray(0);
     gl.BindBuffer(GL_ARRAY_BUFFER, 0);
     free(v), free(idx);
-    s->grid_count = (GLsizei)count;
+    s->grid_count[lod] = (GLsizei)count;
     return true;
 }
 
@@ -165,9 +169,9 @@ static void snow_destroy(r_game *r)
     GLuint fbo[] = {s->map_fbo, s->light_fbo, s->tmp_fbo, s->key_fbo};
     gl.DeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     gl.DeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
-    gl.DeleteBuffers(1, &s->grid_vbo);
-    gl.DeleteBuffers(1, &s->grid_ibo);
-    gl.DeleteVertexArrays(1, &s->grid_vao);
+    gl.DeleteBuffers(2, s->grid_vbo);
+    gl.DeleteBuffers(2, s->grid_ibo);
+    gl.DeleteVertexArrays(2, s->grid_vao);
     free(s);
     r_fx_set_state(r, &fx_snow_module, NULL);
 }
@@ -210,7 +214,7 @@ static bool snow_create(r_game *r, rs_err *err)
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
 
     uint8_t *px = malloc((size_t)R_SNOW_TEX * R_SNOW_TEX * 4);
-    if (!px || !build_grid(s)) {
+    if (!px || !build_grid(s, 0) || !build_grid(s, 1)) {
         free(px);
         return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     }
@@ -420,12 +424,20 @@ static void run_surface(void *u)
     gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "silhouette_mips"));
     r_light_uniforms(p, f);
     gl.Uniform1f(r_loc(p, "u_sil_top"), SIL_LEVELS - 1);
-    gl.BindVertexArray(s->grid_vao);
-    gl.DrawElements(GL_TRIANGLES, s->grid_count, GL_UNSIGNED_INT, NULL);
+    int lod = r_fx_coarse_mesh(r) ? 0 : 1;
+    gl.BindVertexArray(s->grid_vao[lod]);
+    gl.DrawElements(GL_TRIANGLES, s->grid_count[lod], GL_UNSIGNED_INT, NULL);
+    s->grid_drawn = s->grid_count[lod] / 3;
     gl.BindVertexArray(0);
 }
 
 /* ---- test hooks (fx_snow_tex.h) ---- */
+
+int fx_snow_grid_drawn(r_game *r)
+{
+    struct fx_snow_state *s = SNOW(r);
+    return s ? s->grid_drawn : 0;
+}
 
 int fx_snow_light_size(r_game *r)
 {

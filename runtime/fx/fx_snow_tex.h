@@ -41,6 +41,9 @@ void fx_snow_tex_detail_normals(uint8_t *rgba, int n);
 typedef struct r_game r_game;
 bool fx_snow_read(r_game *r, const char *which, float *out);
 int fx_snow_light_size(r_game *r); /* 0: no snow module */
+/* Triangles of the surface grid the frame drawn last drew (its level of
+ * detail: fx_snow.c, snow_grid_lod); 0: none yet. */
+int fx_snow_grid_drawn(r_game *r);
 /* Stamps n capsules into the map the way a tick's contacts are stamped
  * (the next frame's reset restarts it). */
 typedef struct r_fx_capsule r_fx_capsule;
