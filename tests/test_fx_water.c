@@ -136,6 +136,7 @@ static void t_gpu_matches_cpu(void)
     r_game *r = game_new();
     const fx_water_sim_params *prm = fx_water_params(r);
     T_ASSERT(prm);
+    T_ASSERT(fx_water_set_cpu(r, false, NULL)); /* the shaders, also on a software rasteriser */
     static float cpu[NN], tmp[NN], gpu[NN];
     memset(cpu, 0, sizeof cpu);
     T_ASSERT(fx_water_write(r, cpu));
@@ -185,6 +186,7 @@ static void t_tiny_heights_are_zero(void)
     r_game *r = game_new();
     const fx_water_sim_params *prm = fx_water_params(r);
     T_ASSERT(prm);
+    T_ASSERT(fx_water_set_cpu(r, false, NULL)); /* the shaders, also on a software rasteriser */
     static float in[NN], cpu[NN], gpu[NN];
     memset(in, 0, sizeof in);
     float denormal = 1e-39f;
@@ -305,6 +307,48 @@ static void t_shallows_waves_and_picture(void)
     plat_destroy(p);
 }
 
+/* On a software rasteriser the automaton and the normal map run in C
+ * (cpu_steps, cpu_normal_map) by default: a match drawn that way and one
+ * drawn with the shaders keep the same waves (the steps' arithmetic is
+ * the same; the splat's cos() may round differently) and the same
+ * picture. */
+static void t_cpu_path_matches_shaders(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    static float g[2][NN];
+    static uint8_t px[2][W * H * 4];
+    for (int way = 0; way < 2; way++) {
+        r_game *r = game_new();
+        bool was = false;
+        T_ASSERT(fx_water_set_cpu(r, way == 0, &was));
+        T_ASSERTF(was, "llvmpipe's default is not the automaton in C");
+        match m;
+        match_start(&m);
+        while (m.cur.tick < 380) {
+            match_tick(&m);
+            if (m.cur.tick >= 300)
+                t_draw_read(r, &f, &m.prev, &m.cur, W, H, px[way], false);
+        }
+        T_ASSERT(fx_water_read(r, g[way]));
+        r_game_destroy(r);
+    }
+    double worst = 0, scale = 0;
+    for (size_t k = 0; k < NN; k++)
+        worst = fmax(worst, fabs((double)g[0][k] - g[1][k])), scale = fmax(scale, fabs(g[1][k]));
+    int differ = 0;
+    for (int k = 0; k < W * H * 4; k++)
+        differ += abs(px[0][k] - px[1][k]) > 2;
+    fprintf(stderr, "    80 frames: max |c - shaders| %.3g m, max |h| %.4g m; %d of %d bytes more than 2 apart\n", worst,
+            scale, differ, W * H * 4);
+    T_ASSERTF(scale > 1e-3, "the fight made no waves (max |h| %g)", scale);
+    T_ASSERTF(worst <= 1e-4 * scale, "C and shaders differ by %g m (max |h| %g)", worst, scale);
+    T_ASSERTF(differ <= W * H * 4 / 1000, "%d bytes of the frame differ by more than 2", differ);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 static void check_finite(r_game *r, const char *what, bool stepped)
 {
     static float buf[W * H * 4], g[NN];
@@ -389,4 +433,4 @@ T_MAIN({"cpu_bounded_for_a_million_steps", t_cpu_bounded_for_a_million_steps},
        {"gpu_matches_cpu", t_gpu_matches_cpu},
        {"tiny_heights_are_zero", t_tiny_heights_are_zero},
        {"shallows_waves_and_picture", t_shallows_waves_and_picture},
-       {"no_nan_or_inf", t_no_nan_or_inf})
+       {"cpu_path_matches_shaders", t_cpu_path_matches_shaders}, {"no_nan_or_inf", t_no_nan_or_inf})

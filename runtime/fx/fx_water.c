@@ -3,7 +3,10 @@
  *   water_sim      (R_FX_PRE)  contacts -> splats on the CPU; per game tick
  *                              one automaton step on the 256x256 RGBA32F
  *                              ping-pong pair plus the splats drawn as
- *                              GL_POINTS; then the normal map
+ *                              GL_POINTS; then the normal map.  On a
+ *                              software rasteriser the steps and the
+ *                              normal map run in C (fx_water_sim.c, the
+ *                              automaton's reference) and are uploaded
  *   water_reflect  (R_FX_PRE)  the reflection map: the sky and a simple
  *                              model of the fighters, mirrored in the water
  *                              plane, at half the screen size
@@ -52,7 +55,15 @@ typedef struct fx_water_state {
     fx_water_sim_params prm;
     GLuint prog[W_PROGS];
     GLuint sim_tex[2], sim_fbo[2];
-    int cur; /* the sim texture holding the latest state */
+    int cur; /* the sim texture (or grid) holding the latest state */
+    /* On a software rasteriser (cpu) the automaton runs in C on grid and
+     * the drawn frame uploads its state and normal map (nrm): llvmpipe
+     * took about 3 ms a frame for the step's full-screen passes, where the
+     * C step and the normal map take a fraction of it. */
+    bool cpu;
+    float *grid[2]; /* 2 n^2 floats each: h, h a step earlier */
+    float *heights; /* n^2: the latest heights made safe (cpu_normal_map) */
+    uint8_t *nrm;   /* n^2 RGBA8 texels */
     GLuint normal_tex, normal_fbo;
     GLuint splat_vao, splat_vbo;
     fx_water_sim_splat splat[MAX_SPLATS];
@@ -202,6 +213,7 @@ static void free_gl(fx_water_state *w)
     if (w->splat_vbo)
         gl.DeleteBuffers(1, &w->splat_vbo);
     free_targets(w);
+    free(w->grid[0]), free(w->grid[1]), free(w->heights), free(w->nrm);
     fx_water_sim_params prm = w->prm;
     memset(w, 0, sizeof *w);
     w->prm = prm;
@@ -253,6 +265,14 @@ static bool build(fx_water_state *w, rs_err *err)
     w->shallow_tex = color_tex(px, false);
     w->deep_tex = color_tex(px, true);
     free(px);
+    const size_t cells = (size_t)R_WATER_N * R_WATER_N;
+    w->grid[0] = calloc(2 * cells, sizeof(float)), w->grid[1] = calloc(2 * cells, sizeof(float));
+    w->nrm = malloc(4 * cells), w->heights = malloc(cells * sizeof(float));
+    if (!w->grid[0] || !w->grid[1] || !w->nrm || !w->heights) {
+        rs_fail(err, R_ERR_NOMEM, "out of memory for the water");
+        goto fail;
+    }
+    w->cpu = rgl_is_software();
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     w->built = true;
@@ -312,6 +332,8 @@ static void restore_draw_state(void)
 static void clear_state(fx_water_state *w)
 {
     const float zero[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 2; k++)
+        memset(w->grid[k], 0, (size_t)R_WATER_N * R_WATER_N * 2 * sizeof(float));
     for (int k = 0; k < 2; k++) {
         gl.BindFramebuffer(GL_FRAMEBUFFER, w->sim_fbo[k]);
         gl.ClearBufferfv(GL_COLOR, 0, zero);
@@ -362,6 +384,50 @@ static void gpu_steps(r_game *r, fx_water_state *w, const fx_water_sim_splat *s,
     }
 }
 
+/* gpu_steps in C: the automaton's reference step (the shader's arithmetic,
+ * test_fx_water/gpu_matches_cpu), then the splats' bumps */
+static void cpu_steps(fx_water_state *w, const fx_water_sim_splat *s, int ns, int steps)
+{
+    for (int k = 0; k < steps; k++) {
+        int dst = 1 - w->cur;
+        fx_water_sim_step(&w->prm, R_WATER_N, w->grid[w->cur], w->grid[dst]);
+        for (int i = 0; i < ns; i++)
+            fx_water_sim_add_splat(R_WATER_N, w->grid[dst], &s[i]);
+        w->cur = dst;
+    }
+}
+
+/* water_normal.frag in C, and the state and the normal map uploaded for
+ * the passes that read them (the surface's vertices and pixels) */
+static void cpu_normal_map(fx_water_state *w)
+{
+    const int n = R_WATER_N;
+    const float *g = w->grid[w->cur], hm = w->prm.h_max, k2dx = (float)n / (2 * w->prm.size);
+    float *hs = w->heights; /* the safe heights, once each */
+    for (size_t k = 0; k < (size_t)n * n; k++)
+        hs[k] = fx_water_sim_height(g[2 * k], hm);
+    for (int j = 0; j < n; j++) {
+        const float *row = hs + (size_t)j * n, *down = hs + (size_t)(j > 0 ? j - 1 : 0) * n;
+        const float *up = hs + (size_t)(j < n - 1 ? j + 1 : n - 1) * n;
+        uint8_t *o = w->nrm + 4 * (size_t)j * n;
+        for (int i = 0; i < n; i++, o += 4) {
+            float l = row[i > 0 ? i - 1 : 0], r = row[i < n - 1 ? i + 1 : n - 1];
+            float nx = (l - r) * k2dx, nz = (down[i] - up[i]) * k2dx, inv = 1 / sqrtf(nx * nx + 1 + nz * nz);
+            float c[4] = {nx * inv * 0.5f + 0.5f, inv * 0.5f + 0.5f, nz * inv * 0.5f + 0.5f, row[i] * 0.5f / hm + 0.5f};
+            for (int q = 0; q < 4; q++) { /* GL's float -> unorm8: clamped, rounded to nearest */
+                float v = c[q] < 0 ? 0 : c[q] > 1 ? 1 : c[q];
+                o[q] = (uint8_t)(v * 255 + 0.5f);
+            }
+        }
+    }
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.BindTexture(GL_TEXTURE_2D, w->normal_tex);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, n, n, GL_RGBA, GL_UNSIGNED_BYTE, w->nrm);
+    gl.BindTexture(GL_TEXTURE_2D, w->sim_tex[w->cur]);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, n, n, GL_RG, GL_FLOAT, g);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+}
+
 static float ring_half(const r_game *r)
 {
     int st = r_game_ring_stage(r) >= 0 ? r_game_ring_stage(r) : r_fx_stage(r)->game_index;
@@ -390,7 +456,10 @@ static bool step_sim(r_game *r)
     /* one step per game tick; a frame that skipped ticks replays this
      * tick's splats for each (there are no states between) */
     int steps = f->steps < R_WATER_MAX_STEPS ? f->steps : R_WATER_MAX_STEPS;
-    gpu_steps(r, w, w->splat, w->nsplat, steps);
+    if (w->cpu)
+        cpu_steps(w, w->splat, w->nsplat, steps);
+    else
+        gpu_steps(r, w, w->splat, w->nsplat, steps);
     return steps > 0 || f->reset;
 }
 
@@ -400,6 +469,10 @@ static void run_sim(void *u)
     fx_water_state *w = WATER(r);
     if (!step_sim(r))
         return; /* the same tick again: the normal map stands */
+    if (w->cpu) {
+        cpu_normal_map(w);
+        return;
+    }
     /* the normal map from the heights: made for the drawn frame only (an
      * advanced tick's would be made again before anyone reads it) */
     GLuint q = w->prog[W_NORMAL];
@@ -607,6 +680,10 @@ bool fx_water_gpu_steps(r_game *r, const fx_water_sim_splat *s, int ns, int step
 bool fx_water_read(r_game *r, float *grid)
 {
     fx_water_state *w = WATER(r);
+    if (w && w->built && w->cpu) {
+        memcpy(grid, w->grid[w->cur], (size_t)R_WATER_N * R_WATER_N * 2 * sizeof *grid);
+        return true;
+    }
     float *px = w && w->built ? malloc((size_t)R_WATER_N * R_WATER_N * 4 * sizeof *px) : NULL;
     if (!px)
         return false;
@@ -623,6 +700,10 @@ bool fx_water_read(r_game *r, float *grid)
 bool fx_water_write(r_game *r, const float *grid)
 {
     fx_water_state *w = WATER(r);
+    if (w && w->built && w->cpu) {
+        memcpy(w->grid[w->cur], grid, (size_t)R_WATER_N * R_WATER_N * 2 * sizeof *grid);
+        return true;
+    }
     float *px = w && w->built ? calloc((size_t)R_WATER_N * R_WATER_N * 4, sizeof *px) : NULL;
     if (!px)
         return false;
@@ -632,6 +713,26 @@ bool fx_water_write(r_game *r, const float *grid)
     gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, R_WATER_N, R_WATER_N, GL_RGBA, GL_FLOAT, px);
     gl.BindTexture(GL_TEXTURE_2D, 0);
     free(px);
+    return true;
+}
+
+bool fx_water_set_cpu(r_game *r, bool cpu, bool *was)
+{
+    fx_water_state *w = WATER(r);
+    if (!w || !w->built)
+        return false;
+    if (was)
+        *was = w->cpu;
+    if (cpu != w->cpu) { /* the state goes with it */
+        float *g = malloc((size_t)R_WATER_N * R_WATER_N * 2 * sizeof *g);
+        if (!g || !fx_water_read(r, g)) {
+            free(g);
+            return false;
+        }
+        w->cpu = cpu;
+        fx_water_write(r, g);
+        free(g);
+    }
     return true;
 }
 

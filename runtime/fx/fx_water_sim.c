@@ -35,10 +35,9 @@ void fx_water_sim_params_fix(fx_water_sim_params *p)
     p->size = pick(p->size, 8.0f, 0.1f, 1000.0f);
 }
 
-/* A height under R_WATER_H_TINY is 0 (fx_water_sim.h: denormals). */
 static inline float flush(float v)
 {
-    return fabsf(v) < R_WATER_H_TINY ? 0.0f : v;
+    return fx_water_sim_flush(v);
 }
 
 /* h' = damping * ((2 h - h_prev) + C^2 * laplacian), clamped; a NaN
@@ -47,10 +46,7 @@ static inline float flush(float v)
 
 static inline float safe(float v, float h_max)
 {
-    v = flush(v);
-    v = v < -h_max ? -h_max : v;
-    v = v > h_max ? h_max : v;
-    return v == v ? v : 0.0f;
+    return fx_water_sim_height(v, h_max);
 }
 
 static inline float cell(float c2, float damping, float h_max, float h, float hp, float l, float r, float d, float u)

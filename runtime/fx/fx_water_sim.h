@@ -35,6 +35,7 @@
 #ifndef R_FX_WATER_SIM_H
 #define R_FX_WATER_SIM_H
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 
@@ -85,6 +86,21 @@ typedef struct fx_water_sim_splat {
  * False when the centre is off the grid or the height is 0 or not finite. */
 bool fx_water_sim_splat_for(const fx_water_sim_params *p, int n, float wx, float wz, float cap_radius, float depth, float speed,
                        fx_water_sim_splat *out);
+/* A height under R_WATER_H_TINY is 0 (above: denormals). */
+static inline float fx_water_sim_flush(float v)
+{
+    return fabsf(v) < R_WATER_H_TINY ? 0.0f : v;
+}
+/* A simulated height made safe, as water_common.glsl's water_height: NaN
+ * -> 0, under R_WATER_H_TINY -> 0, clamped to +-h_max.  Selects, not
+ * branches, so a vectorising build can vectorise the loops that use it. */
+static inline float fx_water_sim_height(float v, float h_max)
+{
+    v = fx_water_sim_flush(v);
+    v = v < -h_max ? -h_max : v;
+    v = v > h_max ? h_max : v;
+    return v == v ? v : 0.0f;
+}
 /* Adds the splat's bump to h: amp * (1 + cos(pi d / radius)) / 2 at the
  * cells whose centres are within radius of its centre. */
 void fx_water_sim_add_splat(int n, float *grid, const fx_water_sim_splat *s);
@@ -127,6 +143,10 @@ const fx_water_sim_params *fx_water_params(struct r_game *r);
 bool fx_water_gpu_steps(struct r_game *r, const fx_water_sim_splat *s, int ns, int steps);
 /* The current state, R_WATER_N^2 * 2 floats (height, previous). */
 bool fx_water_read(struct r_game *r, float *grid);
+/* The automaton and the normal map in C (true: the default on a software
+ * rasteriser) or in shaders; the state goes along; was (may be NULL): the
+ * way before.  False before a stage with water has loaded. */
+bool fx_water_set_cpu(struct r_game *r, bool cpu, bool *was);
 /* Replaces the state (tests put NaN and Inf in it). */
 bool fx_water_write(struct r_game *r, const float *grid);
 /* Splats the sim pass injected per step in the last frame. */
