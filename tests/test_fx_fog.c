@@ -310,19 +310,27 @@ static void place(r_game *r, t_fb *f, const g_state *prev, const g_state *cur, c
     t_draw_read(r, f, prev, cur, W, H, NULL, true);
 }
 
+/* Mistvale's look over dojo's tick 900, drawn once into a new f: the
+ * seeded mist's map. */
+static r_game *seeded_mist(t_fb *f, g_state *prev, g_state *cur)
+{
+    t_state_at("dojo", 900, prev, cur);
+    r_stage st = mistvale();
+    r_game *r = game_new(&st);
+    t_fb_make(f, W, H);
+    t_draw_read(r, f, prev, cur, W, H, NULL, true);
+    T_ASSERT(t_pass_ran(r, "fog_map"));
+    return r;
+}
+
 /* The map is the particles' sprites: the right height where each is,
  * exactly zero beyond their reach, wrapping round the edge, mean 1. */
 static void t_map_is_where_particles_are(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    t_state_at("dojo", 900, &prev, &cur);
-    r_stage st = mistvale();
-    r_game *r = game_new(&st);
     t_fb f;
-    t_fb_make(&f, W, H);
-    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
-    T_ASSERT(t_pass_ran(r, "fog_map"));
+    r_game *r = seeded_mist(&f, &prev, &cur);
     int n;
     float h;
     float *m = read_map(r, &n, &h);
@@ -410,14 +418,10 @@ static void t_map_cpu_matches_sprites(void)
 {
     plat *p = t_context("egl");
     g_state prev, cur;
-    t_state_at("dojo", 900, &prev, &cur);
-    r_stage st = mistvale();
-    r_game *r = game_new(&st);
     t_fb f;
-    t_fb_make(&f, W, H);
+    r_game *r = seeded_mist(&f, &prev, &cur);
     int n, at = 0;
     float h;
-    t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);
     float *def = read_map(r, &n, &h);
     T_ASSERT(fx_fog_set_cpu(r, true));
     t_draw_read(r, &f, &prev, &cur, W, H, NULL, true);

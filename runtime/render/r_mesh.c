@@ -29,6 +29,20 @@ static int reserve(r_mesh_data *m, size_t nv, size_t ni)
     return 1;
 }
 
+/* Two triangles per quad between consecutive rows of seg + 1 vertices
+ * from base on (a capsule's or a sphere's bands), counter-clockwise
+ * seen from outside. */
+static void band_indices(r_mesh_data *m, size_t base, int rows, int seg)
+{
+    for (int row = 0; row + 1 < rows; row++)
+        for (int s = 0; s < seg; s++) {
+            unsigned a = (unsigned)(base + (size_t)row * (seg + 1) + s), b = a + (unsigned)seg + 1;
+            unsigned q[6] = {a, a + 1, b, a + 1, b + 1, b};
+            memcpy(m->idx + m->ni, q, sizeof q);
+            m->ni += 6;
+        }
+}
+
 int r_mesh_capsule(r_mesh_data *m, float length, float r, int bone, int seg, int rings)
 {
     /* a cylinder with two hemispherical caps, rows from the -x pole to the
@@ -64,13 +78,7 @@ int r_mesh_capsule(r_mesh_data *m, float length, float r, int bone, int seg, int
             v->bone = (float)bone;
         }
     }
-    for (int row = 0; row + 1 < rows; row++)
-        for (int s = 0; s < seg; s++) {
-            unsigned a = (unsigned)(base + (size_t)row * (seg + 1) + s), b = a + (unsigned)seg + 1;
-            unsigned q[6] = {a, a + 1, b, a + 1, b + 1, b};
-            memcpy(m->idx + m->ni, q, sizeof q);
-            m->ni += 6;
-        }
+    band_indices(m, base, rows, seg);
     return 1;
 }
 
@@ -96,13 +104,7 @@ int r_mesh_sphere_rows(r_mesh_data *m, int bone, int seg, const float *phi, int 
             v->bone = (float)bone;
         }
     }
-    for (int row = 0; row + 1 < rows; row++)
-        for (int s = 0; s < seg; s++) {
-            unsigned a = (unsigned)(base + (size_t)row * (seg + 1) + s), b = a + (unsigned)seg + 1;
-            unsigned q[6] = {a, a + 1, b, a + 1, b + 1, b};
-            memcpy(m->idx + m->ni, q, sizeof q);
-            m->ni += 6;
-        }
+    band_indices(m, base, rows, seg);
     return 1;
 }
 
