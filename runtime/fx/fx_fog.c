@@ -146,7 +146,35 @@ static void splat_cpu(struct fx_fog_state *fg, int n, float h, float R, float am
     gl.BindTexture(GL_TEXTURE_2D, 0);
 }
 
-/* Step 2: the particles as sprites into the map; returns the sprites drawn. */
+/* Step 2 on the GL: the n sprites of fg->inst as instanced quads, blended
+ * into the cleared map (fog_splat.vert/.frag). */
+static void splat_gl(struct fx_fog_state *fg, int n, float h, float R, float amp)
+{
+    gl.BindFramebuffer(GL_FRAMEBUFFER, fg->fbo);
+    gl.Viewport(0, 0, fg->size, fg->size);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.Disable(GL_CULL_FACE);
+    gl.ClearColor(0, 0, 0, 0);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+    if (n == 0)
+        return;
+    gl.Enable(GL_BLEND);
+    gl.BlendFunc(GL_ONE, GL_ONE);
+    gl.UseProgram(fg->prog);
+    gl.Uniform1f(r_loc(fg->prog, "u_half"), h);
+    gl.Uniform1f(r_loc(fg->prog, "u_radius"), R);
+    gl.Uniform1f(r_loc(fg->prog, "u_amp"), amp);
+    gl.BindVertexArray(fg->vao);
+    gl.BindBuffer(GL_ARRAY_BUFFER, fg->vbo);
+    gl.BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(fg->cap * 3 * sizeof(float)), NULL, GL_STREAM_DRAW); /* orphan */
+    gl.BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)((size_t)n * 3 * sizeof(float)), fg->inst);
+    gl.BindBuffer(GL_ARRAY_BUFFER, 0);
+    gl.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, n);
+    gl.Disable(GL_BLEND);
+}
+
+/* Step 2: the particles as sprites into the map, on the GL or (fg->cpu)
+ * in C; returns the sprites drawn. */
 static int draw_map(r_game *r, struct fx_fog_state *fg)
 {
     const fx_fog_sim *s = &fg->sim;
@@ -176,29 +204,8 @@ static int draw_map(r_game *r, struct fx_fog_state *fg)
         amp = 60000.0f / sum;
     if (fg->cpu)
         splat_cpu(fg, n, h, R, amp);
-    else {
-        gl.BindFramebuffer(GL_FRAMEBUFFER, fg->fbo);
-        gl.Viewport(0, 0, fg->size, fg->size);
-        gl.Disable(GL_DEPTH_TEST);
-        gl.Disable(GL_CULL_FACE);
-        gl.ClearColor(0, 0, 0, 0);
-        gl.Clear(GL_COLOR_BUFFER_BIT);
-    }
-    if (n > 0 && !fg->cpu) {
-        gl.Enable(GL_BLEND);
-        gl.BlendFunc(GL_ONE, GL_ONE);
-        gl.UseProgram(fg->prog);
-        gl.Uniform1f(r_loc(fg->prog, "u_half"), h);
-        gl.Uniform1f(r_loc(fg->prog, "u_radius"), R);
-        gl.Uniform1f(r_loc(fg->prog, "u_amp"), amp);
-        gl.BindVertexArray(fg->vao);
-        gl.BindBuffer(GL_ARRAY_BUFFER, fg->vbo);
-        gl.BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(fg->cap * 3 * sizeof(float)), NULL, GL_STREAM_DRAW); /* orphan */
-        gl.BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)((size_t)n * 3 * sizeof(float)), fg->inst);
-        gl.BindBuffer(GL_ARRAY_BUFFER, 0);
-        gl.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, n);
-        gl.Disable(GL_BLEND);
-    }
+    else
+        splat_gl(fg, n, h, R, amp);
     /* step 3: a blur, wrapping like the map */
     if (fg->look.blur) {
         r_blur_into(r, fg->tmp_fbo, fg->tex, 0, fg->size, fg->size, 1, 0);

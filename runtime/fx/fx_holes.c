@@ -37,7 +37,7 @@ extern const r_fx_module fx_holes_module;
 
 #define LIFT 0.4f /* the sphere's centre stands 0.4 r above the floor */
 /* The crater's sphere (crater_mesh), in two levels of detail chosen as
- * the fighters' mesh is (r_fx_coarse_mesh: below 540 rows drawn).  Round
+ * the fighters' mesh is (r_fx_mesh_lod: coarse below 540 rows drawn).  Round
  * the vertical axis, SEG segments; below the floor, where its inside is
  * seen, BELOW bands from the bottom pole to a row exactly on the floor, so
  * the rim is a polygon on the true circle; above the floor, where it only
@@ -49,12 +49,12 @@ extern const r_fx_module fx_holes_module;
  * pixels of the circle on the largest craters. */
 static const struct crater_lod {
     int seg, below, above;
-} crater_lod[2] = {{24, 4, 1}, {32, 6, 2}}; /* coarse, fine */
+} crater_lod[R_FIGHTER_LODS] = {[R_FIGHTER_COARSE] = {24, 4, 1}, [R_FIGHTER_FINE] = {32, 6, 2}};
 #define STENCIL_HOLES 0x7F
 
 struct fx_holes {
-    GLuint vao[2], vbo[2], ibo[2]; /* crater_lod's levels */
-    GLsizei count[2];
+    GLuint vao[R_FIGHTER_LODS], vbo[R_FIGHTER_LODS], ibo[R_FIGHTER_LODS]; /* crater_lod's levels */
+    GLsizei count[R_FIGHTER_LODS];
     int drawn; /* holes drawn in the frame drawn last */
 };
 
@@ -126,7 +126,7 @@ static void run_holes(void *u)
     GLuint ps = r_stage_program(r, R_MAT_HOLE); /* the crater's inside */
     gl.Enable(GL_STENCIL_TEST);
     gl.StencilMask(STENCIL_HOLES);
-    int lod = r_fx_coarse_mesh(r) ? 0 : 1;
+    int lod = r_fx_mesh_lod(r);
     GLsizei count = hs->count[lod];
     gl.BindVertexArray(hs->vao[lod]);
     for (int k = 0; k < n; k++) {
@@ -188,7 +188,7 @@ static void holes_destroy(r_game *r)
     struct fx_holes *hs = HOLES(r);
     if (!hs)
         return;
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < R_FIGHTER_LODS; k++)
         r_free_mesh(&hs->vao[k], &hs->vbo[k], &hs->ibo[k]);
     free(hs);
     r_fx_set_state(r, &fx_holes_module, NULL);
@@ -201,7 +201,7 @@ static bool holes_create(r_game *r, rs_err *err)
         return rs_fail(err, R_ERR_NOMEM, "holes: out of memory");
     r_fx_set_state(r, &fx_holes_module, hs);
     /* the unit sphere on bone 0: u_bones[0] places it */
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < R_FIGHTER_LODS; k++) {
         r_mesh_data m = {0};
         if (!crater_mesh(&m, &crater_lod[k])) {
             r_mesh_free(&m);

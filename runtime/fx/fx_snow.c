@@ -49,7 +49,7 @@ extern const r_fx_module fx_snow_module;
  * the detail, and on every `far`-th row beyond, where the snow stays
  * untouched drifts (their fine ripples come from the texture-space
  * lighting, not the geometry).  Two levels, chosen as the fighters' mesh
- * is (r_fx_coarse_mesh: below 540 rows drawn): the fine grid, 16.5k
+ * is (r_fx_mesh_lod: coarse below 540 rows drawn): the fine grid, 16.5k
  * triangles where a uniform grid of every other texel has 34k, and the
  * coarse one with every 4th column, 8.4k: on llvmpipe the triangles cost
  * more than the pixels (snow_surface 10.4-11.8 -> 8.3 ms a frame
@@ -57,7 +57,7 @@ extern const r_fx_module fx_snow_module;
  * the fine grid's. */
 static const struct snow_grid_lod {
     int col, band, far;
-} snow_grid_lod[2] = {{4, 16, 8}, {2, 16, 8}}; /* coarse, fine */
+} snow_grid_lod[R_FIGHTER_LODS] = {[R_FIGHTER_COARSE] = {4, 16, 8}, [R_FIGHTER_FINE] = {2, 16, 8}};
 #define MAX_STAMPS (4 * G_BONES)    /* both fighters, this tick and the one before */
 #define COLOR_TILE 0.8f             /* metres per repeat of the colour textures */
 #define DETAIL_TILE 2.0f            /* metres per repeat of the crust normal map: lumps of ~8 cm, which
@@ -74,8 +74,8 @@ struct fx_snow_state {
     int light_size;                       /* their side: r_quality.snow_light or SNOW_LIGHT */
     GLuint key_tex, key_fbo;              /* 1x1: the key light's colour (snow_key.frag) */
     GLuint color_tex, detail_tex;
-    GLuint grid_vao[2], grid_vbo[2], grid_ibo[2]; /* snow_grid_lod's levels */
-    GLsizei grid_count[2];
+    GLuint grid_vao[R_FIGHTER_LODS], grid_vbo[R_FIGHTER_LODS], grid_ibo[R_FIGHTER_LODS]; /* snow_grid_lod's levels */
+    GLsizei grid_count[R_FIGHTER_LODS];
     int grid_drawn;                       /* triangles of the grid the last frame drew */
     r_fx_capsule stamp[MAX_STAMPS];       /* this frame's contacts (need_map) */
     int nstamp;
@@ -169,9 +169,9 @@ static void snow_destroy(r_game *r)
     GLuint fbo[] = {s->map_fbo, s->light_fbo, s->tmp_fbo, s->key_fbo};
     gl.DeleteTextures((GLsizei)(sizeof tex / sizeof tex[0]), tex);
     gl.DeleteFramebuffers((GLsizei)(sizeof fbo / sizeof fbo[0]), fbo);
-    gl.DeleteBuffers(2, s->grid_vbo);
-    gl.DeleteBuffers(2, s->grid_ibo);
-    gl.DeleteVertexArrays(2, s->grid_vao);
+    gl.DeleteBuffers(R_FIGHTER_LODS, s->grid_vbo);
+    gl.DeleteBuffers(R_FIGHTER_LODS, s->grid_ibo);
+    gl.DeleteVertexArrays(R_FIGHTER_LODS, s->grid_vao);
     free(s);
     r_fx_set_state(r, &fx_snow_module, NULL);
 }
@@ -214,7 +214,7 @@ static bool snow_create(r_game *r, rs_err *err)
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
 
     uint8_t *px = malloc((size_t)R_SNOW_TEX * R_SNOW_TEX * 4);
-    if (!px || !build_grid(s, 0) || !build_grid(s, 1)) {
+    if (!px || !build_grid(s, R_FIGHTER_COARSE) || !build_grid(s, R_FIGHTER_FINE)) {
         free(px);
         return rs_fail(err, R_ERR_NOMEM, "out of memory for the snow");
     }
@@ -424,7 +424,7 @@ static void run_surface(void *u)
     gl.Uniform1i(r_loc(p, "u_shadows"), r_ran(f, r, "silhouette_mips"));
     r_light_uniforms(p, f);
     gl.Uniform1f(r_loc(p, "u_sil_top"), SIL_LEVELS - 1);
-    int lod = r_fx_coarse_mesh(r) ? 0 : 1;
+    int lod = r_fx_mesh_lod(r);
     gl.BindVertexArray(s->grid_vao[lod]);
     gl.DrawElements(GL_TRIANGLES, s->grid_count[lod], GL_UNSIGNED_INT, NULL);
     s->grid_drawn = s->grid_count[lod] / 3;

@@ -35,25 +35,16 @@ void fx_water_sim_params_fix(fx_water_sim_params *p)
     p->size = pick(p->size, 8.0f, 0.1f, 1000.0f);
 }
 
-static inline float flush(float v)
-{
-    return fx_water_sim_flush(v);
-}
-
 /* h' = damping * ((2 h - h_prev) + C^2 * laplacian), clamped; a NaN
  * becomes 0, so nothing that is not finite survives one step.  Selects,
- * not branches, so a vectorising build can vectorise the inner loop. */
-
-static inline float safe(float v, float h_max)
-{
-    return fx_water_sim_height(v, h_max);
-}
-
+ * not branches (fx_water_sim_flush, fx_water_sim_height), so a
+ * vectorising build can vectorise the inner loop. */
 static inline float cell(float c2, float damping, float h_max, float h, float hp, float l, float r, float d, float u)
 {
-    h = flush(h), hp = flush(hp), l = flush(l), r = flush(r), d = flush(d), u = flush(u);
+    h = fx_water_sim_flush(h), hp = fx_water_sim_flush(hp);
+    l = fx_water_sim_flush(l), r = fx_water_sim_flush(r), d = fx_water_sim_flush(d), u = fx_water_sim_flush(u);
     float lap = ((l + r) + (d + u)) - 4.0f * h;
-    return safe(damping * ((2.0f * h - hp) + c2 * lap), h_max);
+    return fx_water_sim_height(damping * ((2.0f * h - hp) + c2 * lap), h_max);
 }
 
 void fx_water_sim_step_raw(float courant, float damping, float h_max, int n, const float *restrict src, float *restrict dst)
@@ -69,12 +60,12 @@ void fx_water_sim_step_raw(float courant, float damping, float h_max, int n, con
             int il = i > 0 ? i - 1 : 0, ir = i < n - 1 ? i + 1 : n - 1;
             float h = row[2 * i];
             out[2 * i] = cell(c2, damping, h_max, h, row[2 * i + 1], row[2 * il], row[2 * ir], down[2 * i], up[2 * i]);
-            out[2 * i + 1] = safe(h, h_max); /* the shader's previous height: the input, made safe */
+            out[2 * i + 1] = fx_water_sim_height(h, h_max); /* the shader's previous height: the input, made safe */
         }
         for (int i = 1; i < n - 1; i++) { /* the inner cells */
             float h = row[2 * i];
             out[2 * i] = cell(c2, damping, h_max, h, row[2 * i + 1], row[2 * i - 2], row[2 * i + 2], down[2 * i], up[2 * i]);
-            out[2 * i + 1] = safe(h, h_max);
+            out[2 * i + 1] = fx_water_sim_height(h, h_max);
         }
     }
 }
@@ -128,7 +119,7 @@ void fx_water_sim_add_splat(int n, float *grid, const fx_water_sim_splat *s)
             float dx = ((float)i + 0.5f) - s->x, dy = ((float)j + 0.5f) - s->y;
             float d = sqrtf(dx * dx + dy * dy);
             if (d < s->radius)
-                grid[((size_t)j * n + i) * 2] += flush(s->amp * fx_water_sim_splat_weight(d, s->radius));
+                grid[((size_t)j * n + i) * 2] += fx_water_sim_flush(s->amp * fx_water_sim_splat_weight(d, s->radius));
         }
 }
 

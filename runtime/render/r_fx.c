@@ -56,9 +56,9 @@ const r_quality *r_fx_quality(const r_game *r)
     return &r->opts.q;
 }
 
-bool r_fx_coarse_mesh(const r_game *r)
+int r_fx_mesh_lod(const r_game *r)
 {
-    return r->fighter == &r->fighter_lod[R_FIGHTER_COARSE];
+    return (int)(r->fighter - r->fighter_lod);
 }
 
 r_fx_gl r_fx_core_gl(const r_game *r)

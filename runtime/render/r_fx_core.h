@@ -84,10 +84,11 @@ int r_fx_stage_game(const r_game *r);
 const float *r_fx_key_dir(const r_game *r);
 /* The quality knobs r_game_create_opts was given (range checked there). */
 const r_quality *r_fx_quality(const r_game *r);
-/* This frame draws the fighters' coarse mesh (drawn below
- * R_FIGHTER_COARSE_ROWS rows, unless the options ask for the fine one):
- * an effect's own meshes may follow the same choice. */
-bool r_fx_coarse_mesh(const r_game *r);
+/* The fighters' level of detail this frame (R_FIGHTER_COARSE below
+ * R_FIGHTER_COARSE_ROWS rows drawn, unless the options ask for the fine
+ * one; r_mesh.h): an effect's own meshes follow the same choice, indexed
+ * the same way. */
+int r_fx_mesh_lod(const r_game *r);
 
 /* The core's GL objects an effect draws with or reads.  The screen
  * targets are remade when the render size changes: ask again each frame. */
