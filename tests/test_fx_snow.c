@@ -479,7 +479,44 @@ static void t_grids_agree(void)
     plat_destroy(p);
 }
 
+/* The scene leaves the ring's top face to the snow (fx_snow.c,
+ * snow_draw_ring): the snow covers it whole (no height below the top:
+ * snow_height clamps at 0), at either grid and two ticks, so the frame is
+ * the same byte for byte as with the top drawn under the snow. */
+static void t_ring_top_left_to_the_snow(void)
+{
+    enum { GW = 320, GH = 180 };
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, GW, GH);
+    static uint8_t px[2][GW * GH * 4];
+    const uint64_t ticks[] = {300, 2600};
+    for (int fine = 0; fine < 2; fine++)
+        for (int t = 0; t < 2; t++) {
+            g_state prev, cur;
+            t_state_at("snowfield", ticks[t], &prev, &cur);
+            r_game *r = t_game_opts(&(r_game_opts){.fine_mesh = fine == 1});
+            rs_err e = {0};
+            T_ASSERTF(r_game_prepare(r, snowfield(), &e), "%s", e.msg);
+            for (int keep = 0; keep < 2; keep++) {
+                fx_snow_test_keep_ring_top(r, keep == 1);
+                t_draw_read(r, &f, &prev, &cur, GW, GH, px[keep], false);
+                T_ASSERT(t_pass_ran(r, "snow_surface"));
+            }
+            int differ = 0;
+            for (int i = 0; i < GW * GH * 4; i++)
+                differ += px[0][i] != px[1][i];
+            fprintf(stderr, "    %s grid, tick %llu: %d bytes differ without the ring's top\n", fine ? "fine" : "coarse",
+                    (unsigned long long)ticks[t], differ);
+            T_EQ(differ, 0);
+            r_game_destroy(r);
+        }
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 T_MAIN({"height_textures", t_height_textures}, {"color_textures", t_color_textures},
        {"contacts_lower_the_map", t_contacts_lower_the_map}, {"never_below_trampled_and_reset", t_never_below_trampled_and_reset},
        {"footprints_where_fighters_walked", t_footprints_where_fighters_walked}, {"snow_is_visible", t_snow_is_visible},
-       {"fp16_extremes", t_fp16_extremes}, {"grids_agree", t_grids_agree})
+       {"fp16_extremes", t_fp16_extremes}, {"grids_agree", t_grids_agree},
+       {"ring_top_left_to_the_snow", t_ring_top_left_to_the_snow})

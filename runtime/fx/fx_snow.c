@@ -77,6 +77,7 @@ struct fx_snow_state {
     GLuint grid_vao[R_FIGHTER_LODS], grid_vbo[R_FIGHTER_LODS], grid_ibo[R_FIGHTER_LODS]; /* snow_grid_lod's levels */
     GLsizei grid_count[R_FIGHTER_LODS];
     int grid_drawn;                       /* triangles of the grid the last frame drew */
+    bool keep_ring_top;                   /* tests: the scene draws the ring's top face after all */
     r_fx_capsule stamp[MAX_STAMPS];       /* this frame's contacts (need_map) */
     int nstamp;
 };
@@ -433,6 +434,12 @@ static void run_surface(void *u)
 
 /* ---- test hooks (fx_snow_tex.h) ---- */
 
+void fx_snow_test_keep_ring_top(r_game *r, bool keep)
+{
+    if (SNOW(r))
+        SNOW(r)->keep_ring_top = keep;
+}
+
 int fx_snow_grid_drawn(r_game *r)
 {
     struct fx_snow_state *s = SNOW(r);
@@ -497,6 +504,22 @@ static void snow_advance(r_game *r)
         run_map(r);
 }
 
+/* Inside "scene": the ring without its top face, which the snow surface
+ * covers whole (its grid spans the top and its skirt walls come down to
+ * the top's edges, and no height is below the top), so the scene does not
+ * shade the pixels the snow then draws over.  A warm-up frame (depth only)
+ * draws no snow, so it keeps the top. */
+static bool snow_draw_ring(r_game *r)
+{
+    if (!need_snow(r) || r_fx_frame(r)->depth_only || SNOW(r)->keep_ring_top)
+        return false;
+    GLsizei n = r_fx_core_gl(r).ring_count;
+    gl.DrawElements(GL_TRIANGLES, R_RING_TOP_FIRST, GL_UNSIGNED_INT, NULL);
+    gl.DrawElements(GL_TRIANGLES, n - R_RING_TOP_FIRST - 6, GL_UNSIGNED_INT,
+                    (const void *)((R_RING_TOP_FIRST + 6) * sizeof(unsigned)));
+    return true;
+}
+
 static int snow_warmup(r_game *r)
 {
     return need_snow(r) ? R_FX_FROM_START : R_FX_STATELESS;
@@ -506,5 +529,5 @@ const r_fx_module fx_snow_module = {
     .name = "snow", .create = snow_create, .destroy = snow_destroy, .load = snow_load,
     .pass = {pre, surface, NULL}, .npass = {3, 1, 0},
     .res = {{RES_SNOW, "snow", true}, {RES_SNOW_LIGHT, "snow light", false}},
-    .warmup = snow_warmup, .advance = snow_advance,
+    .draw_ring = snow_draw_ring, .warmup = snow_warmup, .advance = snow_advance,
 };

@@ -44,6 +44,9 @@ int fx_snow_light_size(r_game *r); /* 0: no snow module */
 /* Triangles of the surface grid the frame drawn last drew (its level of
  * detail: fx_snow.c, snow_grid_lod); 0: none yet. */
 int fx_snow_grid_drawn(r_game *r);
+/* Tests: the scene draws the ring's top face under the snow after all
+ * (true), or leaves it to the snow as it does by default (false). */
+void fx_snow_test_keep_ring_top(r_game *r, bool keep);
 /* Stamps n capsules into the map the way a tick's contacts are stamped
  * (the next frame's reset restarts it). */
 typedef struct r_fx_capsule r_fx_capsule;
