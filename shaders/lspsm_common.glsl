@@ -3,16 +3,15 @@
 // Light space perspective shadow maps (docs/effects.md, "Shadows in a large
 // world"): one 1024x1024 depth map of the key light, warped so texels crowd
 // near the camera, drawn each frame by the lspsm_map pass (r_fx_lspsm.c) from
-// the buildings' low-poly proxies and the fighters.  A second R8 map beside it
-// marks the texels whose nearest caster is a fighter, so the stage, which
-// gets the fighters' shadows from the blurred silhouette (SSFSM) already, can
-// leave them out.  Only when u_lspsm_on == 1: lspsm_bind
+// the buildings' low-poly proxies, and the fighters when their own shadows
+// (the blurred silhouette, SSFSM) are off: with them on, only the buildings
+// look up a map with the fighters in it, bound in its place on the frames a
+// fighter's shadow can reach one (fx_lspsm.c).  Only when u_lspsm_on == 1: lspsm_bind
 // (runtime/fx/fx_lspsm.c) sets it with everything below, and it is 0 whenever
 // the map was not drawn this frame.
 uniform int u_lspsm_on;
 uniform sampler2DShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware
 uniform float u_lspsm_texel;         // one texel of the map, in texture coordinates
-uniform sampler2D u_lspsm_flag;      // 1 where the nearest caster is a fighter
 uniform mat4 u_lspsm_shadow;         // world -> (u, v, depth, w)
 uniform vec3 u_lspsm_eye;
 uniform vec2 u_lspsm_fade;           // strength 1 up to .x metres from the eye, 0 from .y on
@@ -34,9 +33,8 @@ vec3 lspsm_box_exit(vec3 p, vec3 d, vec3 lo, vec3 hi)
 
 // Visibility of the key light at p (1 lit, 0 in shadow), already faded out
 // towards the end of the shadow range; p is pushed along the normal n by
-// `offset` metres against acne.  no_fighters: texels whose nearest caster
-// is a fighter count as lit.
-float lspsm_visibility(vec3 p, vec3 n, float offset, bool no_fighters)
+// `offset` metres against acne.
+float lspsm_visibility(vec3 p, vec3 n, float offset)
 {
     if (u_lspsm_on != 1)
         return 1.0;
@@ -55,26 +53,17 @@ float lspsm_visibility(vec3 p, vec3 n, float offset, bool no_fighters)
     float h = 0.5 * u_lspsm_texel, z = c.z - u_lspsm_bias;
     float lit = 0.25 * (texture(u_lspsm_map, vec3(c.xy + vec2(-h, -h), z)) + texture(u_lspsm_map, vec3(c.xy + vec2(h, -h), z)) +
                         texture(u_lspsm_map, vec3(c.xy + vec2(-h, h), z)) + texture(u_lspsm_map, vec3(c.xy + vec2(h, h), z)));
-    // a flagged texel's caster is a fighter, so whatever it shadows counts
-    // as lit: the filtered sum of the flagged texels' weights (the same
-    // taps) goes back in (exact where those texels shadow the receiver, as
-    // they do but for a receiver nearer the light than the fighter; the
-    // clamp covers that)
-    if (no_fighters)
-        lit = min(lit + 0.25 * (texture(u_lspsm_flag, c.xy + vec2(-h, -h)).r + texture(u_lspsm_flag, c.xy + vec2(h, -h)).r +
-                                texture(u_lspsm_flag, c.xy + vec2(-h, h)).r + texture(u_lspsm_flag, c.xy + vec2(h, h)).r),
-                  1.0);
     return mix(1.0, lit, strength);
 }
 
 // A fighter at p: no self-shadow, others' shadows received.  The map is
 // looked up where the ray towards the light leaves the fighter's own box.
-// no_fighters: the screen-space mask (SSFSM) already holds the other
-// fighter's shadow, so only the scenery's counts here.
-float lspsm_fighter_visibility(vec3 p, bool no_fighters)
+// (With the screen-space mask on, the map holds no fighters: the mask has
+// the other fighter's shadow.)
+float lspsm_fighter_visibility(vec3 p)
 {
     int i = clamp(u_fighter, 0, 1);
     vec3 q = lspsm_box_exit(p, u_lspsm_dir, u_lspsm_box[2 * i], u_lspsm_box[2 * i + 1]);
-    return lspsm_visibility(q, vec3(0.0), 0.0, no_fighters);
+    return lspsm_visibility(q, vec3(0.0), 0.0);
 }
 #endif

@@ -133,7 +133,7 @@ void main()
 #endif
 #ifdef FX_LSPSM
     if (u_lspsm_on == 1)
-        key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world, u_shadows == 1));
+        key *= mix(u_lspsm_keep, 1.0, lspsm_fighter_visibility(v_world));
 #endif
     vec3 albedo = v_color.rgb;
     float alpha = 1.0;
@@ -182,8 +182,8 @@ void main()
     // the buildings are always drawn with u_shadows 0 (fx_lspsm.c,
     // run_buildings: the fighters' silhouette stops short of them, the
     // LSPSM map casts the fighters there): a constant, so their program
-    // has neither the silhouette's tap nor the fighter flag's four, which
-    // llvmpipe would run (and throw away) on every building pixel
+    // has no silhouette tap, which llvmpipe would run (and throw away) on
+    // every building pixel
     const bool ssfsm = false;
 #else
     bool ssfsm = u_shadows == 1;
@@ -193,8 +193,8 @@ void main()
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
 #endif
 #ifdef FX_LSPSM
-    if (u_lspsm_on == 1) // with the SSFSM shadows on, the fighters' come from the silhouette
-        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye), ssfsm);
+    if (u_lspsm_on == 1) // with the SSFSM shadows on, the map has no fighters: theirs come from the silhouette
+        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye));
 #endif
     float alpha = 0.0;
 #endif

@@ -1,5 +1,5 @@
 #version 330 core
-// variants: FIGHTER STAGE LENS LIGHT_VIEW LIGHT_VIEW+SILHOUETTE LIGHT_VIEW+LSPSM FIGHTER+FX_FOG LENS+FX_FOG STAGE+MATERIAL=1 STAGE+MATERIAL=2 STAGE+MATERIAL=3
+// variants: FIGHTER STAGE LENS LIGHT_VIEW LIGHT_VIEW+SILHOUETTE FIGHTER+FX_FOG LENS+FX_FOG STAGE+MATERIAL=1 STAGE+MATERIAL=2 STAGE+MATERIAL=3
 // Scene geometry for every pass that draws it: rigid skinning, one matrix
 // per bone (bone index -1: world space).  Variants by #define:
 //   FIGHTER, STAGE, LENS   the HDR scene pass (scene.frag)

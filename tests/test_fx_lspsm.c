@@ -2,7 +2,8 @@
  * C) on GL: the buildings' shadows show; culling drops casters without
  * changing the map; the auto-focus reads exactly the 20x16 pattern of the
  * depth buffer and uses it the next frame; the fighters do not shadow
- * themselves but receive each other's; light exactly parallel and
+ * themselves but receive each other's, and leave the map to their own
+ * shadows but on the buildings; light exactly parallel and
  * anti-parallel to the view stays finite and does not pop; fp16 extremes;
  * determinism.  The mathematics alone is tests/test_lspsm.c, the layout
  * tests/test_city.c.  T_DUMP=DIR writes the frames as PPM. */
@@ -84,13 +85,11 @@ static void t_buildings_cast_shadows(void)
     draw_run(r, &f, "plaza", 600, 2);
     T_ASSERT(t_pass_ran(r, "lspsm_map") && t_pass_ran(r, "buildings") && t_pass_ran(r, "lspsm_focus"));
     float *on = hdr(r);
-    float *map = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *map), *flag = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *flag);
-    T_ASSERT(map && flag && fx_lspsm_read(r, "map", map) && fx_lspsm_read(r, "flag", flag));
-    size_t scenery = 0, fighters = 0;
-    for (size_t i = 0; i < (size_t)R_LSPSM_MAP * R_LSPSM_MAP; i++) {
-        scenery += map[i] < 1 && flag[i] < 0.5f;
-        fighters += flag[i] > 0.5f;
-    }
+    float *map = malloc((size_t)R_LSPSM_MAP * R_LSPSM_MAP * sizeof *map);
+    T_ASSERT(map && fx_lspsm_read(r, "map", map));
+    size_t scenery = 0;
+    for (size_t i = 0; i < (size_t)R_LSPSM_MAP * R_LSPSM_MAP; i++)
+        scenery += map[i] < 1;
     st.lspsm = false;
     set_stage(r, &st);
     draw_run(r, &f, "plaza", 600, 2);
@@ -107,13 +106,115 @@ static void t_buildings_cast_shadows(void)
         bad += !isfinite(a);
     }
     fprintf(stderr, "    plaza@600: mean luminance %.3f with the map, %.3f without; %d of %d pixels darker by 30%%+; "
-                    "map: %zu scenery texels, %zu fighter texels\n",
-            sum_on / (W * H), sum_off / (W * H), darker, W * H, scenery, fighters);
+                    "map: %zu scenery texels\n",
+            sum_on / (W * H), sum_off / (W * H), darker, W * H, scenery);
     T_EQ(bad, 0);
     T_ASSERTF(darker > W * H / 20, "only %d pixels in a building's shadow", darker);
     T_ASSERTF(brighter < W * H / 200, "%d pixels got brighter with shadows", brighter);
-    T_ASSERT(scenery > 10000); /* the fighters' texels: t_fighters_no_self_shadow_but_each_others */
-    free(on), free(off), free(map), free(flag);
+    T_ASSERT(scenery > 10000); /* the fighters' texels: t_fighters_leave_the_map_to_their_shadows */
+    free(on), free(off), free(map);
+    r_game_destroy(r);
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
+/* Texels of map b nearer the light than a's (fighters), and farther (none
+ * should be). */
+static void map_minus(const float *a, const float *b, size_t *nearer, size_t *farther)
+{
+    *nearer = *farther = 0;
+    for (size_t i = 0; i < (size_t)R_LSPSM_MAP * R_LSPSM_MAP; i++) {
+        *nearer += b[i] < a[i] - 1e-6f;
+        *farther += b[i] > a[i] + 1e-6f;
+    }
+}
+
+/* With the fighter shadows on, the receivers' map holds the buildings
+ * alone (the silhouette casts the fighters on the ring and the mask on
+ * each other): with those shadows off it is the same map plus the
+ * fighters.  The silhouette stops short of the buildings, so with a light
+ * low enough for a fighter's shadow to reach one, the buildings get a map
+ * with the fighters drawn in: the facade darkens where the shadow falls,
+ * and nothing else changes.  With the stage's own light, or one from
+ * above, it is not drawn. */
+static void t_fighters_leave_the_map_to_their_shadows(void)
+{
+    plat *p = t_context("egl");
+    t_fb f;
+    t_fb_make(&f, W, H);
+    r_game *r = t_game_new(false);
+    r_stage st = plaza();
+    size_t n = (size_t)R_LSPSM_MAP * R_LSPSM_MAP, nearer, farther;
+    float *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    T_ASSERT(a && b);
+    fx_lspsm_stats s;
+    set_stage(r, &st);
+    draw_run(r, &f, "plaza", 600, 2);
+    T_ASSERT(fx_lspsm_stats_get(r, &s));
+    T_ASSERT(!s.fighters_in_map && !s.fighters_cast);
+    /* the stage's sun puts the fighters in the tower's shadow, behind it
+     * in the map: a light from above shows them */
+    const float up[3] = {0, 1, 0};
+    fx_lspsm_test_set(r, up, false, false);
+    set_stage(r, &st);
+    draw_run(r, &f, "plaza", 600, 2);
+    T_ASSERT(fx_lspsm_stats_get(r, &s) && fx_lspsm_read(r, "map", a));
+    T_ASSERT(!s.fighters_in_map && !s.fighters_cast);
+    st.shadows = false;
+    set_stage(r, &st);
+    draw_run(r, &f, "plaza", 600, 2);
+    T_ASSERT(fx_lspsm_stats_get(r, &s) && fx_lspsm_read(r, "map", b));
+    T_ASSERT(s.fighters_in_map && !s.fighters_cast);
+    map_minus(a, b, &nearer, &farther);
+    fprintf(stderr, "    shadows off: %zu fighter texels added to the map, %zu texels farther\n", nearer, farther);
+    T_ASSERTF(nearer > 200, "only %zu texels of fighters", nearer);
+    T_EQ(farther, 0);
+
+    /* a light 3 degrees up, round the horizon in 16 steps: where the
+     * buildings' map is drawn, it is the receivers' plus fighters, and the
+     * frame differs from the one without it only by darker pixels; at
+     * some azimuth a fighter's shadow shows on a facade */
+    st.shadows = true;
+    int cast = 0, shown = -1, most = 0;
+    for (int k = 0; k < 16; k++) {
+        float az = (float)k * 6.2831853f / 16, L[3] = {cosf(az), 0.05f, sinf(az)};
+        fx_lspsm_test_set(r, L, false, false);
+        fx_lspsm_test_no_cast(r, false);
+        set_stage(r, &st);
+        draw_run(r, &f, "plaza", 600, 2);
+        T_ASSERT(fx_lspsm_stats_get(r, &s));
+        if (!s.fighters_cast)
+            continue;
+        cast++;
+        float *with = hdr(r);
+        T_ASSERT(fx_lspsm_read(r, "map", a) && fx_lspsm_read(r, "cast", b));
+        map_minus(a, b, &nearer, &farther);
+        fx_lspsm_test_no_cast(r, true);
+        set_stage(r, &st);
+        draw_run(r, &f, "plaza", 600, 2);
+        T_ASSERT(fx_lspsm_stats_get(r, &s) && !s.fighters_cast);
+        float *without = hdr(r);
+        int darker = 0, brighter = 0;
+        for (size_t i = 0; i < (size_t)W * H; i++) {
+            float x = luma(with + 4 * i), y = luma(without + 4 * i);
+            darker += x < 0.9f * y;
+            brighter += x > y * 1.001f + 1e-4f;
+        }
+        fprintf(stderr, "    light at azimuth %2d/16: the buildings' map has %zu fighter texels (%zu farther); "
+                        "%d pixels darker for it, %d brighter\n", k, nearer, farther, darker, brighter);
+        T_EQ(farther, 0);
+        T_EQ(brighter, 0);
+        if (darker > most && nearer > 20) {
+            most = darker, shown = k;
+            dump("cast_with", with), dump("cast_without", without);
+        }
+        free(with), free(without);
+    }
+    T_ASSERTF(cast > 0, "no light round the horizon casts a fighter onto a building");
+    T_ASSERTF(shown >= 0 && most > 10, "%d lights drew the buildings' map, and no fighter's shadow showed on a facade",
+              cast);
+    fx_lspsm_test_no_cast(r, false);
+    free(a), free(b);
     r_game_destroy(r);
     t_fb_free(&f);
     plat_destroy(p);
@@ -493,7 +594,7 @@ static void t_far_shadow_edges_smooth(void)
     plat_destroy(p);
 }
 
-/* r_quality.lspsm_size sizes the map (and its flag target): 512 reads back
+/* r_quality.lspsm_size sizes the map: 512 reads back
  * as 512x512, 0 as R_LSPSM_MAP, out-of-range values clamp to 256..4096. */
 static void t_map_size_knob(void)
 {
@@ -509,7 +610,7 @@ static void t_map_size_knob(void)
         float size[4] = {0};
         T_ASSERT(fx_lspsm_read(r, "size", size));
         T_ASSERTF(size[0] == want[k] && size[1] == want[k] && size[2] == want[k] && size[3] == want[k],
-                  "lspsm_size %d: map %gx%g, flag %gx%g, want %d", ask[k], size[0], size[1], size[2], size[3], want[k]);
+                  "lspsm_size %d: map %gx%g, %gx%g, want %d", ask[k], size[0], size[1], size[2], size[3], want[k]);
         if (k == 0) { /* the map reads back as exactly 512x512 floats, scenery in it */
             size_t n = 512 * 512;
             float *map = malloc((n + 16) * sizeof *map);
@@ -535,6 +636,7 @@ static void t_map_size_knob(void)
 T_MAIN({"buildings_cast_shadows", t_buildings_cast_shadows}, {"culling_keeps_the_map", t_culling_keeps_the_map},
        {"focus_reads_the_pattern_one_frame_late", t_focus_reads_the_pattern_one_frame_late},
        {"fighters_no_self_shadow_but_each_others", t_fighters_no_self_shadow_but_each_others},
+       {"fighters_leave_the_map_to_their_shadows", t_fighters_leave_the_map_to_their_shadows},
        {"parallel_and_antiparallel_light", t_parallel_and_antiparallel_light}, {"fp16_extremes", t_fp16_extremes},
        {"deterministic", t_deterministic}, {"far_shadow_edges_smooth", t_far_shadow_edges_smooth},
        {"map_size_knob", t_map_size_knob})

@@ -10,9 +10,9 @@
  *                1024x1024 depth map is drawn from the buildings' low-poly
  *                proxies (one merged mesh; each building's range is drawn
  *                only when r_lspsm_caster_visible says it can cast into
- *                the view) and the fighters (movable: their own mesh).
- *                An R8 target beside the depth marks the texels whose
- *                nearest caster is a fighter.
+ *                the view), and the fighters (movable: their own mesh)
+ *                only where the fighter shadows do not cast them already
+ *                (below).
  *   buildings    (R_FX_SURFACE) the detailed building meshes, lit like the
  *                stage (IBL, fog, the LSPSM map).  Runs on any stage with
  *                `buildings` > 0, shadow map or not.
@@ -28,8 +28,15 @@
  * and keep u_lspsm_keep of the key light in full shadow, so they keep their
  * directional shading.  When the stage's fighter shadows run (the blurred
  * silhouette on the stage, the screen-space mask on the fighters), those
- * already cast the fighters, and every receiver ignores the
- * fighter-flagged texels; without them this map casts the fighters too.
+ * already cast the fighters on the ring, the ground and each other, so
+ * the map holds the buildings alone; without them it casts the fighters
+ * too.  The silhouette stops short of the buildings, though: on a frame
+ * where a fighter's shadow can reach a building (fighters_reach_buildings),
+ * a second map, this one with the fighters drawn in, is what the
+ * buildings look up.  (The map used to hold the fighters always, with an
+ * R8 target flagging their texels and four more taps a pixel to take them
+ * out again: on plaza, llvmpipe spent about 2 ms a frame on those taps, and
+ * they could not see a building's shadow behind a fighter.)
  *
  * The focus readback waits, in the next frame, for the previous frame's
  * 1280-byte transfer; every frame is then a function of the frames drawn
@@ -55,8 +62,11 @@ extern const r_fx_module fx_lspsm_module;
 
 struct fx_lspsm_state {
     GLuint prog_map, prog_focus;
-    GLuint map_tex, flag_tex, map_fbo; /* map x map depth (compare mode) + R8 fighter flag */
-    int map;                           /* the map's edge: r_quality.lspsm_size, 0 = R_LSPSM_MAP */
+    GLuint map_tex, map_fbo;   /* map x map depth (compare mode): every receiver's */
+    GLuint cast_tex, cast_fbo; /* the same with the fighters in it, for the buildings (made when first needed) */
+    int map;                   /* the maps' edge: r_quality.lspsm_size, 0 = R_LSPSM_MAP */
+    int unit;                  /* the map's texture unit in the scene programs (lspsm_bind) */
+    bool cast_drawn;           /* cast_tex holds this frame's map */
     GLuint focus_tex, focus_fbo;       /* 20x16 R32F */
     GLuint pbo;                        /* the samples of the frame drawn last */
     bool pending;                      /* pbo holds samples not used yet */
@@ -74,7 +84,7 @@ struct fx_lspsm_state {
     GLint proxy_first[R_CITY_MAX];
     GLsizei proxy_count[R_CITY_MAX];
     /* tests and --passes */
-    bool no_cull, uniform;
+    bool no_cull, uniform, no_cast;
     bool light_override;
     r_vec3 light;
     fx_lspsm_stats stats;
@@ -122,6 +132,79 @@ static void take_focus(struct fx_lspsm_state *ls, bool reset)
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
 }
 
+/* The fighters' boxes: each bone's origin +-0.4 m holds its far end too
+ * (lo 0, hi 0, lo 1, hi 1). */
+static void fighter_boxes(const frame *f, float box[4][3])
+{
+    for (int i = 0; i < 2; i++) {
+        for (int a = 0; a < 3; a++)
+            box[2 * i][a] = 1e9f, box[2 * i + 1][a] = -1e9f;
+        for (int k = 0; k < G_BONES; k++)
+            for (int a = 0; a < 3; a++) {
+                float c = f->bones[i][k][12 + a];
+                box[2 * i][a] = fminf(box[2 * i][a], c - 0.4f);
+                box[2 * i + 1][a] = fmaxf(box[2 * i + 1][a], c + 0.4f);
+            }
+    }
+}
+
+/* Can a fighter's shadow fall on a building?  Each fighter's box is swept
+ * away from the light until its top is below every building's base, and
+ * tested against each building's box grown by the fighter box's half size
+ * (the swept centre, a segment, against a box: the slab test).  A yes may
+ * be a near miss, never a no a hit. */
+static bool fighters_reach_buildings(const struct fx_lspsm_state *ls, const float box[4][3], r_vec3 L)
+{
+    const float d[3] = {-L.x, -L.y, -L.z}, far = 1e4f;
+    float base = 1e30f;
+    for (int j = 0; j < ls->nb; j++)
+        base = fminf(base, ls->lo[j][1]);
+    for (int i = 0; i < 2; i++) {
+        float c[3], e[3];
+        for (int a = 0; a < 3; a++)
+            c[a] = 0.5f * (box[2 * i][a] + box[2 * i + 1][a]), e[a] = 0.5f * (box[2 * i + 1][a] - box[2 * i][a]);
+        /* the top drops L.y a metre along the sweep */
+        float len = L.y > 1e-3f ? fminf((box[2 * i + 1][1] - base) / L.y, far) : far;
+        for (int j = 0; j < ls->nb; j++) {
+            float t0 = 0, t1 = len;
+            for (int a = 0; a < 3 && t0 <= t1; a++) {
+                float lo = ls->lo[j][a] - e[a], hi = ls->hi[j][a] + e[a];
+                if (fabsf(d[a]) < 1e-9f) {
+                    if (c[a] < lo || c[a] > hi)
+                        t1 = -1;
+                    continue;
+                }
+                float ta = (lo - c[a]) / d[a], tb = (hi - c[a]) / d[a];
+                t0 = fmaxf(t0, fminf(ta, tb)), t1 = fminf(t1, fmaxf(ta, tb));
+            }
+            if (t0 <= t1)
+                return true;
+        }
+    }
+    return false;
+}
+
+/* A depth map target: compare mode, bilinear = 2x2 PCF; outside it (the
+ * border) nothing casts. */
+static bool make_map(int n, GLuint *tex, GLuint *fbo)
+{
+    const float one[4] = {1, 1, 1, 1};
+    *tex = r_tex2d(GL_DEPTH_COMPONENT24, n, n, GL_DEPTH_COMPONENT, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_BORDER);
+    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, one);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.GenFramebuffers(1, fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, *fbo);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, *tex, 0);
+    GLenum none = GL_NONE;
+    gl.DrawBuffers(1, &none);
+    gl.ReadBuffer(GL_NONE);
+    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    return st == GL_FRAMEBUFFER_COMPLETE;
+}
+
 static void run_map(void *u)
 {
     r_game *r = u;
@@ -131,6 +214,7 @@ static void run_map(void *u)
     r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
                       .far = ls->focus.range > 0 ? ls->focus.range : R_LSPSM_LIMIT, .uniform = ls->uniform};
     r_lspsm_build(&d, &ls->s);
+    ls->cast_drawn = false;
     if (f->depth_only) /* a warm-up frame: the focus above is the history; the map only shades */
         return;
 
@@ -139,9 +223,8 @@ static void run_map(void *u)
     gl.Enable(GL_DEPTH_TEST);
     gl.DepthFunc(GL_LESS);
     gl.DepthMask(GL_TRUE);
-    gl.ClearColor(0, 0, 0, 0);
     gl.ClearDepth(1.0);
-    gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl.Clear(GL_DEPTH_BUFFER_BIT);
     /* the buildings' proxies are closed boxes: their faces turned from the
      * light lie behind the ones turned to it, so only those are drawn
      * (lspsm_map 5.1 -> 3.3 ms a plaza frame single-threaded).  Where the
@@ -159,7 +242,6 @@ static void run_map(void *u)
     gl.UseProgram(p);
     gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->s.light_vp.m);
     /* static scenery: each building's proxy, when it can cast into the view */
-    gl.Uniform1f(r_loc(p, "u_flag"), 0.0f);
     gl.BindVertexArray(ls->proxy_vao);
     int drawn = 0;
     for (int i = 0; i < ls->nb; i++) {
@@ -170,10 +252,29 @@ static void run_map(void *u)
                         (const void *)((size_t)ls->proxy_first[i] * sizeof(unsigned)));
         drawn++;
     }
-    /* movable casters: the fighters, both sides */
+    /* movable casters: the fighters, both sides.  With the fighter
+     * shadows on (the same test as run_scene's) they cast on the ring, the
+     * ground and the fighters already, so they go only into the buildings'
+     * map, and only when their shadow can reach one */
     gl.Disable(GL_CULL_FACE);
-    gl.Uniform1f(r_loc(p, "u_flag"), 1.0f);
-    r_draw_fighters(r, p);
+    bool ssfsm = r_ran(f, r, "mask_filter") && r_ran(f, r, "silhouette_mips");
+    float box[4][3];
+    fighter_boxes(f, box);
+    ls->stats.fighters_in_map = !ssfsm;
+    ls->stats.fighters_cast = false;
+    if (!ssfsm) {
+        r_draw_fighters(r, p);
+    } else if (ls->nb > 0 && !ls->no_cast && fighters_reach_buildings(ls, box, to_light(r)) &&
+               (ls->cast_fbo || make_map(ls->map, &ls->cast_tex, &ls->cast_fbo))) {
+        /* the buildings' map: this one's depth, then the fighters */
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, ls->map_fbo);
+        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, ls->cast_fbo);
+        gl.BlitFramebuffer(0, 0, ls->map, ls->map, 0, 0, ls->map, ls->map, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, ls->cast_fbo);
+        gl.UseProgram(p);
+        r_draw_fighters(r, p);
+        ls->cast_drawn = ls->stats.fighters_cast = true;
+    }
     gl.Disable(GL_POLYGON_OFFSET_FILL);
     gl.Disable(GL_DEPTH_CLAMP);
     ls->stats.casters_drawn = drawn;
@@ -203,9 +304,11 @@ static void run_buildings(void *u)
         gl.DepthFunc(GL_LEQUAL);
     ls->depth_laid = false;
     GLuint p = r_stage_program(r, R_MAT_BUILDING);
-    /* the fighters' blurred silhouette stops short of the buildings: this
-     * map casts them there (u_shadows 0 counts its fighter texels) */
+    /* the fighters' blurred silhouette stops short of the buildings: the
+     * map with the fighters in it casts them there, when run_map drew it */
     gl.Uniform1i(r_loc(p, "u_shadows"), 0);
+    if (ls->cast_drawn)
+        r_bind_tex(p, "u_lspsm_map", ls->unit, GL_TEXTURE_2D, ls->cast_tex);
     gl.BindVertexArray(ls->city_vao);
     gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
     gl.Disable(GL_CULL_FACE);
@@ -262,9 +365,9 @@ static const r_pass focus_passes[] = {
 
 /* ---- the receivers' side ---- */
 
-/* The scene's programs (lspsm_common.glsl): u_lspsm_* and the two maps on
- * units `unit` and `unit + 1` (u_lspsm_on = 0 whenever the map was not
- * drawn this frame).  The sky and the visors do not receive it. */
+/* The scene's programs (lspsm_common.glsl): u_lspsm_* and the map on unit
+ * `unit` (u_lspsm_on = 0 whenever the map was not drawn this frame).  The
+ * sky and the visors do not receive it. */
 static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
 {
     if (what != R_FX_BIND_SCENE)
@@ -273,10 +376,11 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
     bool on = ls && r_fx_stage(r)->lspsm && r_ran(r_fx_frame(r), r, "lspsm_map");
     gl.UseProgram(p);
     gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
-    /* the two samplers get their own units whether on or not: samplers of
-     * different types must never share a unit */
+    /* the sampler gets its unit whether on or not: samplers of different
+     * types must never share a unit */
     r_bind_tex(p, "u_lspsm_map", unit, GL_TEXTURE_2D, on ? ls->map_tex : 0);
-    r_bind_tex(p, "u_lspsm_flag", unit + 1, GL_TEXTURE_2D, on ? ls->flag_tex : 0);
+    if (ls)
+        ls->unit = unit;
     if (!on)
         return;
     const frame *f = r_fx_frame(r);
@@ -288,18 +392,8 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
     gl.Uniform1f(r_loc(p, "u_lspsm_bias"), DEPTH_BIAS);
     gl.Uniform1f(r_loc(p, "u_lspsm_texel"), 1.0f / (float)ls->map);
     gl.Uniform1f(r_loc(p, "u_lspsm_keep"), KEEP);
-    /* the fighters' boxes: each bone's origin +-0.4 m holds its far end too */
     float box[4][3];
-    for (int i = 0; i < 2; i++) {
-        for (int a = 0; a < 3; a++)
-            box[2 * i][a] = 1e9f, box[2 * i + 1][a] = -1e9f;
-        for (int k = 0; k < G_BONES; k++)
-            for (int a = 0; a < 3; a++) {
-                float c = f->bones[i][k][12 + a];
-                box[2 * i][a] = fminf(box[2 * i][a], c - 0.4f);
-                box[2 * i + 1][a] = fmaxf(box[2 * i + 1][a], c + 0.4f);
-            }
-    }
+    fighter_boxes(f, box);
     gl.Uniform3fv(r_loc(p, "u_lspsm_box"), 4, &box[0][0]);
 }
 
@@ -319,9 +413,9 @@ static void lspsm_destroy(r_game *r)
     if (!ls)
         return;
     free_city(ls);
-    GLuint tex[3] = {ls->map_tex, ls->flag_tex, ls->focus_tex}, fbo[2] = {ls->map_fbo, ls->focus_fbo};
+    GLuint tex[3] = {ls->map_tex, ls->cast_tex, ls->focus_tex}, fbo[3] = {ls->map_fbo, ls->cast_fbo, ls->focus_fbo};
     gl.DeleteTextures(3, tex);
-    gl.DeleteFramebuffers(2, fbo);
+    gl.DeleteFramebuffers(3, fbo);
     if (ls->pbo)
         gl.DeleteBuffers(1, &ls->pbo);
     gl.DeleteProgram(ls->prog_map);
@@ -337,29 +431,15 @@ static bool lspsm_create(r_game *r, rs_err *err)
         return rs_fail(err, R_ERR_NOMEM, "lspsm: out of memory");
     r_fx_set_state(r, &fx_lspsm_module, ls);
     if (!(ls->prog_map = r_program(&(r_program_desc){.vs = "scene.vert", .fs = "light_depth.frag",
-                                                     .defines = "#define LIGHT_VIEW 1\n#define LSPSM 1\n"},
+                                                     .defines = "#define LIGHT_VIEW 1\n"},
                                    err)) ||
         !(ls->prog_focus = r_program(&(r_program_desc){.vs = "cap_fullscreen.vert", .fs = "lspsm_focus.frag"}, err))) {
         lspsm_destroy(r);
         return false;
     }
-    /* the map: depth with hardware comparison, bilinear = 2x2 PCF; outside
-     * it (the border) nothing casts */
-    const float one[4] = {1, 1, 1, 1}, zero[4] = {0, 0, 0, 0};
     int q = r_fx_quality(r)->lspsm_size;
     ls->map = q <= 0 ? R_LSPSM_MAP : q < 256 ? 256 : q > 4096 ? 4096 : q;
-    ls->map_tex = r_tex2d(GL_DEPTH_COMPONENT24, ls->map, ls->map, GL_DEPTH_COMPONENT, GL_FLOAT, NULL, GL_LINEAR,
-                          GL_CLAMP_TO_BORDER);
-    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, one);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-    ls->flag_tex = r_tex2d(GL_R8, ls->map, ls->map, GL_RED, GL_UNSIGNED_BYTE, NULL, GL_LINEAR, GL_CLAMP_TO_BORDER);
-    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, zero);
-    gl.GenFramebuffers(1, &ls->map_fbo);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ls->flag_tex, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, ls->map_tex, 0);
-    GLenum st = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    GLenum st = make_map(ls->map, &ls->map_tex, &ls->map_fbo) ? GL_FRAMEBUFFER_COMPLETE : GL_FRAMEBUFFER_UNSUPPORTED;
     ls->focus_tex = r_tex2d(GL_R32F, R_LSPSM_FOCUS_W, R_LSPSM_FOCUS_H, GL_RED, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
     ls->focus_fbo = r_fbo_for(ls->focus_tex, 0, 0);
     GLenum st2 = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
@@ -455,7 +535,7 @@ const r_fx_module fx_lspsm_module = {
     .npass = {(int)(sizeof map_passes / sizeof map_passes[0]), (int)(sizeof surface_passes / sizeof surface_passes[0]),
               (int)(sizeof focus_passes / sizeof focus_passes[0])},
     .res = {{RES_LSPSM, "lspsm map", false}}, .scene_reads = RES_LSPSM,
-    .units = 2, .bind = lspsm_bind, .scene_define = lspsm_define, .scene_depth = lspsm_scene_depth,
+    .units = 1, .bind = lspsm_bind, .scene_define = lspsm_define, .scene_depth = lspsm_scene_depth,
     .warmup = lspsm_warmup, .advance = lspsm_advance, .needs_frame = lspsm_needs_frame,
 };
 
@@ -482,21 +562,29 @@ void fx_lspsm_test_set(r_game *r, const float *light, bool no_cull, bool uniform
     LSPSM(r)->uniform = uniform;
 }
 
+void fx_lspsm_test_no_cast(r_game *r, bool off)
+{
+    if (LSPSM(r))
+        LSPSM(r)->no_cast = off;
+}
+
 bool fx_lspsm_read(r_game *r, const char *what, float *out)
 {
     struct fx_lspsm_state *ls = LSPSM(r);
     if (!ls)
         return false;
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    if (!strcmp(what, "map") || !strcmp(what, "flag")) {
-        bool map = what[0] == 'm';
-        gl.BindTexture(GL_TEXTURE_2D, map ? ls->map_tex : ls->flag_tex);
-        gl.GetTexImage(GL_TEXTURE_2D, 0, map ? GL_DEPTH_COMPONENT : GL_RED, GL_FLOAT, out);
+    if (!strcmp(what, "map") || !strcmp(what, "cast")) {
+        GLuint t = what[0] == 'm' ? ls->map_tex : ls->cast_tex;
+        if (!t)
+            return false;
+        gl.BindTexture(GL_TEXTURE_2D, t);
+        gl.GetTexImage(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT, GL_FLOAT, out);
         gl.BindTexture(GL_TEXTURE_2D, 0);
         return true;
     }
     if (!strcmp(what, "size")) {
-        GLuint tex[2] = {ls->map_tex, ls->flag_tex};
+        GLuint tex[2] = {ls->map_tex, ls->cast_tex ? ls->cast_tex : ls->map_tex};
         for (int i = 0; i < 2; i++) {
             GLint w = 0, h = 0;
             gl.BindTexture(GL_TEXTURE_2D, tex[i]);

@@ -15,15 +15,22 @@ typedef struct fx_lspsm_stats {
     float warp, gamma;            /* r_lspsm's warp strength and view-light angle */
     float focus_farthest;         /* the farthest sample the focus found, m */
     int focus_used;               /* samples that counted */
+    bool fighters_in_map;         /* the fighters are in the receivers' map (their shadows off) */
+    bool fighters_cast;           /* the buildings' map with the fighters was drawn (a shadow may reach one) */
 } fx_lspsm_stats;
 bool fx_lspsm_stats_get(struct r_game *r, fx_lspsm_stats *out);
 /* Tests and bench: force the light direction (NULL: the stage's key),
  * switch caster culling off, or the warp (plain uniform shadow mapping). */
 void fx_lspsm_test_set(struct r_game *r, const float *light, bool no_cull, bool uniform);
+/* Tests: never draw the buildings' map with the fighters (the frame as it
+ * would be without it). */
+void fx_lspsm_test_no_cast(struct r_game *r, bool off);
 /* Tests: "map" (N x N depth floats, N = r_quality.lspsm_size clamped to
- * 256..4096, 0: R_LSPSM_MAP 1024), "flag" (N x N), "size" (4 floats: the
- * map's and the flag's width and height as GL has them), "focus" (20x16
- * depth samples of the frame drawn last), "shadow" (16 floats). */
+ * 256..4096, 0: R_LSPSM_MAP 1024), "cast" (N x N: the buildings' map with
+ * the fighters, false until one was drawn), "size" (4 floats: the map's
+ * and the buildings' map's width and height as GL has them; the map's
+ * twice while the second was never made), "focus" (20x16 depth samples
+ * of the frame drawn last), "shadow" (16 floats). */
 bool fx_lspsm_read(struct r_game *r, const char *what, float *out);
 
 #endif
