@@ -978,6 +978,65 @@ static void t_fighter_mesh_by_rows(void)
     plat_destroy(p);
 }
 
+/* Bloom's blurs and glow in C (r_bloom.c, the default on a software
+ * rasteriser) give the GL chain's glow: within its RGBE levels' 8-bit
+ * mantissas (each level 0.4 % of its largest channel), with the flare in
+ * it, at 640x360 (the levels halve, the flare's image is half the glow's
+ * size) and at 641x360 (neither: the bilinear paths); the frames differ by
+ * two levels at most. */
+static void t_bloom_cpu_matches_gl(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    t_state_at("dojo", 1200, &prev, &cur);
+    const int sizes[2][2] = {{640, 360}, {641, 360}};
+    for (int k = 0; k < 2; k++) {
+        int w = sizes[k][0], h = sizes[k][1];
+        t_fb f;
+        t_fb_make(&f, w, h);
+        r_game *r = t_game_opts(NULL);
+        uint8_t *px[2] = {malloc((size_t)w * h * 4), malloc((size_t)w * h * 4)};
+        float *glow[2] = {NULL, NULL};
+        int gw = 0, gh = 0;
+        T_ASSERT(px[0] && px[1]);
+        T_ASSERTF(r_game_set_bloom_cpu(r, true), "a software rasteriser's default is the GL chain");
+        for (int cpu = 1; cpu >= 0; cpu--) {
+            r_game_set_bloom_cpu(r, cpu == 1);
+            t_draw_read(r, &f, &prev, &cur, w, h, px[cpu], true);
+            T_ASSERT(t_pass_ran(r, "bloom_blur") && t_pass_ran(r, "flare"));
+            T_ASSERT(r_game_read_buffer(r, "bloom", NULL, &gw, &gh));
+            glow[cpu] = malloc((size_t)gw * gh * 4 * sizeof(float));
+            T_ASSERT(glow[cpu] && r_game_read_buffer(r, "bloom", glow[cpu], NULL, NULL));
+        }
+        double worst = 0, sum = 0, top = 0;
+        for (int i = 0; i < gw * gh; i++) {
+            const float *a = glow[1] + 4 * i, *b = glow[0] + 4 * i;
+            float m = fmaxf(fmaxf(b[0], b[1]), b[2]);
+            top = fmax(top, m);
+            for (int c = 0; c < 3; c++) {
+                double d = fabs((double)a[c] - b[c]) / (m + 1e-3);
+                worst = fmax(worst, d), sum += d;
+            }
+        }
+        int bytes = 0, most = 0;
+        for (int i = 0; i < w * h * 4; i++) {
+            int d = abs((int)px[0][i] - px[1][i]);
+            bytes += d != 0, most = d > most ? d : most;
+        }
+        fprintf(stderr, "    %dx%d (glow %dx%d, brightest %.2f): C against GL %.2e mean, %.2e largest (of the texel's "
+                        "largest channel); frames: %d bytes differ, by %d at most\n",
+                w, h, gw, gh, top, sum / (3.0 * gw * gh), worst, bytes, most);
+        T_ASSERTF(top > 0.05, "no glow to compare (%.3f)", top);
+        T_ASSERTF(worst < 0.02 && sum / (3.0 * gw * gh) < 0.004, "the C glow is %.2e (mean %.2e) from the GL's", worst,
+                  sum / (3.0 * gw * gh));
+        T_ASSERTF(most <= 2, "the frames differ by %d levels", most);
+        free(px[0]), free(px[1]), free(glow[0]), free(glow[1]);
+        r_game_destroy(r);
+        t_fb_free(&f);
+    }
+    plat_destroy(p);
+}
+
 T_MAIN({"error_ids", t_error_ids}, {"fighter_mesh_by_rows", t_fighter_mesh_by_rows}, {"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"resolution_independent", t_resolution_independent},
        {"fighters_where_the_camera_says", t_fighters_where_the_camera_says},
@@ -990,4 +1049,4 @@ T_MAIN({"error_ids", t_error_ids}, {"fighter_mesh_by_rows", t_fighter_mesh_by_ro
        {"shadow_follows_the_key_light", t_shadow_follows_the_key_light}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
        {"packed_float_hdr", t_packed_float_hdr}, {"lens_stays_on_the_head", t_lens_stays_on_the_head},
        {"fighters_read_on_every_stage", t_fighters_read_on_every_stage},
-       {"texel_blur_matches_pairs", t_texel_blur_matches_pairs})
+       {"texel_blur_matches_pairs", t_texel_blur_matches_pairs}, {"bloom_cpu_matches_gl", t_bloom_cpu_matches_gl})

@@ -132,10 +132,10 @@ static void free_targets(r_game *r)
 {
     GLuint tex[] = {r->hdr_tex, r->depth_tex, r->mask_tex[0], r->mask_tex[1], r->b2_tex, r->b4_tex[0],
                     r->b4_tex[1], r->b8_tex[0], r->b8_tex[1], r->sunvis_tex, r->fl_tex, r->ldr_tex, r->luma_tex,
-                    r->sc_tex, r->glow_tex};
+                    r->sc_tex, r->glow_tex, r->bc_tex};
     GLuint fbo[] = {r->hdr_fbo, r->depth_fbo, r->mask_fbo[0], r->mask_fbo[1], r->b2_fbo, r->b4_fbo[0],
                     r->b4_fbo[1], r->b8_fbo[0], r->b8_fbo[1], r->sunvis_fbo, r->fl_fbo, r->ldr_fbo, r->sc_fbo,
-                    r->glow_fbo};
+                    r->glow_fbo, r->bc_fbo};
     for (size_t i = 0; i < sizeof tex / sizeof tex[0]; i++)
         if (tex[i])
             gl.DeleteTextures(1, &tex[i]);
@@ -148,6 +148,7 @@ static void free_targets(r_game *r)
     r->hdr_tex = r->depth_tex = r->b2_tex = r->sunvis_tex = r->fl_tex = 0;
     r->hdr_fbo = r->depth_fbo = r->b2_fbo = r->sunvis_fbo = r->fl_fbo = 0;
     r->ldr_tex = r->ldr_fbo = r->luma_tex = r->sc_tex = r->sc_fbo = r->glow_tex = r->glow_fbo = 0;
+    r->bc_tex = r->bc_fbo = 0;
     memset(r->mask_tex, 0, sizeof r->mask_tex), memset(r->mask_fbo, 0, sizeof r->mask_fbo);
     memset(r->b4_tex, 0, sizeof r->b4_tex), memset(r->b4_fbo, 0, sizeof r->b4_fbo);
     memset(r->b8_tex, 0, sizeof r->b8_tex), memset(r->b8_fbo, 0, sizeof r->b8_fbo);
@@ -185,8 +186,13 @@ static bool make_targets(r_game *r, int w, int h, int ow, int oh, rs_err *err)
                                    GL_CLAMP_TO_EDGE);
         r->bx_fbo[k - 2] = r_fbo_for(r->bx_tex[k - 2], 0, 0);
     }
-    r->glow_tex = r_tex2d(GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
+    /* RGBA32F where the CPU makes it: its upload is then a copy (the tone
+     * map's tap of it costs llvmpipe the same) */
+    r->glow_tex = r_tex2d(r->bloom_cpu ? GL_RGBA32F : GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR,
+                          GL_CLAMP_TO_EDGE);
     r->glow_fbo = r_fbo_for(r->glow_tex, 0, 0);
+    r->bc_tex = r_tex2d(GL_RGBA32F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
+    r->bc_fbo = r_fbo_for(r->bc_tex, 0, 0);
     r->b2_tex = r_tex2d(GL_RGBA16F, r_half(w, 1), r_half(h, 1), GL_RGBA, GL_FLOAT, NULL, GL_LINEAR, GL_CLAMP_TO_EDGE);
     r->b2_fbo = r_fbo_for(r->b2_tex, 0, 0);
     r->sunvis_tex = r_tex2d(GL_R16F, 1, 1, GL_RED, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
@@ -469,6 +475,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     r->sil_size = r->opts.q.sil_size > 0 ? r->opts.q.sil_size : SIL_SIZE;
     r->stage_game = -2;
     r->ring_stage = -1;
+    r->bloom_cpu = rgl_is_software();
     r->fighter = &r->fighter_lod[R_FIGHTER_FINE]; /* until a frame chooses (select_fighter_mesh) */
     r->lut_size = r->opts.lut_size > 0 ? r->opts.lut_size : R_TONE_LUT_DEFAULT;
     r->lut_size = r->lut_size < R_TONE_LUT_MIN ? R_TONE_LUT_MIN : r->lut_size > R_TONE_LUT_MAX ? R_TONE_LUT_MAX : r->lut_size;
@@ -600,6 +607,7 @@ void r_game_destroy(r_game *r)
             r_fx_modules[i]->destroy(r);
     free_look(r);
     free_targets(r);
+    free(r->bloom_buf);
     r_graph_release(&r->graph);
     for (int lod = 0; lod < R_FIGHTER_LODS; lod++)
         r_free_mesh(&r->fighter_lod[lod].vao, &r->fighter_lod[lod].vbo, &r->fighter_lod[lod].ibo);
@@ -782,6 +790,13 @@ void r_game_report(r_game *r, FILE *out)
             scene, (unsigned long long)r->graph.frame, r->graph.gpu_timer ? "GL_TIMESTAMP queries" : "not available, cpu only",
             r->graph.serial ? "; software renderer: glFinish after each pass, cpu ms = wall time" : "");
     r_graph_report(&r->graph, out);
+}
+
+bool r_game_set_bloom_cpu(r_game *r, bool cpu)
+{
+    bool was = r->bloom_cpu;
+    r->bloom_cpu = cpu;
+    return was;
 }
 
 bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h)

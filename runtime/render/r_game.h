@@ -141,6 +141,10 @@ r_graph *r_game_graph(r_game *r);
  * levels "silhouette1".."silhouette4"): tests.  out NULL: size only. */
 bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h);
 
+/* Tests: bloom's blurs and glow in C (the default on a software
+ * rasteriser: r_bloom.h) or on the GL; returns the setting before. */
+bool r_game_set_bloom_cpu(r_game *r, bool cpu);
+
 /* The game stage whose ring size the last frame drew (the match's, also
  * under a --stage-file look for another stage); -1 before the first. */
 int r_game_ring_stage(const r_game *r);

@@ -96,6 +96,12 @@ struct r_game {
     /* bloom: b2 and bx RGBA16F, the levels b4 and b8 RGBE in RGBA8 (rgbe_common.glsl), the glow RGBA16F */
     GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2], glow_tex, glow_fbo;
     GLuint bx_tex[BLOOM_XSTEPS], bx_fbo[BLOOM_XSTEPS]; /* halvings between b2 and b4 (renders over 720 rows) */
+    /* on a software rasteriser (bloom_cpu) the bright pass's level is
+     * RGBA32F (bc), read back, and the blurs and the glow are C (r_bloom.c) */
+    bool bloom_cpu;
+    GLuint bc_tex, bc_fbo;
+    float *bloom_buf; /* the level, the glow, the flare and r_bloom_glow's scratch */
+    size_t bloom_buf_n;
     int bloom_steps, b4_w, b8_w; /* hdr -> b4 in bloom_steps steps; b4 BLOOM_ROWS rows, b8 half */
     int mask_w, mask_h;          /* the shadow mask: the render size, or half (q.mask_half) */
     GLuint fl_tex, fl_fbo; /* the flare image, quarter size */

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "r_bloom.h"
 #include "r_local.h"
 #include "r_tone.h"
 
@@ -40,10 +41,11 @@ void r_bloom_plan(int w, int h, int *steps, int *w4)
     *w4 = v > 0 ? (int)v : 1;
 }
 
-/* step k's target (1 <= k < bloom_steps): b2, then the extra halvings */
+/* step k's target (1 <= k < bloom_steps): b2, then the extra halvings;
+ * the last, the first level: b4, or bc for the CPU's blurs */
 static GLuint bloom_step_fbo(r_game *r, int k)
 {
-    return k == r->bloom_steps ? r->b4_fbo[0] : k == 1 ? r->b2_fbo : r->bx_fbo[k - 2];
+    return k == r->bloom_steps ? (r->bloom_cpu ? r->bc_fbo : r->b4_fbo[0]) : k == 1 ? r->b2_fbo : r->bx_fbo[k - 2];
 }
 
 static GLuint bloom_step_tex(r_game *r, int k)
@@ -57,10 +59,11 @@ static void bloom_step_size(r_game *r, int k, int *w, int *h)
     *h = k == r->bloom_steps ? BLOOM_ROWS : r_half(r->f.h, k);
 }
 
-/* the step into b4, the first of the levels, encodes (P_DOWN_RGBE); b2 and the halvings are RGBA16F */
+/* the step into b4, the first of the levels, encodes (P_DOWN_RGBE); b2,
+ * the halvings and bc are floats */
 static GLuint bloom_step_prog(r_game *r, int k)
 {
-    return r->prog[k == r->bloom_steps ? P_DOWN_RGBE : P_DOWN];
+    return r->prog[k == r->bloom_steps && !r->bloom_cpu ? P_DOWN_RGBE : P_DOWN];
 }
 
 static void run_bloom_bright(void *u)
@@ -86,6 +89,43 @@ static void run_bloom_bright(void *u)
  * on llvmpipe a 9-tap blur of them costs a third of the 5 bilinear taps of
  * RGBA16F it replaced (0.69 against 1.9-2.0 ms at 320x180, one thread);
  * the glow, which the tone map filters, stays RGBA16F. */
+/* The same levels and glow in C (r_bloom.c), on a software rasteriser:
+ * the first level is read back as floats (and the flare's image when it
+ * ran), and the glow goes up as the one texture the tone map taps.  On
+ * llvmpipe the GL's five passes over the levels cost 3.4 ms a 640x360
+ * frame on one thread; reading back, the C and the upload about 0.6. */
+static void bloom_blur_cpu(r_game *r, bool level2, bool flare)
+{
+    frame *f = &r->f;
+    r_bloom_cpu b = {.w4 = r->b4_w, .h4 = BLOOM_ROWS, .w8 = r->b8_w, .h8 = BLOOM_ROWS / 2, .level2 = level2,
+                     .bloom = r->stage.bloom, .fw = r_half(f->w, 2), .fh = r_half(f->h, 2)};
+    r_blur_kernel(1, b.kw);
+    size_t n4 = 4 * (size_t)b.w4 * (size_t)b.h4, nf = flare ? 4 * (size_t)b.fw * (size_t)b.fh : 0;
+    size_t need = 2 * n4 + nf + r_bloom_scratch_floats(&b);
+    if (need > r->bloom_buf_n) {
+        float *p = realloc(r->bloom_buf, need * sizeof *p);
+        if (!p)
+            return; /* the glow keeps the last frame's */
+        r->bloom_buf = p, r->bloom_buf_n = need;
+    }
+    float *level = r->bloom_buf, *glow = level + n4, *fl = glow + n4, *scratch = fl + nf;
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r->bc_fbo);
+    gl.ReadPixels(0, 0, b.w4, b.h4, GL_RGBA, GL_FLOAT, level);
+    if (flare) {
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r->fl_fbo);
+        gl.ReadPixels(0, 0, b.fw, b.fh, GL_RGBA, GL_FLOAT, fl);
+        b.flare = fl;
+    }
+    r_bloom_glow(&b, level, scratch, glow);
+    gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.BindTexture(GL_TEXTURE_2D, r->glow_tex);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, b.w4, b.h4, GL_RGBA, GL_FLOAT, glow);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+}
+
 static void run_bloom_blur(void *u)
 {
     r_game *r = u;
@@ -94,6 +134,10 @@ static void run_bloom_blur(void *u)
     for (int k = 2; k <= r->bloom_steps; k++) {
         bloom_step_size(r, k, &w, &h);
         r_down_with(r, bloom_step_prog(r, k), bloom_step_fbo(r, k), bloom_step_tex(r, k - 1), 0, w, h, -1, 1);
+    }
+    if (r->bloom_cpu) {
+        bloom_blur_cpu(r, r->opts.q.bloom_levels != 1, r_ran(f, r, "flare"));
+        return;
     }
     int w4 = r->b4_w, h4 = BLOOM_ROWS, w8 = r->b8_w, h8 = BLOOM_ROWS / 2;
     GLuint blur = r->prog[P_BLUR_RGBE];
