@@ -402,8 +402,10 @@ static void t_sunless_stage_skips_its_passes(void)
     t_state_at("dojo", 1200, &prev, &cur);
     t_fb f;
     t_fb_make(&f, W, H);
-    /* dojo: the sun is on screen, everything runs */
+    /* dojo: the sun is on screen, everything runs (each pass with its GL
+     * draws: a software rasteriser's C paths leave some out) */
     r_game *r = t_game_opts(NULL);
+    r_game_set_cpu_paths(r, false);
     int d_all, b_all, d_less, b_less;
     /* the second frame: the first also creates the screen targets */
     counted_frame(r, &f, &prev, &cur, &d_all, &b_all);
@@ -415,6 +417,7 @@ static void t_sunless_stage_skips_its_passes(void)
     r_game_destroy(r);
     /* sunless: no sun, no bloom, no shadows (stages/sunless.stage) */
     r = t_game_opts(&(r_game_opts){.stage_file = RS_SOURCE_DIR "/stages/sunless.stage"});
+    r_game_set_cpu_paths(r, false);
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     counted_frame(r, &f, &prev, &cur, &d_less, &b_less);
     const char *skipped[] = {"shadow_map", "silhouette", "silhouette_mips", "z_prepass", "shadow_mask", "mask_filter",
@@ -999,9 +1002,9 @@ static void t_bloom_cpu_matches_gl(void)
         float *glow[2] = {NULL, NULL};
         int gw = 0, gh = 0;
         T_ASSERT(px[0] && px[1]);
-        T_ASSERTF(r_game_set_bloom_cpu(r, true), "a software rasteriser's default is the GL chain");
+        T_ASSERTF(r_game_set_cpu_paths(r, true), "a software rasteriser's default is the GL passes");
         for (int cpu = 1; cpu >= 0; cpu--) {
-            r_game_set_bloom_cpu(r, cpu == 1);
+            r_game_set_cpu_paths(r, cpu == 1);
             t_draw_read(r, &f, &prev, &cur, w, h, px[cpu], true);
             T_ASSERT(t_pass_ran(r, "bloom_blur") && t_pass_ran(r, "flare"));
             T_ASSERT(r_game_read_buffer(r, "bloom", NULL, &gw, &gh));
@@ -1037,6 +1040,58 @@ static void t_bloom_cpu_matches_gl(void)
     plat_destroy(p);
 }
 
+/* The silhouette's blurred levels made in C (r_shadow.c, the default on
+ * a software rasteriser) are the GL passes' levels, each texel within a
+ * step of its R8 byte (the rounding of the three bytes each level is
+ * made through), at the standard 512 and at 256, and without the GL's
+ * twelve draws (three a level). */
+static void t_silhouette_cpu_matches_gl(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    t_state_at("dojo", 1200, &prev, &cur);
+    t_fb f;
+    t_fb_make(&f, W, H);
+    const int sizes[2] = {512, 256};
+    for (int s = 0; s < 2; s++) {
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.sil_size = sizes[s]}});
+        float *lv[2][SIL_LEVELS] = {{NULL}};
+        int n[SIL_LEVELS], draws[2], binds;
+        T_ASSERTF(r_game_set_cpu_paths(r, true), "a software rasteriser's default is the GL passes");
+        for (int cpu = 1; cpu >= 0; cpu--) {
+            r_game_set_cpu_paths(r, cpu == 1);
+            counted_frame(r, &f, &prev, &cur, &draws[cpu], &binds);
+            T_ASSERT(t_pass_ran(r, "silhouette_mips"));
+            for (int k = 1; k < SIL_LEVELS; k++) {
+                char name[16];
+                snprintf(name, sizeof name, "silhouette%d", k);
+                T_ASSERT(r_game_read_buffer(r, name, NULL, &n[k], NULL));
+                lv[cpu][k] = malloc((size_t)n[k] * n[k] * 4 * sizeof(float));
+                T_ASSERT(lv[cpu][k] && r_game_read_buffer(r, name, lv[cpu][k], NULL, NULL));
+            }
+        }
+        for (int k = 1; k < SIL_LEVELS; k++) {
+            int differ = 0, lit = 0;
+            float most = 0;
+            for (int i = 0; i < n[k] * n[k]; i++) {
+                float a = lv[1][k][4 * i], b = lv[0][k][4 * i], d = fabsf(a - b);
+                differ += d > 0, lit += b > 0, most = fmaxf(most, d);
+            }
+            fprintf(stderr, "    %d, level %d (%dx%d): %d texels non-zero, %d differ, by %.0f/255 at most\n", sizes[s], k,
+                    n[k], n[k], lit, differ, most * 255);
+            T_ASSERTF(lit > 20, "level %d is empty", k);
+            T_ASSERTF(draws[1] + 12 <= draws[0], "the C levels still draw: %d draws a frame, %d with the GL's", draws[1],
+                      draws[0]);
+            T_ASSERTF(most <= 1.5f / 255, "level %d: C and GL %g apart", k, most);
+            T_ASSERTF(differ <= lit / 10, "level %d: %d of %d texels differ", k, differ, lit);
+            free(lv[0][k]), free(lv[1][k]);
+        }
+        r_game_destroy(r);
+    }
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 T_MAIN({"error_ids", t_error_ids}, {"fighter_mesh_by_rows", t_fighter_mesh_by_rows}, {"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"resolution_independent", t_resolution_independent},
        {"fighters_where_the_camera_says", t_fighters_where_the_camera_says},
@@ -1049,4 +1104,5 @@ T_MAIN({"error_ids", t_error_ids}, {"fighter_mesh_by_rows", t_fighter_mesh_by_ro
        {"shadow_follows_the_key_light", t_shadow_follows_the_key_light}, {"stress_no_nan_or_inf", t_stress_no_nan_or_inf},
        {"packed_float_hdr", t_packed_float_hdr}, {"lens_stays_on_the_head", t_lens_stays_on_the_head},
        {"fighters_read_on_every_stage", t_fighters_read_on_every_stage},
-       {"texel_blur_matches_pairs", t_texel_blur_matches_pairs}, {"bloom_cpu_matches_gl", t_bloom_cpu_matches_gl})
+       {"texel_blur_matches_pairs", t_texel_blur_matches_pairs}, {"bloom_cpu_matches_gl", t_bloom_cpu_matches_gl},
+       {"silhouette_cpu_matches_gl", t_silhouette_cpu_matches_gl})

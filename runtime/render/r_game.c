@@ -188,7 +188,7 @@ static bool make_targets(r_game *r, int w, int h, int ow, int oh, rs_err *err)
     }
     /* RGBA32F where the CPU makes it: its upload is then a copy (the tone
      * map's tap of it costs llvmpipe the same) */
-    r->glow_tex = r_tex2d(r->bloom_cpu ? GL_RGBA32F : GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR,
+    r->glow_tex = r_tex2d(r->cpu_paths ? GL_RGBA32F : GL_RGBA16F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_LINEAR,
                           GL_CLAMP_TO_EDGE);
     r->glow_fbo = r_fbo_for(r->glow_tex, 0, 0);
     r->bc_tex = r_tex2d(GL_RGBA32F, r->b4_w, BLOOM_ROWS, GL_RGBA, GL_FLOAT, NULL, GL_NEAREST, GL_CLAMP_TO_EDGE);
@@ -475,7 +475,7 @@ r_game *r_game_create_opts(const r_game_opts *o, rs_err *err)
     r->sil_size = r->opts.q.sil_size > 0 ? r->opts.q.sil_size : SIL_SIZE;
     r->stage_game = -2;
     r->ring_stage = -1;
-    r->bloom_cpu = rgl_is_software();
+    r->cpu_paths = rgl_is_software();
     r->fighter = &r->fighter_lod[R_FIGHTER_FINE]; /* until a frame chooses (select_fighter_mesh) */
     r->lut_size = r->opts.lut_size > 0 ? r->opts.lut_size : R_TONE_LUT_DEFAULT;
     r->lut_size = r->lut_size < R_TONE_LUT_MIN ? R_TONE_LUT_MIN : r->lut_size > R_TONE_LUT_MAX ? R_TONE_LUT_MAX : r->lut_size;
@@ -608,6 +608,7 @@ void r_game_destroy(r_game *r)
     free_look(r);
     free_targets(r);
     free(r->bloom_buf);
+    free(r->sil_buf);
     r_graph_release(&r->graph);
     for (int lod = 0; lod < R_FIGHTER_LODS; lod++)
         r_free_mesh(&r->fighter_lod[lod].vao, &r->fighter_lod[lod].vbo, &r->fighter_lod[lod].ibo);
@@ -792,10 +793,10 @@ void r_game_report(r_game *r, FILE *out)
     r_graph_report(&r->graph, out);
 }
 
-bool r_game_set_bloom_cpu(r_game *r, bool cpu)
+bool r_game_set_cpu_paths(r_game *r, bool cpu)
 {
-    bool was = r->bloom_cpu;
-    r->bloom_cpu = cpu;
+    bool was = r->cpu_paths;
+    r->cpu_paths = cpu;
     return was;
 }
 

@@ -141,9 +141,10 @@ r_graph *r_game_graph(r_game *r);
  * levels "silhouette1".."silhouette4"): tests.  out NULL: size only. */
 bool r_game_read_buffer(r_game *r, const char *name, float *out, int *w, int *h);
 
-/* Tests: bloom's blurs and glow in C (the default on a software
- * rasteriser: r_bloom.h) or on the GL; returns the setting before. */
-bool r_game_set_bloom_cpu(r_game *r, bool cpu);
+/* Tests: the core passes' C paths (the default on a software rasteriser:
+ * bloom's blurs and glow, r_bloom.h; the silhouette's blurred levels) or
+ * their GL passes; returns the setting before. */
+bool r_game_set_cpu_paths(r_game *r, bool cpu);
 
 /* The game stage whose ring size the last frame drew (the match's, also
  * under a --stage-file look for another stage); -1 before the first. */

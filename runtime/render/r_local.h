@@ -87,6 +87,12 @@ struct r_game {
     GLuint shadow_tex, shadow_fbo;
     GLuint shadow_sil_fbo; /* the shadow map and silhouette level 0 together, when their sides agree (else 0) */
     GLuint sil_tex, sil_tmp, sil_fbo[SIL_LEVELS], sil_tmp_fbo[SIL_LEVELS];
+    /* C instead of GL passes where a CPU does the work better: on a
+     * software rasteriser (rgl_is_software), bloom's blurs (r_post.c) and
+     * the silhouette's blurred levels (r_shadow.c) */
+    bool cpu_paths;
+    uint8_t *sil_buf; /* the levels as bytes, and the C blurs' floats */
+    size_t sil_buf_n;
     /* screen targets */
     int tw, th;   /* the scene's targets' size */
     int tow, toh; /* the output's, for the AA pass's targets */
@@ -96,9 +102,8 @@ struct r_game {
     /* bloom: b2 and bx RGBA16F, the levels b4 and b8 RGBE in RGBA8 (rgbe_common.glsl), the glow RGBA16F */
     GLuint b2_tex, b2_fbo, b4_tex[2], b4_fbo[2], b8_tex[2], b8_fbo[2], glow_tex, glow_fbo;
     GLuint bx_tex[BLOOM_XSTEPS], bx_fbo[BLOOM_XSTEPS]; /* halvings between b2 and b4 (renders over 720 rows) */
-    /* on a software rasteriser (bloom_cpu) the bright pass's level is
+    /* on a software rasteriser (cpu_paths) the bright pass's level is
      * RGBA32F (bc), read back, and the blurs and the glow are C (r_bloom.c) */
-    bool bloom_cpu;
     GLuint bc_tex, bc_fbo;
     float *bloom_buf; /* the level, the glow, the flare and r_bloom_glow's scratch */
     size_t bloom_buf_n;

@@ -45,7 +45,7 @@ void r_bloom_plan(int w, int h, int *steps, int *w4)
  * the last, the first level: b4, or bc for the CPU's blurs */
 static GLuint bloom_step_fbo(r_game *r, int k)
 {
-    return k == r->bloom_steps ? (r->bloom_cpu ? r->bc_fbo : r->b4_fbo[0]) : k == 1 ? r->b2_fbo : r->bx_fbo[k - 2];
+    return k == r->bloom_steps ? (r->cpu_paths ? r->bc_fbo : r->b4_fbo[0]) : k == 1 ? r->b2_fbo : r->bx_fbo[k - 2];
 }
 
 static GLuint bloom_step_tex(r_game *r, int k)
@@ -63,7 +63,7 @@ static void bloom_step_size(r_game *r, int k, int *w, int *h)
  * the halvings and bc are floats */
 static GLuint bloom_step_prog(r_game *r, int k)
 {
-    return r->prog[k == r->bloom_steps && !r->bloom_cpu ? P_DOWN_RGBE : P_DOWN];
+    return r->prog[k == r->bloom_steps && !r->cpu_paths ? P_DOWN_RGBE : P_DOWN];
 }
 
 static void run_bloom_bright(void *u)
@@ -109,13 +109,15 @@ static void bloom_blur_cpu(r_game *r, bool level2, bool flare)
         r->bloom_buf = p, r->bloom_buf_n = need;
     }
     float *level = r->bloom_buf, *glow = level + n4, *fl = glow + n4, *scratch = fl + nf;
+    /* from the textures, not their framebuffers (r_shadow.c's
+     * sil_mips_cpu says why) */
     gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r->bc_fbo);
-    gl.ReadPixels(0, 0, b.w4, b.h4, GL_RGBA, GL_FLOAT, level);
+    gl.BindTexture(GL_TEXTURE_2D, r->bc_tex);
+    gl.GetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, level);
     if (flare) {
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r->fl_fbo);
-        gl.ReadPixels(0, 0, b.fw, b.fh, GL_RGBA, GL_FLOAT, fl);
+        gl.BindTexture(GL_TEXTURE_2D, r->fl_tex);
+        gl.GetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, fl);
         b.flare = fl;
     }
     r_bloom_glow(&b, level, scratch, glow);
@@ -135,7 +137,7 @@ static void run_bloom_blur(void *u)
         bloom_step_size(r, k, &w, &h);
         r_down_with(r, bloom_step_prog(r, k), bloom_step_fbo(r, k), bloom_step_tex(r, k - 1), 0, w, h, -1, 1);
     }
-    if (r->bloom_cpu) {
+    if (r->cpu_paths) {
         bloom_blur_cpu(r, r->opts.q.bloom_levels != 1, r_ran(f, r, "flare"));
         return;
     }

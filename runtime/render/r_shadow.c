@@ -134,22 +134,117 @@ static void clear_then_scissor(GLuint fbo, const int b[4])
     gl.Scissor(b[0], b[1], b[2] - b[0], b[3] - b[1]);
 }
 
+/* Level k's box from level k-1's: where it can be non-zero.  The
+ * downsample reads source texels 2i-1..2i+2, each blur reaches 4 texels
+ * (downsample.frag, blur.frag); a texel more for rounding. */
+static void sil_level_box(int b[4], int n)
+{
+    for (int a = 0; a < 2; a++) {
+        b[a] = b[a] / 2 - 2 - 4 - 1, b[a + 2] = (b[a + 2] + 1) / 2 + 1 + 4 + 1;
+        b[a] = b[a] < 0 ? 0 : b[a], b[a + 2] = b[a + 2] > n ? n : b[a + 2];
+    }
+}
+
+/* an R8 target's byte for x */
+static uint8_t unorm8(float x)
+{
+    x = x * 255.0f + 0.5f;
+    return x <= 0 ? 0 : x >= 255 ? 255 : (uint8_t)x;
+}
+
+/* The same levels in C (r->cpu_paths: a software rasteriser).  Level 0
+ * is read back; each level is made from the one before as the passes
+ * below make it, rounded to bytes where their R8 targets round (after the
+ * downsample, the blur across, the blur down), zero outside its box as
+ * the clear leaves it, and uploaded whole.  On llvmpipe those passes cost
+ * 1.7-2.2 ms a frame on one thread, most of it their fixed costs: twelve
+ * draws and eight clears on small targets, each a flush. */
+static bool sil_mips_cpu(r_game *r, int b[4])
+{
+    int n0 = r->sil_size;
+    size_t bytes = 0, n1 = (size_t)(n0 / 2) * (size_t)(n0 / 2);
+    for (int k = 0; k < SIL_LEVELS; k++)
+        bytes += (size_t)(n0 >> k) * (size_t)(n0 >> k);
+    bytes = (bytes + 15) & ~(size_t)15;
+    size_t need = bytes + 2 * n1 * sizeof(float);
+    if (need > r->sil_buf_n) {
+        uint8_t *p = realloc(r->sil_buf, need);
+        if (!p)
+            return false; /* the GL passes instead */
+        r->sil_buf = p, r->sil_buf_n = need;
+    }
+    uint8_t *lev[SIL_LEVELS];
+    lev[0] = r->sil_buf;
+    for (int k = 1; k < SIL_LEVELS; k++)
+        lev[k] = lev[k - 1] + (size_t)(n0 >> (k - 1)) * (size_t)(n0 >> (k - 1));
+    float *down = (float *)(void *)(r->sil_buf + bytes), *across = down + n1;
+    /* the texture, not its framebuffer: with the silhouette drawn through
+     * that same framebuffer (a silhouette of 1024), llvmpipe's
+     * glReadPixels (Mesa 22.3) returned the previous frame's level 0 */
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.BindTexture(GL_TEXTURE_2D, r->sil_tex);
+    gl.GetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_UNSIGNED_BYTE, lev[0]);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    float kw[5];
+    r_blur_kernel(1, kw);
+    gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl.BindTexture(GL_TEXTURE_2D, r->sil_tex);
+    for (int k = 1; k < SIL_LEVELS; k++) {
+        int n = n0 >> k, pn = n0 >> (k - 1);
+        sil_level_box(b, n);
+        const uint8_t *src = lev[k - 1];
+        uint8_t *dst = lev[k];
+        memset(dst, 0, (size_t)n * (size_t)n);
+        memset(down, 0, (size_t)n * (size_t)n * sizeof *down);
+        memset(across, 0, (size_t)n * (size_t)n * sizeof *across);
+        /* the 4x4 box of the level before (off it: zero, the border) */
+        for (int j = b[1]; j < b[3]; j++)
+            for (int i = b[0]; i < b[2]; i++) {
+                int s = 0;
+                for (int y = 2 * j - 1; y <= 2 * j + 2; y++)
+                    for (int x = 2 * i - 1; x <= 2 * i + 2; x++)
+                        s += x >= 0 && x < pn && y >= 0 && y < pn ? src[(size_t)y * (size_t)pn + (size_t)x] : 0;
+                down[(size_t)j * (size_t)n + (size_t)i] = (float)unorm8((float)s * (1.0f / (16 * 255.0f))) * (1.0f / 255);
+            }
+        /* the blurs, each tap off the level zero */
+        for (int j = b[1]; j < b[3]; j++)
+            for (int i = b[0]; i < b[2]; i++) {
+                const float *row = down + (size_t)j * (size_t)n;
+                float c = kw[0] * row[i];
+                for (int t = 1; t <= 4; t++)
+                    c += kw[t] * ((i - t >= 0 ? row[i - t] : 0) + (i + t < n ? row[i + t] : 0));
+                across[(size_t)j * (size_t)n + (size_t)i] = (float)unorm8(c) * (1.0f / 255);
+            }
+        for (int j = b[1]; j < b[3]; j++)
+            for (int i = b[0]; i < b[2]; i++) {
+                const float *col = across + i;
+                float c = kw[0] * col[(size_t)j * (size_t)n];
+                for (int t = 1; t <= 4; t++)
+                    c += kw[t] * ((j - t >= 0 ? col[(size_t)(j - t) * (size_t)n] : 0) +
+                                  (j + t < n ? col[(size_t)(j + t) * (size_t)n] : 0));
+                dst[(size_t)j * (size_t)n + (size_t)i] = unorm8(c);
+            }
+        gl.TexSubImage2D(GL_TEXTURE_2D, k, 0, 0, n, n, GL_RED, GL_UNSIGNED_BYTE, dst);
+    }
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    return true;
+}
+
 static void run_silhouette_mips(void *u)
 {
     r_game *r = u;
     int b[4];
     sil_footprint(r, b);
+    if (r->cpu_paths && sil_mips_cpu(r, b))
+        return;
     gl.Disable(GL_DEPTH_TEST);
     gl.ClearColor(0, 0, 0, 0);
     for (int k = 1; k < SIL_LEVELS; k++) {
         int n = r->sil_size >> k;
-        /* where level k can be non-zero: the downsample reads source
-         * texels 2i-1..2i+2, each blur reaches 4 texels (downsample.frag,
-         * blur.frag); a texel more for rounding */
-        for (int a = 0; a < 2; a++) {
-            b[a] = b[a] / 2 - 2 - 4 - 1, b[a + 2] = (b[a + 2] + 1) / 2 + 1 + 4 + 1;
-            b[a] = b[a] < 0 ? 0 : b[a], b[a + 2] = b[a + 2] > n ? n : b[a + 2];
-        }
+        sil_level_box(b, n);
         restrict_level(r->sil_tex, k - 1);
         clear_then_scissor(r->sil_fbo[k], b);
         r_down_into(r, r->sil_fbo[k], r->sil_tex, 0, n, n, -1, 1);
