@@ -1092,6 +1092,53 @@ static void t_silhouette_cpu_matches_gl(void)
     plat_destroy(p);
 }
 
+/* The shadow mask's filter in C (r_shadow.c, the default on a software
+ * rasteriser) is the GL passes' filter: the final mask within two steps of
+ * its R8 bytes (the grow's bilinear taps: llvmpipe filters 8-bit texels
+ * with 8-bit weights), on the same texels darkened, with the mask at half
+ * the render's rows (the standard preset) and whole; and without the GL's
+ * three draws (with the other C paths', 20). */
+static void t_mask_filter_cpu_matches_gl(void)
+{
+    plat *p = t_context("egl");
+    g_state prev, cur;
+    t_state_at("dojo", 1200, &prev, &cur);
+    t_fb f;
+    t_fb_make(&f, W, H);
+    for (int half = 1; half >= 0; half--) {
+        r_game *r = t_game_opts(&(r_game_opts){.q = {.mask_half = half == 1}});
+        float *m[2];
+        int mw = 0, mh = 0, draws[2], binds;
+        for (int cpu = 1; cpu >= 0; cpu--) {
+            r_game_set_cpu_paths(r, cpu == 1);
+            counted_frame(r, &f, &prev, &cur, &draws[cpu], &binds);
+            T_ASSERT(t_pass_ran(r, "mask_filter"));
+            T_ASSERT(r_game_read_buffer(r, "mask", NULL, &mw, &mh));
+            m[cpu] = malloc((size_t)mw * mh * 4 * sizeof(float));
+            T_ASSERT(m[cpu] && r_game_read_buffer(r, "mask", m[cpu], NULL, NULL));
+        }
+        int dark = 0, differ = 0, shade = 0;
+        float most = 0;
+        for (int i = 0; i < mw * mh; i++) {
+            float a = m[1][4 * i], b = m[0][4 * i], d = fabsf(a - b);
+            dark += b < 0.5f, differ += d > 0, most = fmaxf(most, d);
+            shade += (a < 0.99f) != (b < 0.99f);
+        }
+        fprintf(stderr, "    mask %dx%d: %d texels in shadow, %d differ, by %.0f/255 at most, %d shaded on one side only; "
+                        "draws %d -> %d\n", mw, mh, dark, differ, most * 255, shade, draws[0], draws[1]);
+        T_ASSERTF(dark > 50, "only %d texels of the fighters' shadows", dark);
+        T_ASSERTF(most <= 2.5f / 255, "the C mask is %g from the GL's", most);
+        T_ASSERTF(shade <= dark / 50, "%d texels shaded by one filter and not the other", shade);
+        /* the C paths leave out the silhouette's 12 draws, bloom's 5 and the filter's 3 */
+        T_ASSERTF(draws[1] + 20 <= draws[0], "the C paths still draw: %d draws a frame, %d with the GL's", draws[1],
+                  draws[0]);
+        free(m[0]), free(m[1]);
+        r_game_destroy(r);
+    }
+    t_fb_free(&f);
+    plat_destroy(p);
+}
+
 T_MAIN({"error_ids", t_error_ids}, {"fighter_mesh_by_rows", t_fighter_mesh_by_rows}, {"golden_egl", t_golden_egl}, {"golden_osmesa", t_golden_osmesa},
        {"resolution_independent", t_resolution_independent},
        {"fighters_where_the_camera_says", t_fighters_where_the_camera_says},
@@ -1105,4 +1152,5 @@ T_MAIN({"error_ids", t_error_ids}, {"fighter_mesh_by_rows", t_fighter_mesh_by_ro
        {"packed_float_hdr", t_packed_float_hdr}, {"lens_stays_on_the_head", t_lens_stays_on_the_head},
        {"fighters_read_on_every_stage", t_fighters_read_on_every_stage},
        {"texel_blur_matches_pairs", t_texel_blur_matches_pairs}, {"bloom_cpu_matches_gl", t_bloom_cpu_matches_gl},
-       {"silhouette_cpu_matches_gl", t_silhouette_cpu_matches_gl})
+       {"silhouette_cpu_matches_gl", t_silhouette_cpu_matches_gl},
+       {"mask_filter_cpu_matches_gl", t_mask_filter_cpu_matches_gl})

@@ -609,6 +609,7 @@ void r_game_destroy(r_game *r)
     free_targets(r);
     free(r->bloom_buf);
     free(r->sil_buf);
+    free(r->mask_buf);
     r_graph_release(&r->graph);
     for (int lod = 0; lod < R_FIGHTER_LODS; lod++)
         r_free_mesh(&r->fighter_lod[lod].vao, &r->fighter_lod[lod].vbo, &r->fighter_lod[lod].ibo);

@@ -93,6 +93,8 @@ struct r_game {
     bool cpu_paths;
     uint8_t *sil_buf; /* the levels as bytes, and the C blurs' floats */
     size_t sil_buf_n;
+    uint8_t *mask_buf; /* the shadow mask's filter in C: bytes in and out, and floats */
+    size_t mask_buf_n;
     /* screen targets */
     int tw, th;   /* the scene's targets' size */
     int tow, toh; /* the output's, for the AA pass's targets */

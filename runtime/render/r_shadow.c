@@ -285,23 +285,31 @@ static float mask_unit(const r_game *r)
     return (float)r->mask_h / R_REF_ROWS;
 }
 
+/* The fighters' box in mask pixels (x0 y0 x1 y1, x1 y1 exclusive): render
+ * pixels taken to the mask's, rounded outwards. */
+static void mask_box(const r_game *r, int m[4])
+{
+    const int *b = r->f.fig_box;
+    if (r->mask_w == r->f.w && r->mask_h == r->f.h) {
+        m[0] = b[0], m[1] = b[1], m[2] = b[0] + b[2], m[3] = b[1] + b[3];
+        return;
+    }
+    double sx = (double)r->mask_w / r->f.w, sy = (double)r->mask_h / r->f.h;
+    m[0] = (int)floor(b[0] * sx), m[1] = (int)floor(b[1] * sy);
+    m[2] = (int)ceil((b[0] + b[2]) * sx), m[3] = (int)ceil((b[1] + b[3]) * sy);
+}
+
 /* The bound mask buffer: all 1 (lit), then draws limited to the fighters'
- * box (render pixels, taken to the mask's, rounded outwards). */
+ * box. */
 static void mask_clear_and_scissor(r_game *r)
 {
     gl.Disable(GL_SCISSOR_TEST);
     gl.ClearColor(1, 1, 1, 1);
     gl.Clear(GL_COLOR_BUFFER_BIT);
     gl.Enable(GL_SCISSOR_TEST);
-    const int *b = r->f.fig_box;
-    if (r->mask_w == r->f.w && r->mask_h == r->f.h) {
-        gl.Scissor(b[0], b[1], b[2], b[3]);
-        return;
-    }
-    double sx = (double)r->mask_w / r->f.w, sy = (double)r->mask_h / r->f.h;
-    int x0 = (int)floor(b[0] * sx), y0 = (int)floor(b[1] * sy);
-    int x1 = (int)ceil((b[0] + b[2]) * sx), y1 = (int)ceil((b[1] + b[3]) * sy);
-    gl.Scissor(x0, y0, x1 - x0, y1 - y0);
+    int m[4];
+    mask_box(r, m);
+    gl.Scissor(m[0], m[1], m[2] - m[0], m[3] - m[1]);
 }
 
 static void run_shadow_mask(void *u)
@@ -325,6 +333,90 @@ static void run_shadow_mask(void *u)
     gl.Disable(GL_SCISSOR_TEST);
 }
 
+/* The filter in C (r->cpu_paths: a software rasteriser), for blur steps
+ * of at most a texel (the mask at 1440 rows or fewer): the mask is read
+ * back, grown and blurred inside the fighters' box as mask_grow.frag and
+ * blur.frag's REACH variants do, each step rounded to a byte where its R8
+ * target rounds, 1 outside the box as the clears leave it, and uploaded
+ * as the final mask.  On llvmpipe the three passes and their clears cost
+ * 1.3-1.6 ms a frame on one thread for a box of about 10,000 texels. */
+static bool mask_filter_cpu(r_game *r, float k)
+{
+    int w = r->mask_w, h = r->mask_h, b[4];
+    float kw[5];
+    int reach = r_blur_kernel(k, kw);
+    if (!(k > 0 && k <= 1))
+        return false;
+    mask_box(r, b);
+    b[0] = b[0] < 0 ? 0 : b[0], b[1] = b[1] < 0 ? 0 : b[1];
+    b[2] = b[2] > w ? w : b[2], b[3] = b[3] > h ? h : b[3];
+    size_t n = (size_t)w * (size_t)h, need = 2 * n + 16 + 2 * n * sizeof(float); /* 16: the floats' alignment */
+    if (need > r->mask_buf_n) {
+        uint8_t *p = realloc(r->mask_buf, need);
+        if (!p)
+            return false;
+        r->mask_buf = p, r->mask_buf_n = need;
+    }
+    uint8_t *src = r->mask_buf, *out = src + n;
+    float *grown = (float *)(void *)(out + n + (16 - (2 * n) % 16) % 16), *across = grown + n;
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.BindTexture(GL_TEXTURE_2D, r->mask_tex[0]);
+    gl.GetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_UNSIGNED_BYTE, src);
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    for (size_t i = 0; i < n; i++)
+        grown[i] = across[i] = 1;
+    memset(out, 255, n);
+    /* grow: the minimum of the 3x3 bilinear taps k texels apart (k <= 1:
+     * mask_grow.frag's one tap each side); a tap k to the left of texel x
+     * is k of texel x - 1 and 1 - k of x, so each is two weights of the
+     * texels next to it, clamped at the edges */
+    const float kk = k, k1 = 1 - k, inv = 1.0f / 255;
+    for (int y = b[1]; y < b[3]; y++) {
+        const uint8_t *rows[3] = {src + (size_t)(y > 0 ? y - 1 : 0) * (size_t)w, src + (size_t)y * (size_t)w,
+                                  src + (size_t)(y + 1 < h ? y + 1 : h - 1) * (size_t)w};
+        for (int x = b[0]; x < b[2]; x++) {
+            int xa = x > 0 ? x - 1 : 0, xb = x + 1 < w ? x + 1 : w - 1;
+            float t[3][3];
+            for (int q = 0; q < 3; q++) {
+                float c = (float)rows[q][x] * inv;
+                t[q][0] = kk * (float)rows[q][xa] * inv + k1 * c, t[q][1] = c, t[q][2] = k1 * c + kk * (float)rows[q][xb] * inv;
+            }
+            float lo = 1;
+            for (int c = 0; c < 3; c++) {
+                float up = kk * t[0][c] + k1 * t[1][c], mid = t[1][c], down = k1 * t[1][c] + kk * t[2][c];
+                lo = fminf(lo, fminf(mid, fminf(up, down)));
+            }
+            grown[(size_t)y * (size_t)w + (size_t)x] = (float)unorm8(lo) * inv;
+        }
+    }
+    /* the blurs (clamped at the edges), across then down */
+    for (int y = b[1]; y < b[3]; y++)
+        for (int x = b[0]; x < b[2]; x++) {
+            const float *row = grown + (size_t)y * (size_t)w;
+            float c = kw[0] * row[x];
+            for (int t = 1; t <= reach; t++)
+                c += kw[t] * (row[x - t < 0 ? 0 : x - t] + row[x + t >= w ? w - 1 : x + t]);
+            across[(size_t)y * (size_t)w + (size_t)x] = (float)unorm8(c) * (1.0f / 255);
+        }
+    for (int y = b[1]; y < b[3]; y++)
+        for (int x = b[0]; x < b[2]; x++) {
+            float c = kw[0] * across[(size_t)y * (size_t)w + (size_t)x];
+            for (int t = 1; t <= reach; t++)
+                c += kw[t] * (across[(size_t)(y - t < 0 ? 0 : y - t) * (size_t)w + (size_t)x] +
+                              across[(size_t)(y + t >= h ? h - 1 : y + t) * (size_t)w + (size_t)x]);
+            out[(size_t)y * (size_t)w + (size_t)x] = unorm8(c);
+        }
+    gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl.BindTexture(GL_TEXTURE_2D, r->mask_tex[1]);
+    gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, out);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    r->mask_final = 1;
+    return true;
+}
+
 /* SSFSM step 3: grow dark by 1/720 of the frame height, then blur (sigma
  * 2/720 of it) (mask 0 -> 1 -> 0 -> 1) */
 static void run_mask_filter(void *u)
@@ -332,6 +424,8 @@ static void run_mask_filter(void *u)
     r_game *r = u;
     GLuint p = r->prog[P_GROW];
     float k = mask_unit(r);
+    if (r->cpu_paths && mask_filter_cpu(r, k))
+        return;
     gl.BindFramebuffer(GL_FRAMEBUFFER, r->mask_fbo[1]);
     gl.Viewport(0, 0, r->mask_w, r->mask_h);
     mask_clear_and_scissor(r);
