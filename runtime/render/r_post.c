@@ -76,24 +76,12 @@ static void run_bloom_bright(void *u)
     r_down_with(r, bloom_step_prog(r, 1), bloom_step_fbo(r, 1), r->hdr_tex, 0, w, h, r->stage.bloom_threshold, r->f.exposure);
 }
 
-/* The levels, then the glow: the one image the tone map adds.  The first
- * level is blurred across, the second level is made from that (down, then
- * blurred both ways), and the first level's blur down the columns writes
- * the glow: u_bloom x (itself + the second level) + the flare when it
- * ran (blur.frag's GLOW).  The tone map then taps one texture a pixel
- * where it tapped three: at 640x360 on llvmpipe each full-size tap costs
- * about 1 ms, the glow's two extra taps at bloom's size a quarter of
- * that.  The second level is made from the first blurred across only, not
- * both ways as before (a slightly narrower glow down the columns).
- * The levels are RGBE in RGBA8 (rgbe_common.glsl), read texel by texel:
- * on llvmpipe a 9-tap blur of them costs a third of the 5 bilinear taps of
- * RGBA16F it replaced (0.69 against 1.9-2.0 ms at 320x180, one thread);
- * the glow, which the tone map filters, stays RGBA16F. */
 /* The same levels and glow in C (r_bloom.c), on a software rasteriser:
  * the first level is read back as floats (and the flare's image when it
  * ran), and the glow goes up as the one texture the tone map taps.  On
- * llvmpipe the GL's five passes over the levels cost 3.4 ms a 640x360
- * frame on one thread; reading back, the C and the upload about 0.6. */
+ * llvmpipe the GL's five passes over the levels (run_bloom_blur, below)
+ * cost 3.4 ms a 640x360 frame on one thread; the reads, the C and the
+ * upload about 1.4. */
 static void bloom_blur_cpu(r_game *r, bool level2, bool flare)
 {
     frame *f = &r->f;
@@ -128,6 +116,20 @@ static void bloom_blur_cpu(r_game *r, bool level2, bool flare)
     gl.BindTexture(GL_TEXTURE_2D, 0);
 }
 
+/* The levels, then the glow: the one image the tone map adds.  The first
+ * level is blurred across, the second level is made from that (down, then
+ * blurred both ways), and the first level's blur down the columns writes
+ * the glow: u_bloom x (itself + the second level) + the flare when it
+ * ran (blur.frag's GLOW).  The tone map then taps one texture a pixel
+ * where it tapped three: at 640x360 on llvmpipe each full-size tap costs
+ * about 1 ms, the glow's two extra taps at bloom's size a quarter of
+ * that.  The second level is made from the first blurred across only, not
+ * both ways as before (a slightly narrower glow down the columns).
+ * The levels are RGBE in RGBA8 (rgbe_common.glsl), read texel by texel:
+ * on llvmpipe a 9-tap blur of them costs a third of the 5 bilinear taps of
+ * RGBA16F it replaced (0.69 against 1.9-2.0 ms at 320x180, one thread);
+ * the glow, which the tone map filters, stays RGBA16F (RGBA32F where
+ * bloom_blur_cpu makes it). */
 static void run_bloom_blur(void *u)
 {
     r_game *r = u;
