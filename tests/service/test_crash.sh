@@ -13,13 +13,22 @@ crash_leftovers() { # D
 }
 
 # Starts a daemon on d, lets it run for a while, SIGKILLs it; KILLS times,
-# the moments drawn from awk's generator with SEED (the same run each time)
+# the moments drawn from awk's generator with SEED (the same run each time).
+# A kill waits, past its moment, until the daemon has files of its own on
+# disk (a render under way: up to 10 s more), so that every kill lands in
+# the middle of work however fast the renders have become: with the
+# renders of 2026-11-29 the jobs were all done before the fourth kill.
 crash_kill_run() { # KILLS SEED [serve options...]
     kills=$1 seed=$2
     shift 2
     for delay in $(awk -v n="$kills" -v s="$seed" 'BEGIN { srand(s); for (i = 0; i < n; i++) printf "%.1f ", 1 + 4 * rand() }'); do
         svc_start d $SVC_FAST "$@" || return 1
         sleep "$delay"
+        w=0
+        while [ $w -lt 100 ] && ! crash_leftovers d | grep -q -- "-$SVC_PID-"; do
+            sleep 0.1
+            w=$((w + 1))
+        done
         kill -KILL "$SVC_PID"
         wait "$SVC_PID" 2>/dev/null
         echo "killed the daemon after $delay s"
@@ -30,7 +39,9 @@ crash_kill_run() { # KILLS SEED [serve options...]
 # run of docs/service.md; its figures go to the file CRASH_REPORT names
 t_random_kills_charge_nothing_and_leave_nothing() {
     n=${CRASH_JOBS:-8} kills=${CRASH_KILLS:-4} seed=${CRASH_SEED:-21} cap=${CRASH_MAX_ATTEMPTS:-1}
-    svc_replays r "$n" 3 || return 1
+    # 6 s replays: enough work that the last daemon killed has some (3 s
+    # ones were all rendered before it by 2026-11-29's renderer)
+    svc_replays r "$n" 6 || return 1
     svc_start d $SVC_FAST --workers 2 || return 1
     ids="" k=1
     while [ $k -le "$n" ]; do ids="$ids $(svc_submit r/r$k.rsr)" || return 1; k=$((k + 1)); done

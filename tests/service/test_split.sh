@@ -89,10 +89,14 @@ t_segment_out_of_attempts_fails_the_job() {
     dojo 3 8 three.rsr || return 1
     svc_start d $SVC_FAST --segment-seconds 1 --max-attempts 1 || return 1
     id=$(svc_submit three.rsr) || return 1
+    # segment 0's render, found by its command line and stopped first (as
+    # in segment_retried_alone: waiting for frames to show let segment 0
+    # finish first with 2026-11-29's renders, and the kill hit segment 1)
     i=0
-    until w=$(svc_worker_pid "$SVC_PID" "$id") && [ "$(svc_field "$id" frames_done)" -gt 3 ] 2>/dev/null; do
-        sleep 0.1; i=$((i + 1)); [ $i -lt 600 ] || { echo "no render"; return 1; }
+    until w=$(svc_worker_pid "$SVC_PID" "$id") && tr '\0' ' ' <"/proc/$w/cmdline" 2>/dev/null | grep -q -- '--ticks 0:60'; do
+        sleep 0.05; i=$((i + 1)); [ $i -lt 1200 ] || { echo "segment 0 never ran"; return 1; }
     done
+    kill -STOP "$w"
     kill -KILL "$w"
     svc_wait_state "$id" failed 60 || return 1
     svc_field "$id" error | grep -q "^gave up after 1 attempt: segment 0 (ticks 0-60): the render process was killed by signal 9" ||
