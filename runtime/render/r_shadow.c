@@ -152,6 +152,41 @@ static uint8_t unorm8(float x)
     return x <= 0 ? 0 : x >= 255 ? 255 : (uint8_t)x;
 }
 
+/* blur.frag's REACH blur (texel weights kw[0..reach]) of src (w x h)
+ * inside the box b (x0 y0 x1 y1) along x (across) or y, each result
+ * rounded to a byte where its R8 target rounds: into bytes when dst_b,
+ * else into dst_f as floats (the byte / 255).  A tap off the image reads
+ * zero (zero_border: the silhouette's border) or the edge's texel (the
+ * mask's clamp). */
+static void blur_box(const float *src, int w, int h, const int b[4], const float kw[5], int reach, bool across,
+                     bool zero_border, float *dst_f, uint8_t *dst_b)
+{
+    size_t step = across ? 1 : (size_t)w;
+    for (int y = b[1]; y < b[3]; y++)
+        for (int x = b[0]; x < b[2]; x++) {
+            size_t at = (size_t)y * (size_t)w + (size_t)x;
+            float c = kw[0] * src[at];
+            /* every tap on the image: no edge to test (most texels) */
+            bool inside = across ? x >= reach && x + reach < w : y >= reach && y + reach < h;
+            for (int t = 1; t <= reach && inside; t++)
+                c += kw[t] * (src[at - (size_t)t * step] + src[at + (size_t)t * step]);
+            for (int t = 1; t <= reach && !inside; t++) {
+                float side[2];
+                for (int e = 0; e < 2; e++) {
+                    int xx = across ? x + (e ? t : -t) : x, yy = across ? y : y + (e ? t : -t);
+                    bool off = xx < 0 || xx >= w || yy < 0 || yy >= h;
+                    xx = xx < 0 ? 0 : xx >= w ? w - 1 : xx, yy = yy < 0 ? 0 : yy >= h ? h - 1 : yy;
+                    side[e] = off && zero_border ? 0 : src[(size_t)yy * (size_t)w + (size_t)xx];
+                }
+                c += kw[t] * (side[0] + side[1]);
+            }
+            if (dst_b)
+                dst_b[at] = unorm8(c);
+            else
+                dst_f[at] = (float)unorm8(c) * (1.0f / 255);
+        }
+}
+
 /* The same levels in C (r->cpu_paths: a software rasteriser).  Level 0
  * is read back; each level is made from the one before as the passes
  * below make it, rounded to bytes where their R8 targets round (after the
@@ -187,7 +222,7 @@ static bool sil_mips_cpu(r_game *r, int b[4])
     gl.GetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_UNSIGNED_BYTE, lev[0]);
     gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
     float kw[5];
-    r_blur_kernel(1, kw);
+    int reach = r_blur_kernel(1, kw);
     gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
     gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     gl.BindTexture(GL_TEXTURE_2D, r->sil_tex);
@@ -209,23 +244,8 @@ static bool sil_mips_cpu(r_game *r, int b[4])
                 down[(size_t)j * (size_t)n + (size_t)i] = (float)unorm8((float)s * (1.0f / (16 * 255.0f))) * (1.0f / 255);
             }
         /* the blurs, each tap off the level zero */
-        for (int j = b[1]; j < b[3]; j++)
-            for (int i = b[0]; i < b[2]; i++) {
-                const float *row = down + (size_t)j * (size_t)n;
-                float c = kw[0] * row[i];
-                for (int t = 1; t <= 4; t++)
-                    c += kw[t] * ((i - t >= 0 ? row[i - t] : 0) + (i + t < n ? row[i + t] : 0));
-                across[(size_t)j * (size_t)n + (size_t)i] = (float)unorm8(c) * (1.0f / 255);
-            }
-        for (int j = b[1]; j < b[3]; j++)
-            for (int i = b[0]; i < b[2]; i++) {
-                const float *col = across + i;
-                float c = kw[0] * col[(size_t)j * (size_t)n];
-                for (int t = 1; t <= 4; t++)
-                    c += kw[t] * ((j - t >= 0 ? col[(size_t)(j - t) * (size_t)n] : 0) +
-                                  (j + t < n ? col[(size_t)(j + t) * (size_t)n] : 0));
-                dst[(size_t)j * (size_t)n + (size_t)i] = unorm8(c);
-            }
+        blur_box(down, n, n, b, kw, reach, true, true, across, NULL);
+        blur_box(across, n, n, b, kw, reach, false, true, NULL, dst);
         gl.TexSubImage2D(GL_TEXTURE_2D, k, 0, 0, n, n, GL_RED, GL_UNSIGNED_BYTE, dst);
     }
     gl.BindTexture(GL_TEXTURE_2D, 0);
@@ -391,22 +411,8 @@ static bool mask_filter_cpu(r_game *r, float k)
         }
     }
     /* the blurs (clamped at the edges), across then down */
-    for (int y = b[1]; y < b[3]; y++)
-        for (int x = b[0]; x < b[2]; x++) {
-            const float *row = grown + (size_t)y * (size_t)w;
-            float c = kw[0] * row[x];
-            for (int t = 1; t <= reach; t++)
-                c += kw[t] * (row[x - t < 0 ? 0 : x - t] + row[x + t >= w ? w - 1 : x + t]);
-            across[(size_t)y * (size_t)w + (size_t)x] = (float)unorm8(c) * (1.0f / 255);
-        }
-    for (int y = b[1]; y < b[3]; y++)
-        for (int x = b[0]; x < b[2]; x++) {
-            float c = kw[0] * across[(size_t)y * (size_t)w + (size_t)x];
-            for (int t = 1; t <= reach; t++)
-                c += kw[t] * (across[(size_t)(y - t < 0 ? 0 : y - t) * (size_t)w + (size_t)x] +
-                              across[(size_t)(y + t >= h ? h - 1 : y + t) * (size_t)w + (size_t)x]);
-            out[(size_t)y * (size_t)w + (size_t)x] = unorm8(c);
-        }
+    blur_box(grown, w, h, b, kw, reach, true, false, across, NULL);
+    blur_box(across, w, h, b, kw, reach, false, false, NULL, out);
     gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
     gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     gl.BindTexture(GL_TEXTURE_2D, r->mask_tex[1]);
