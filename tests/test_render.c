@@ -981,6 +981,14 @@ static void t_fighter_mesh_by_rows(void)
     plat_destroy(p);
 }
 
+/* A named buffer of the last frame at whatever size it has (t_read
+ * with the size asked first). */
+static float *read_sized(r_game *r, const char *name, int *w, int *h)
+{
+    T_ASSERTF(r_game_read_buffer(r, name, NULL, w, h), "no buffer '%s'", name);
+    return t_read(r, name, 4, *w, *h);
+}
+
 /* Bloom's blurs and glow in C (r_bloom.c, the default on a software
  * rasteriser) give the GL chain's glow: within its RGBE levels' 8-bit
  * mantissas (each level 0.4 % of its largest channel), with the flare in
@@ -1007,9 +1015,7 @@ static void t_bloom_cpu_matches_gl(void)
             r_game_set_cpu_paths(r, cpu == 1);
             t_draw_read(r, &f, &prev, &cur, w, h, px[cpu], true);
             T_ASSERT(t_pass_ran(r, "bloom_blur") && t_pass_ran(r, "flare"));
-            T_ASSERT(r_game_read_buffer(r, "bloom", NULL, &gw, &gh));
-            glow[cpu] = malloc((size_t)gw * gh * 4 * sizeof(float));
-            T_ASSERT(glow[cpu] && r_game_read_buffer(r, "bloom", glow[cpu], NULL, NULL));
+            glow[cpu] = read_sized(r, "bloom", &gw, &gh);
         }
         double worst = 0, sum = 0, top = 0;
         for (int i = 0; i < gw * gh; i++) {
@@ -1065,9 +1071,7 @@ static void t_silhouette_cpu_matches_gl(void)
             for (int k = 1; k < SIL_LEVELS; k++) {
                 char name[16];
                 snprintf(name, sizeof name, "silhouette%d", k);
-                T_ASSERT(r_game_read_buffer(r, name, NULL, &n[k], NULL));
-                lv[cpu][k] = malloc((size_t)n[k] * n[k] * 4 * sizeof(float));
-                T_ASSERT(lv[cpu][k] && r_game_read_buffer(r, name, lv[cpu][k], NULL, NULL));
+                lv[cpu][k] = read_sized(r, name, &n[k], &n[k]);
             }
         }
         for (int k = 1; k < SIL_LEVELS; k++) {
@@ -1113,9 +1117,7 @@ static void t_mask_filter_cpu_matches_gl(void)
             r_game_set_cpu_paths(r, cpu == 1);
             counted_frame(r, &f, &prev, &cur, &draws[cpu], &binds);
             T_ASSERT(t_pass_ran(r, "mask_filter"));
-            T_ASSERT(r_game_read_buffer(r, "mask", NULL, &mw, &mh));
-            m[cpu] = malloc((size_t)mw * mh * 4 * sizeof(float));
-            T_ASSERT(m[cpu] && r_game_read_buffer(r, "mask", m[cpu], NULL, NULL));
+            m[cpu] = read_sized(r, "mask", &mw, &mh);
         }
         int dark = 0, differ = 0, shade = 0;
         float most = 0;
