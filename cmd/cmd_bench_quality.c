@@ -75,6 +75,8 @@ static const config fixed_configs[] = {
     {"1x mask half", 1, {.mask_half = true}, 0},
     {"1x bloom 1 level", 1, {.bloom_levels = 1}, 0},
     {"1x lspsm 1024", 1, {.lspsm_size = 1024}, 0},
+    {"1x lspsm static 2048", 1, {.lspsm_static = 2048}, 0},
+    {"1x lspsm static 4096", 1, {.lspsm_static = 4096}, 0},
     {"1x fog 64", 1, {.fog_size = 64}, 0},
     {"1x water 32", 1, {.water_grid = 32}, 0},
     {"1x snow light 128", 1, {.snow_light = 128}, 0},
@@ -91,6 +93,7 @@ static const config fixed_configs[] = {
     {"1x lean scene 90%", 1, {LEAN_Q, .scene_pct = 90}, 1},
     /* each stage at its own size (its standard_scene_pct, chosen from the rows above) */
     {"1x lean stage scene", 1, {LEAN_Q, .stage_scene = true}, 1},
+    {"1x lean stage scene static", 1, {LEAN_Q, .stage_scene = true, .lspsm_static = 2048}, 1},
     {"1x fxaa lean scene 75%", 1, {LEAN_Q, .aa = R_AA_FXAA, .scene_pct = 75}, 1},
     {"1x fxaa lean scene 85%", 1, {LEAN_Q, .aa = R_AA_FXAA, .scene_pct = 85}, 1},
     {"1.5x fxaa", 1.5, {.aa = R_AA_FXAA}, 1},
@@ -121,7 +124,7 @@ static void help(void)
            "                              [--chart FILE.png] [-y|-n] [-q|-v]\n\n"
            "Draws the same frames of every shipped demo under each knob of the renderer\n"
            "(render scale, FXAA, shadow and silhouette map sizes, the shadow mask at half\n"
-           "size, bloom levels, LSPSM and fog map sizes, the water grid, the snow's light\n"
+           "size, bloom levels, LSPSM and fog map sizes, LSPSM's static layers, the water grid, the snow's light\n"
            "map, the scene's size under the output's) and under\n"
            "combinations of them, brings each to the output size with the box filter, and\n"
            "compares it with a reference drawn at 4x4 pixels per output pixel with every\n"
@@ -309,6 +312,7 @@ static bool q_equal(const r_quality *a, const r_quality *b)
 {
     return a->shadow_size == b->shadow_size && a->sil_size == b->sil_size && a->mask_half == b->mask_half &&
            a->bloom_levels == b->bloom_levels && a->aa == b->aa && a->lspsm_size == b->lspsm_size &&
+           a->lspsm_static == b->lspsm_static &&
            a->fog_size == b->fog_size && a->water_grid == b->water_grid && a->snow_light == b->snow_light &&
            a->scene_pct == b->scene_pct && a->stage_scene == b->stage_scene;
 }
@@ -534,15 +538,15 @@ static bool write_outputs(const quality_opts *o, const quality_res *q, rs_err *e
         FILE *f = cli_bench_open("bench", csv, o->user_csv, o->overwrite);
         if (!f)
             return rs_fail(err, JOB_ERR_WRITE, "%s: not written", csv);
-        fprintf(f, "stage,configuration,scale,aa,shadow_size,sil_size,mask_half,bloom_levels,lspsm_size,fog_size,water_grid,"
+        fprintf(f, "stage,configuration,scale,aa,shadow_size,sil_size,mask_half,bloom_levels,lspsm_size,lspsm_static,fog_size,water_grid,"
                    "snow_light,scene_pct,ms_per_frame,psnr_db,ssim,frames,w,h\n");
         for (int d = 0; d < NDEMOS; d++)
             for (int ci = 0; o->use[d] && ci < NCONFIGS; ci++) {
                 const config *cf = &configs[ci];
                 const result *rr = &q->res[d][ci];
-                fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
+                fprintf(f, "%s,%s,%g,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.5f,%d,%d,%d\n", demos[d].name, cf->name, cf->scale,
                         cf->q.aa == R_AA_FXAA ? "fxaa" : "off", cf->q.shadow_size, cf->q.sil_size, cf->q.mask_half,
-                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.fog_size, cf->q.water_grid, cf->q.snow_light, rr->scene_pct, rr->ms, rr->psnr, rr->ssim,
+                        cf->q.bloom_levels, cf->q.lspsm_size, cf->q.lspsm_static, cf->q.fog_size, cf->q.water_grid, cf->q.snow_light, rr->scene_pct, rr->ms, rr->psnr, rr->ssim,
                         o->frames, o->w, o->h);
             }
         if (cli_fclose(f) != 0)

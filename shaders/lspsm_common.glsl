@@ -9,8 +9,18 @@
 // fighter's shadow can reach one (fx_lspsm.c).  Only when u_lspsm_on == 1: lspsm_bind
 // (runtime/fx/fx_lspsm.c) sets it with everything below, and it is 0 whenever
 // the map was not drawn this frame.
-uniform int u_lspsm_on;
+// FX_LSPSM_STATIC (r_quality.lspsm_static): the casters and the light do
+// not move, so the map is two orthographic layers of one array drawn
+// once (layer 0 round the ring, layer 1 over everything within reach;
+// r_lspsm.h): an affine lookup and one tap.
+#ifdef FX_LSPSM_STATIC
+#define FX_LSPSM 1
+uniform sampler2DArrayShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware
+uniform vec4 u_lspsm_fit[1];              // layer 0's (u, v) = the last layer's * .xy + .zw
+#else
 uniform sampler2DShadow u_lspsm_map; // compare mode, bilinear: 2x2 PCF in hardware
+#endif
+uniform int u_lspsm_on;
 uniform float u_lspsm_texel;         // one texel of the map, in texture coordinates
 uniform mat4 u_lspsm_shadow;         // world -> (u, v, depth, w)
 uniform vec3 u_lspsm_eye;
@@ -31,6 +41,28 @@ vec3 lspsm_box_exit(vec3 p, vec3 d, vec3 lo, vec3 hi)
     return te < 1e30 ? p + d * te : p;
 }
 
+#ifdef FX_LSPSM_STATIC
+// The static layers at c, layer 1's (u, v, depth): layer 0 where its
+// (u, v) and the tap's texels lie inside it.  No branch (llvmpipe would
+// run both sides anyway); outside layer 1 its border (depth 1) is lit.
+float lspsm_static_lit(vec3 c)
+{
+    vec2 c0 = c.xy * u_lspsm_fit[0].xy + u_lspsm_fit[0].zw;
+    bool l0 = max(abs(c0.x - 0.5), abs(c0.y - 0.5)) < 0.5 - u_lspsm_texel;
+    return texture(u_lspsm_map, vec4(l0 ? c0 : c.xy, l0 ? 0.0 : 1.0, c.z - u_lspsm_bias));
+}
+
+// lspsm_visibility for a stage surface whose layer coordinates (pushed
+// along its normal) the vertex shader interpolated: c
+float lspsm_static_visibility(vec3 p, vec3 c)
+{
+    if (u_lspsm_on != 1)
+        return 1.0;
+    float strength = 1.0 - smoothstep(u_lspsm_fade.x, u_lspsm_fade.y, distance(p, u_lspsm_eye));
+    return mix(1.0, lspsm_static_lit(c), strength);
+}
+#endif
+
 // Visibility of the key light at p (1 lit, 0 in shadow), already faded out
 // towards the end of the shadow range; p is pushed along the normal n by
 // `offset` metres against acne.
@@ -39,6 +71,9 @@ float lspsm_visibility(vec3 p, vec3 n, float offset)
     if (u_lspsm_on != 1)
         return 1.0;
     float strength = 1.0 - smoothstep(u_lspsm_fade.x, u_lspsm_fade.y, distance(p, u_lspsm_eye));
+#ifdef FX_LSPSM_STATIC
+    float lit = lspsm_static_lit((u_lspsm_shadow * vec4(p + n * offset, 1.0)).xyz);
+#else
     if (!(strength > 0.0))
         return 1.0;
     vec4 s = u_lspsm_shadow * vec4(p + n * offset, 1.0);
@@ -53,6 +88,7 @@ float lspsm_visibility(vec3 p, vec3 n, float offset)
     float h = 0.5 * u_lspsm_texel, z = c.z - u_lspsm_bias;
     float lit = 0.25 * (texture(u_lspsm_map, vec3(c.xy + vec2(-h, -h), z)) + texture(u_lspsm_map, vec3(c.xy + vec2(h, -h), z)) +
                         texture(u_lspsm_map, vec3(c.xy + vec2(-h, h), z)) + texture(u_lspsm_map, vec3(c.xy + vec2(h, h), z)));
+#endif
     return mix(1.0, lit, strength);
 }
 

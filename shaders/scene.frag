@@ -1,5 +1,5 @@
 #version 330 core
-// variants: FIGHTER STAGE FIGHTER+SHADOWS+FX_FOG+FX_LSPSM STAGE+SHADOWS+FX_FOG+FX_LSPSM STAGE+MATERIAL=1 STAGE+MATERIAL=2+SHADOWS+FX_LSPSM STAGE+MATERIAL=3+SHADOWS
+// variants: FIGHTER STAGE FIGHTER+SHADOWS+FX_FOG+FX_LSPSM STAGE+SHADOWS+FX_FOG+FX_LSPSM STAGE+MATERIAL=1 STAGE+MATERIAL=2+SHADOWS+FX_LSPSM STAGE+MATERIAL=3+SHADOWS FIGHTER+SHADOWS+FX_LSPSM_STATIC STAGE+MATERIAL=1+SHADOWS+FX_LSPSM_STATIC STAGE+MATERIAL=2+SHADOWS+FX_LSPSM_STATIC STAGE+MATERIAL=3+SHADOWS+FX_FOG+FX_LSPSM_STATIC
 // The HDR scene pass (docs/renderer.md: "HDR, materials, mask", "Image-based
 // lighting", "Shadows"): image-based lighting only, no ambient term.  Every
 // surface blends its key-on and key-off IBL results by its shadow factor: the
@@ -35,6 +35,9 @@ in vec3 v_proj;
 in float v_lod;
 #if MATERIAL != 3
 flat in vec3 v_diff_on, v_diff_off; // the face's ibl_diffuse maps (scene.vert)
+#endif
+#ifdef FX_LSPSM_STATIC
+in vec3 v_lspsm, v_lspsm_n; // the static layers' coordinates of v_world and of the normal (scene.vert)
 #endif
 uniform sampler2D u_silhouette;
 uniform vec3 u_ring_color;
@@ -193,8 +196,14 @@ void main()
         key = 1.0 - textureLod(u_silhouette, v_proj.xy, v_lod).r * 0.85;
 #endif
 #ifdef FX_LSPSM
-    if (u_lspsm_on == 1) // with the SSFSM shadows on, the map has no fighters: theirs come from the silhouette
-        key *= lspsm_visibility(v_world, n, 0.02 + 0.006 * distance(v_world, u_eye));
+    if (u_lspsm_on == 1) { // with the SSFSM shadows on, the map has no fighters: theirs come from the silhouette
+        float offset = 0.02 + 0.006 * distance(v_world, u_eye);
+#ifdef FX_LSPSM_STATIC
+        key *= lspsm_static_visibility(v_world, v_lspsm + v_lspsm_n * offset);
+#else
+        key *= lspsm_visibility(v_world, n, offset);
+#endif
+    }
 #endif
     float alpha = 0.0;
 #endif

@@ -1,5 +1,5 @@
 #version 330 core
-// variants: FIGHTER STAGE LENS LIGHT_VIEW LIGHT_VIEW+SILHOUETTE FIGHTER+FX_FOG LENS+FX_FOG STAGE+MATERIAL=1 STAGE+MATERIAL=2 STAGE+MATERIAL=3
+// variants: FIGHTER STAGE LENS LIGHT_VIEW LIGHT_VIEW+SILHOUETTE FIGHTER+FX_FOG LENS+FX_FOG STAGE+MATERIAL=1 STAGE+MATERIAL=2 STAGE+MATERIAL=3 STAGE+MATERIAL=1+FX_LSPSM_STATIC STAGE+MATERIAL=3+FX_LSPSM_STATIC
 // Scene geometry for every pass that draws it: rigid skinning, one matrix
 // per bone (bone index -1: world space).  Variants by #define:
 //   FIGHTER, STAGE, LENS   the HDR scene pass (scene.frag)
@@ -45,6 +45,13 @@ out float v_lod;
 // one normal, so this is what scene.frag would fetch at each of its pixels
 flat out vec3 v_diff_on, v_diff_off;
 #endif
+#ifdef FX_LSPSM_STATIC
+// the static shadow layers' map is affine (lspsm_common.glsl): this point's
+// (u, v, depth) and its normal's, interpolated exactly, so the pixel only
+// adds its offset along the normal
+uniform mat4 u_lspsm_shadow;
+out vec3 v_lspsm, v_lspsm_n;
+#endif
 #endif
 
 out vec3 v_world;
@@ -89,6 +96,10 @@ void main()
     // blurrier by a level per halving (r_quality.sil_size)
     float lod = (d - u_lod_start) * u_lod_scale - log2(512.0 / float(textureSize(u_silhouette, 0).x));
     v_lod = clamp(lod, 0.0, 4.0);
+#ifdef FX_LSPSM_STATIC
+    v_lspsm = (u_lspsm_shadow * world).xyz;
+    v_lspsm_n = mat3(u_lspsm_shadow) * (MATERIAL == 3 ? -v_normal : v_normal);
+#endif
 #if MATERIAL != 3
     vec3 fn = normalize(v_normal);
     v_diff_on = textureLod(u_diffuse_on, fn, 0.0).rgb;

@@ -1,7 +1,7 @@
 /* runtime/render/r_lspsm: Light Space Perspective Shadow Maps, CPU side
  * (techniques C): the light's matrices, the fallback to uniform shadow
- * mapping, the depth auto-focus, the fade, caster culling and the fighters'
- * box-exit lookup. */
+ * mapping, the depth auto-focus, the fade, caster culling, the fighters'
+ * box-exit lookup and the static layers' matrices. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -839,7 +839,69 @@ static void t_warp_near(void)
     T_ASSERT(low.warp == old.warp && memcmp(&low.light_vp, &old.light_vp, sizeof low.light_vp) == 0);
 }
 
-T_MAIN({"unit_cube_random", t_unit_cube_random}, {"unit_cube_degenerate", t_unit_cube_degenerate},
+/* ---- the static layers ---- */
+
+static void mat_apply(const r_mat4 *m, const float p[3], double out[4])
+{
+    for (int r = 0; r < 4; r++)
+        out[r] = m->m[r] * p[0] + m->m[4 + r] * p[1] + m->m[8 + r] * p[2] + m->m[12 + r];
+}
+
+/* r_lspsm_static_build: random lights (and straight up, straight down, a
+ * zero vector) and boxes.  The last layer's (u, v, depth) puts the outer
+ * box in 0..1 exactly (corners on both ends of each axis); each layer's
+ * fit puts its own box in 0..1 the same way; each layer's clip matrix is
+ * 2 (u, v, depth) - 1 of its own texture coordinates; depth falls towards
+ * the light. */
+static void t_static_layers(void)
+{
+    seed();
+    for (int k = 0; k < 400; k++) {
+        r_vec3 L = k == 0 ? r_v3(0, 1, 0) : k == 1 ? r_v3(0, -1, 0) : k == 2 ? r_v3(0, 0, 0) : rand_unit();
+        float box[R_LSPSM_LAYERS][2][3];
+        for (int l = R_LSPSM_LAYERS - 1; l >= 0; l--)
+            for (int a = 0; a < 3; a++) {
+                double h = l == R_LSPSM_LAYERS - 1 ? urange(20, 150) : urange(1, 15);
+                box[l][0][a] = (float)(-h + urange(-2, 2)), box[l][1][a] = (float)(h + urange(-2, 2));
+            }
+        r_lspsm_static st;
+        r_lspsm_static_build(L, (const float(*)[2][3])box, &st);
+        T_ASSERTF(isfinite(st.depth_m) && st.depth_m > 0, "light %d: depth range %g m", k, st.depth_m);
+        for (int l = 0; l < R_LSPSM_LAYERS; l++) {
+            double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+            for (int c = 0; c < 8; c++) {
+                const float p[3] = {box[l][c & 1][0], box[l][(c >> 1) & 1][1], box[l][(c >> 2) & 1][2]};
+                double t[4], clip[4];
+                mat_apply(&st.shadow, p, t);
+                T_ASSERTF(fabs(t[3] - 1) < 1e-6, "w %g", t[3]);
+                if (l < R_LSPSM_LAYERS - 1)
+                    for (int a = 0; a < 2; a++)
+                        t[a] = t[a] * st.fit[l][a] + st.fit[l][2 + a];
+                mat_apply(&st.light_vp[l], p, clip);
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fmin(lo[a], t[a]), hi[a] = fmax(hi[a], t[a]);
+                    T_ASSERTF(fabs(clip[a] - (2 * t[a] - 1)) < 1e-4, "light %d layer %d: clip %g, texture %g", k, l, clip[a],
+                              t[a]);
+                }
+            }
+            for (int a = 0; a < (l == R_LSPSM_LAYERS - 1 ? 3 : 2); a++)
+                T_ASSERTF(fabs(lo[a]) < 1e-4 && fabs(hi[a] - 1) < 1e-4, "light %d layer %d axis %d: %g..%g", k, l, a, lo[a],
+                          hi[a]);
+            T_ASSERT(st.extent[l][0] > 0 && st.extent[l][1] > 0 && isfinite(st.extent[l][0]));
+        }
+        /* a metre towards the light: nearer by a metre */
+        r_vec3 Ln = r_dot(L, L) > 0 ? r_norm(L) : r_v3(0, 1, 0);
+        const float p[3] = {0, 0, 0}, q[3] = {Ln.x, Ln.y, Ln.z};
+        double tp[4], tq[4];
+        mat_apply(&st.shadow, p, tp);
+        mat_apply(&st.shadow, q, tq);
+        T_ASSERTF(fabs((tp[2] - tq[2]) * st.depth_m - 1) < 1e-3, "light %d: a metre towards it is %g m", k,
+                  (tp[2] - tq[2]) * st.depth_m);
+        T_ASSERTF(fabs(tp[0] - tq[0]) < 1e-5 && fabs(tp[1] - tq[1]) < 1e-5, "light %d: the light's ray moved in u, v", k);
+    }
+}
+
+T_MAIN({"unit_cube_random", t_unit_cube_random}, {"static_layers", t_static_layers}, {"unit_cube_degenerate", t_unit_cube_degenerate},
        {"density", t_density}, {"no_pop", t_no_pop}, {"focus_pattern", t_focus_pattern},
        {"focus_grow_shrink", t_focus_grow_shrink}, {"focus_memory", t_focus_memory}, {"focus_nan", t_focus_nan}, {"fade", t_fade},
        {"box_exit", t_box_exit}, {"cull", t_cull}, {"camera_from", t_camera_from}, {"density_rows", t_density_rows},

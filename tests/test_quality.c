@@ -698,6 +698,8 @@ static void t_presets_are_the_documented_table(void)
                 q.shadow_size = v;
             else if (sscanf(tok, "silhouette %d", &v) == 1)
                 q.sil_size = v;
+            else if (sscanf(tok, "LSPSM static %d", &v) == 1)
+                q.lspsm_static = v;
             else if (sscanf(tok, "LSPSM %d", &v) == 1)
                 q.lspsm_size = v;
             else if (sscanf(tok, "water %d", &v) == 1)

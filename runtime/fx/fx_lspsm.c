@@ -38,6 +38,15 @@
  * out again: on plaza, llvmpipe spent about 2 ms a frame on those taps, and
  * they could not see a building's shadow behind a fighter.)
  *
+ * The static layers (r_quality.lspsm_static; static_mode): where the
+ * light and the buildings stand still and the fighters' own shadows run,
+ * the map is instead two orthographic layers of one depth array
+ * (r_lspsm_static_build), drawn from every proxy on the first frame of a
+ * look (draw_static) and looked up with an affine map and one tap
+ * (FX_LSPSM_STATIC in the scene's programs).  No focus, no history:
+ * lspsm_focus does not run and nothing warms up.  The fighters go into a
+ * copy of the layers on the frames their shadow can reach a building.
+ *
  * The focus readback waits, in the next frame, for the previous frame's
  * 1280-byte transfer; every frame is then a function of the frames drawn
  * before it, so a replay's video is the same on every run.  A reset
@@ -59,6 +68,7 @@ extern const r_fx_module fx_lspsm_module;
 
 #define KEEP 0.4f         /* a fighter in full shadow keeps 40 % of the key light */
 #define DEPTH_BIAS 0.0005f /* receivers, window depth units */
+#define STATIC_BIAS_M 0.03f /* the static layers' receivers, metres along the light */
 
 struct fx_lspsm_state {
     GLuint prog_map, prog_focus;
@@ -74,6 +84,15 @@ struct fx_lspsm_state {
     r_mat4 pending_inv_vp;
     r_lspsm_focus focus;
     r_lspsm s;            /* this frame's matrices */
+    /* the static layers (r_quality.lspsm_static, static_mode): drawn once */
+    bool stat;                 /* this look's map is the static layers */
+    int stat_size;             /* their edge, texels */
+    GLuint stat_tex, stat_fbo[R_LSPSM_LAYERS];           /* the layers' depth array (compare mode) */
+    GLuint stat_cast_tex, stat_cast_fbo[R_LSPSM_LAYERS]; /* the same with the fighters, made when first needed */
+    bool stat_drawn;           /* stat_tex holds the layers for stat_light */
+    bool cast_all;             /* this frame every receiver looks up the map with the fighters */
+    r_vec3 stat_light;
+    r_lspsm_static st;
     /* the city */
     int nb;
     r_building b[R_CITY_MAX];
@@ -94,6 +113,21 @@ static bool need_map(void *u)
 {
     r_game *r = u;
     return r_fx_stage(r)->lspsm && LSPSM(r);
+}
+
+/* The static layers: asked for by the quality (lspsm_static), with the
+ * fighters' own shadows on (they cast the fighters; the layers hold the
+ * buildings alone) and buildings to cast. */
+static bool static_mode(const r_game *r)
+{
+    const r_stage *st = r_fx_stage(r);
+    return r_fx_quality(r)->lspsm_static > 0 && st->lspsm && st->shadows && st->buildings > 0;
+}
+
+static bool need_focus(void *u)
+{
+    r_game *r = u;
+    return need_map(u) && !LSPSM(r)->stat;
 }
 
 static bool need_buildings(void *u)
@@ -205,11 +239,147 @@ static bool make_map(int n, GLuint *tex, GLuint *fbo)
     return st == GL_FRAMEBUFFER_COMPLETE;
 }
 
+/* The layers' depth array, n x n each, compare mode, bilinear (2x2 PCF),
+ * lit beyond its border, with a framebuffer per layer. */
+static bool make_layers(int n, GLuint *tex, GLuint fbo[R_LSPSM_LAYERS])
+{
+    const float one[4] = {1, 1, 1, 1};
+    gl.GenTextures(1, tex);
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, *tex);
+    gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT16, n, n, R_LSPSM_LAYERS, 0, GL_DEPTH_COMPONENT,
+                  GL_UNSIGNED_SHORT, NULL);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    gl.TexParameterfv(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BORDER_COLOR, one);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    gl.TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    gl.GenFramebuffers(R_LSPSM_LAYERS, fbo);
+    bool ok = true;
+    for (int l = 0; l < R_LSPSM_LAYERS; l++) {
+        gl.BindFramebuffer(GL_FRAMEBUFFER, fbo[l]);
+        gl.FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, *tex, 0, l);
+        GLenum none = GL_NONE;
+        gl.DrawBuffers(1, &none);
+        gl.ReadBuffer(GL_NONE);
+        ok = ok && gl.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    }
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    return ok;
+}
+
+/* The casters' state of both kinds of map: depth, front faces (closed
+ * proxies: the faces turned from the light lie behind the ones turned to
+ * it), polygon offset, depth clamp (a tall building nearer the light than
+ * the map's near plane still casts). */
+static void caster_state(void)
+{
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LESS);
+    gl.DepthMask(GL_TRUE);
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
+    gl.Enable(GL_POLYGON_OFFSET_FILL);
+    gl.PolygonOffset(1.5f, 4.0f);
+    gl.Enable(GL_DEPTH_CLAMP);
+}
+
+/* The static layers for light L: every building's proxy, once.  Layer 1
+ * covers every receiver within R_LSPSM_LIMIT of an eye that stays within
+ * STATIC_EYE_REACH of the ring's centre (r_game_camera_parts keeps it
+ * within 12 m), layer 0 the ring and STATIC_INNER metres round it. */
+#define STATIC_EYE_REACH 20.0f
+#define STATIC_INNER 6.0f
+static void draw_static(r_game *r, struct fx_lspsm_state *ls, r_vec3 L)
+{
+    float ring_half = 4.0f, top = R_CITY_GROUND + 1;
+    int gs = r_fx_stage_game(r) >= 0 ? r_fx_stage_game(r) : r_fx_stage(r)->game_index;
+    if (gs >= 0 && gs < G_STAGES)
+        ring_half = fx_to_float(g_stages[gs].ring_half);
+    for (int i = 0; i < ls->nb; i++)
+        top = fmaxf(top, ls->hi[i][1]);
+    float reach = R_LSPSM_LIMIT + STATIC_EYE_REACH, in = ring_half + STATIC_INNER;
+    const float box[R_LSPSM_LAYERS][2][3] = {{{-in, R_CITY_GROUND, -in}, {in, 3.0f, in}},
+                                             {{-reach, R_CITY_GROUND, -reach}, {reach, top, reach}}};
+    r_lspsm_static_build(L, box, &ls->st);
+    caster_state();
+    gl.Viewport(0, 0, ls->stat_size, ls->stat_size);
+    gl.ClearDepth(1.0);
+    GLuint p = ls->prog_map;
+    gl.UseProgram(p);
+    gl.BindVertexArray(ls->proxy_vao);
+    for (int l = 0; l < R_LSPSM_LAYERS; l++) {
+        gl.BindFramebuffer(GL_FRAMEBUFFER, ls->stat_fbo[l]);
+        gl.Clear(GL_DEPTH_BUFFER_BIT);
+        gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->st.light_vp[l].m);
+        gl.DrawElements(GL_TRIANGLES, (GLsizei)(ls->stats.proxy_triangles * 3), GL_UNSIGNED_INT, NULL);
+    }
+    gl.Disable(GL_CULL_FACE);
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_DEPTH_CLAMP);
+    ls->stat_drawn = true;
+    ls->stat_light = L;
+    ls->stats.static_draws++;
+    for (int l = 0; l < R_LSPSM_LAYERS; l++)
+        ls->stats.static_texel[l] = fmaxf(ls->st.extent[l][0], ls->st.extent[l][1]) / (float)ls->stat_size;
+}
+
+/* A static frame: the layers (drawn when the light is new), and the
+ * fighters into a copy of them when they must cast through the map. */
+static void run_static(r_game *r, struct fx_lspsm_state *ls, const frame *f)
+{
+    r_vec3 L = to_light(r);
+    if (!ls->stat_drawn || L.x != ls->stat_light.x || L.y != ls->stat_light.y || L.z != ls->stat_light.z)
+        draw_static(r, ls, L);
+    ls->cast_drawn = ls->cast_all = false;
+    bool ssfsm = r_ran(f, r, "mask_filter") && r_ran(f, r, "silhouette_mips");
+    float box[4][3];
+    fighter_boxes(f, box);
+    ls->stats.fighters_in_map = !ssfsm;
+    ls->stats.fighters_cast = false;
+    ls->stats.casters_drawn = 0;
+    ls->stats.casters = ls->nb;
+    ls->stats.range = R_LSPSM_LIMIT;
+    ls->stats.warp = 0;
+    if (f->depth_only)
+        return;
+    /* the fighters' own shadows cast them on everything but the buildings;
+     * without them (a pass left out) everything looks the copy up */
+    bool cast = !ssfsm || (!ls->no_cast && fighters_reach_buildings(ls, box, L));
+    if (!cast || !(ls->stat_cast_tex || make_layers(ls->stat_size, &ls->stat_cast_tex, ls->stat_cast_fbo)))
+        return;
+    caster_state();
+    gl.Disable(GL_CULL_FACE);
+    gl.Viewport(0, 0, ls->stat_size, ls->stat_size);
+    GLuint p = ls->prog_map;
+    for (int l = 0; l < R_LSPSM_LAYERS; l++) {
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, ls->stat_fbo[l]);
+        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, ls->stat_cast_fbo[l]);
+        gl.BlitFramebuffer(0, 0, ls->stat_size, ls->stat_size, 0, 0, ls->stat_size, ls->stat_size, GL_DEPTH_BUFFER_BIT,
+                           GL_NEAREST);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, ls->stat_cast_fbo[l]);
+        gl.UseProgram(p);
+        gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->st.light_vp[l].m);
+        r_draw_fighters(r, p);
+    }
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_DEPTH_CLAMP);
+    ls->cast_drawn = true;
+    ls->cast_all = !ssfsm;
+    ls->stats.fighters_cast = ssfsm;
+}
+
 static void run_map(void *u)
 {
     r_game *r = u;
     struct fx_lspsm_state *ls = LSPSM(r);
     const frame *f = r_fx_frame(r);
+    if (ls->stat) {
+        run_static(r, ls, f);
+        return;
+    }
     take_focus(ls, f->reset);
     r_lspsm_desc d = {.cam = r_lspsm_camera_from(f->view, f->proj), .to_light = to_light(r),
                       .far = ls->focus.range > 0 ? ls->focus.range : R_LSPSM_LIMIT, .uniform = ls->uniform};
@@ -220,24 +390,14 @@ static void run_map(void *u)
 
     gl.BindFramebuffer(GL_FRAMEBUFFER, ls->map_fbo);
     gl.Viewport(0, 0, ls->map, ls->map);
-    gl.Enable(GL_DEPTH_TEST);
-    gl.DepthFunc(GL_LESS);
-    gl.DepthMask(GL_TRUE);
     gl.ClearDepth(1.0);
     gl.Clear(GL_DEPTH_BUFFER_BIT);
-    /* the buildings' proxies are closed boxes: their faces turned from the
-     * light lie behind the ones turned to it, so only those are drawn
-     * (lspsm_map 5.1 -> 3.3 ms a plaza frame single-threaded).  Where the
-     * warp clips a face turned to the light, the one behind no longer
-     * stands in for it: in 30 frames of plaza, 433 bytes of 31 MB changed
-     * on one shadow edge, and bench quality's dB did not move */
-    gl.Enable(GL_CULL_FACE);
-    gl.CullFace(GL_BACK);
-    gl.Enable(GL_POLYGON_OFFSET_FILL);
-    gl.PolygonOffset(1.5f, 4.0f);
-    /* a tall building beyond the frustum's near plane (100 m towards the
-     * light) still casts: its depth clamps to the plane instead of clipping */
-    gl.Enable(GL_DEPTH_CLAMP);
+    /* only the proxies' faces turned to the light are drawn (lspsm_map 5.1
+     * -> 3.3 ms a plaza frame single-threaded).  Where the warp clips a
+     * face turned to the light, the one behind no longer stands in for it:
+     * in 30 frames of plaza, 433 bytes of 31 MB changed on one shadow
+     * edge, and bench quality's dB did not move */
+    caster_state();
     GLuint p = ls->prog_map;
     gl.UseProgram(p);
     gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->s.light_vp.m);
@@ -308,7 +468,8 @@ static void run_buildings(void *u)
      * map with the fighters in it casts them there, when run_map drew it */
     gl.Uniform1i(r_loc(p, "u_shadows"), 0);
     if (ls->cast_drawn)
-        r_bind_tex(p, "u_lspsm_map", ls->unit, GL_TEXTURE_2D, ls->cast_tex);
+        r_bind_tex(p, "u_lspsm_map", ls->unit, ls->stat ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D,
+                   ls->stat ? ls->stat_cast_tex : ls->cast_tex);
     gl.BindVertexArray(ls->city_vao);
     gl.DrawElements(GL_TRIANGLES, ls->city_count, GL_UNSIGNED_INT, NULL);
     gl.Disable(GL_CULL_FACE);
@@ -360,7 +521,7 @@ static const r_pass surface_passes[] = {
     {"buildings", RES_ENV, RES_HDR | RES_DEPTH, need_buildings, run_buildings, RES_LSPSM | RES_FOGMAP},
 };
 static const r_pass focus_passes[] = {
-    {"lspsm_focus", RES_DEPTH, 0, need_map, run_focus, 0},
+    {"lspsm_focus", RES_DEPTH, 0, need_focus, run_focus, 0},
 };
 
 /* ---- the receivers' side ---- */
@@ -378,19 +539,33 @@ static void lspsm_bind(r_game *r, GLuint p, int unit, int what)
     gl.Uniform1i(r_loc(p, "u_lspsm_on"), on);
     /* the sampler gets its unit whether on or not: samplers of different
      * types must never share a unit */
-    r_bind_tex(p, "u_lspsm_map", unit, GL_TEXTURE_2D, on ? ls->map_tex : 0);
+    if (ls && ls->stat)
+        r_bind_tex(p, "u_lspsm_map", unit, GL_TEXTURE_2D_ARRAY,
+                   !on ? 0 : ls->cast_all ? ls->stat_cast_tex : ls->stat_tex);
+    else
+        r_bind_tex(p, "u_lspsm_map", unit, GL_TEXTURE_2D, on ? ls->map_tex : 0);
     if (ls)
         ls->unit = unit;
     if (!on)
         return;
     const frame *f = r_fx_frame(r);
-    gl.UniformMatrix4fv(r_loc(p, "u_lspsm_shadow"), 1, GL_FALSE, ls->s.shadow.m);
-    gl.Uniform3f(r_loc(p, "u_lspsm_eye"), ls->s.eye.x, ls->s.eye.y, ls->s.eye.z);
-    gl.Uniform2f(r_loc(p, "u_lspsm_fade"), ls->s.fade[0], ls->s.fade[1]);
     r_vec3 L = to_light(r);
+    if (ls->stat) {
+        const r_lspsm_static *st = &ls->st;
+        gl.UniformMatrix4fv(r_loc(p, "u_lspsm_shadow"), 1, GL_FALSE, st->shadow.m);
+        gl.Uniform4fv(r_loc(p, "u_lspsm_fit"), R_LSPSM_LAYERS - 1, &st->fit[0][0]);
+        gl.Uniform3f(r_loc(p, "u_lspsm_eye"), f->eye.x, f->eye.y, f->eye.z);
+        gl.Uniform2f(r_loc(p, "u_lspsm_fade"), R_LSPSM_LIMIT * (1 - R_LSPSM_FADE), R_LSPSM_LIMIT);
+        gl.Uniform1f(r_loc(p, "u_lspsm_bias"), STATIC_BIAS_M / st->depth_m);
+        gl.Uniform1f(r_loc(p, "u_lspsm_texel"), 1.0f / (float)ls->stat_size);
+    } else {
+        gl.UniformMatrix4fv(r_loc(p, "u_lspsm_shadow"), 1, GL_FALSE, ls->s.shadow.m);
+        gl.Uniform3f(r_loc(p, "u_lspsm_eye"), ls->s.eye.x, ls->s.eye.y, ls->s.eye.z);
+        gl.Uniform2f(r_loc(p, "u_lspsm_fade"), ls->s.fade[0], ls->s.fade[1]);
+        gl.Uniform1f(r_loc(p, "u_lspsm_bias"), DEPTH_BIAS);
+        gl.Uniform1f(r_loc(p, "u_lspsm_texel"), 1.0f / (float)ls->map);
+    }
     gl.Uniform3f(r_loc(p, "u_lspsm_dir"), L.x, L.y, L.z);
-    gl.Uniform1f(r_loc(p, "u_lspsm_bias"), DEPTH_BIAS);
-    gl.Uniform1f(r_loc(p, "u_lspsm_texel"), 1.0f / (float)ls->map);
     gl.Uniform1f(r_loc(p, "u_lspsm_keep"), KEEP);
     float box[4][3];
     fighter_boxes(f, box);
@@ -413,9 +588,12 @@ static void lspsm_destroy(r_game *r)
     if (!ls)
         return;
     free_city(ls);
-    GLuint tex[3] = {ls->map_tex, ls->cast_tex, ls->focus_tex}, fbo[3] = {ls->map_fbo, ls->cast_fbo, ls->focus_fbo};
-    gl.DeleteTextures(3, tex);
+    GLuint tex[5] = {ls->map_tex, ls->cast_tex, ls->focus_tex, ls->stat_tex, ls->stat_cast_tex},
+           fbo[3] = {ls->map_fbo, ls->cast_fbo, ls->focus_fbo};
+    gl.DeleteTextures(5, tex);
     gl.DeleteFramebuffers(3, fbo);
+    gl.DeleteFramebuffers(R_LSPSM_LAYERS, ls->stat_fbo);
+    gl.DeleteFramebuffers(R_LSPSM_LAYERS, ls->stat_cast_fbo);
     if (ls->pbo)
         gl.DeleteBuffers(1, &ls->pbo);
     gl.DeleteProgram(ls->prog_map);
@@ -466,6 +644,8 @@ static bool lspsm_load(r_game *r, rs_err *err)
     ls->pending = false;
     ls->focus.range = 0;
     memset(&ls->stats, 0, sizeof ls->stats);
+    ls->stat = false;
+    ls->stat_drawn = ls->cast_all = false;
     const r_stage *st = r_fx_stage(r);
     if (st->buildings <= 0)
         return true;
@@ -493,6 +673,25 @@ static bool lspsm_load(r_game *r, rs_err *err)
         free_city(ls);
         return rs_fail(err, R_ERR_NOMEM, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
     }
+    if (static_mode(r)) { /* the look's programs were built for them (lspsm_define) */
+        int n = r_fx_quality(r)->lspsm_static;
+        n = n < 256 ? 256 : n > 4096 ? 4096 : n;
+        if (ls->stat_tex && ls->stat_size != n) {
+            GLuint tex[2] = {ls->stat_tex, ls->stat_cast_tex};
+            gl.DeleteTextures(2, tex);
+            gl.DeleteFramebuffers(R_LSPSM_LAYERS, ls->stat_fbo);
+            gl.DeleteFramebuffers(R_LSPSM_LAYERS, ls->stat_cast_fbo);
+            ls->stat_tex = ls->stat_cast_tex = 0;
+            memset(ls->stat_fbo, 0, sizeof ls->stat_fbo);
+            memset(ls->stat_cast_fbo, 0, sizeof ls->stat_cast_fbo);
+        }
+        ls->stat_size = n;
+        if (!ls->stat_tex && !make_layers(n, &ls->stat_tex, ls->stat_fbo))
+            return rs_fail(err, R_ERR_TARGET, "lspsm: the static shadow layers (%dx%d, %d layers) are incomplete", n, n,
+                          R_LSPSM_LAYERS);
+        RGL_CHECK("lspsm static layers");
+        ls->stat = ls->stats.is_static = true;
+    }
     return true;
 }
 
@@ -510,12 +709,12 @@ static bool lspsm_load(r_game *r, rs_err *err)
  *                reset state whatever this renderer drew before. */
 static int lspsm_warmup(r_game *r)
 {
-    return need_map(r) ? r_lspsm_focus_memory(&LSPSM(r)->focus) : R_FX_STATELESS;
+    return need_map(r) && !LSPSM(r)->stat ? r_lspsm_focus_memory(&LSPSM(r)->focus) : R_FX_STATELESS;
 }
 
 static bool lspsm_needs_frame(r_game *r)
 {
-    return need_map(r);
+    return need_map(r) && !LSPSM(r)->stat;
 }
 
 static void lspsm_advance(r_game *r)
@@ -526,7 +725,7 @@ static void lspsm_advance(r_game *r)
 
 static const char *lspsm_define(const r_game *r)
 {
-    return r_fx_stage(r)->lspsm ? "FX_LSPSM" : NULL;
+    return !r_fx_stage(r)->lspsm ? NULL : static_mode(r) ? "FX_LSPSM_STATIC" : "FX_LSPSM";
 }
 
 const r_fx_module fx_lspsm_module = {

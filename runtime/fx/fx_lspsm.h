@@ -17,6 +17,9 @@ typedef struct fx_lspsm_stats {
     int focus_used;               /* samples that counted */
     bool fighters_in_map;         /* the fighters are in the receivers' map (their shadows off) */
     bool fighters_cast;           /* the buildings' map with the fighters was drawn (a shadow may reach one) */
+    bool is_static;               /* the map is the static layers (r_quality.lspsm_static) */
+    int static_draws;             /* times the static layers were drawn since the look was loaded */
+    float static_texel[2];        /* their texels across the light, metres (the longer side), finest first */
 } fx_lspsm_stats;
 bool fx_lspsm_stats_get(struct r_game *r, fx_lspsm_stats *out);
 /* Tests and bench: force the light direction (NULL: the stage's key),
@@ -30,7 +33,8 @@ void fx_lspsm_test_no_cast(struct r_game *r, bool off);
  * the fighters, false until one was drawn), "size" (4 floats: the map's
  * and the buildings' map's width and height as GL has them; the map's
  * twice while the second was never made), "focus" (20x16 depth samples
- * of the frame drawn last), "shadow" (16 floats). */
+ * of the frame drawn last), "shadow" (16 floats).  With the static
+ * layers (fx_lspsm_stats.is_static) "map" and "cast" are not drawn. */
 bool fx_lspsm_read(struct r_game *r, const char *what, float *out);
 
 #endif

@@ -47,6 +47,9 @@ typedef struct r_quality {
     int bloom_levels; /* bloom pyramid levels added, 1..2: 0 = 2 (1/4 and 1/8 of 720 rows) */
     r_aa aa;          /* post-process anti-aliasing on the tone-mapped image */
     int lspsm_size;   /* LSPSM shadow map, texels a side: 0 = the module's default; clamped to 256..4096 */
+    int lspsm_static; /* where the light and the casters stand still (plaza) and the fighters' own shadows
+                         run: the buildings' shadows from two orthographic layers of this many texels a
+                         side (256..4096), drawn once per look, instead of an LSPSM map every frame; 0 = off */
     int fog_size;     /* the mist's top-down density map, 64..1024: 0 = the module's default */
     int water_grid;   /* water surface quads a side, 16..256: 0 = the module's default */
     int snow_light;   /* the snow's texture-space light map, texels a side, 64..256: 0 = 256 */

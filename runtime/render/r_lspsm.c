@@ -208,6 +208,61 @@ void r_lspsm_build(const r_lspsm_desc *d, r_lspsm *out)
     out->axis[0] = fv(x_axis), out->axis[1] = fv(y_axis), out->axis[2] = fv(L);
 }
 
+/* The light-frame bounds of a world box: its 8 corners on x, y and z. */
+static void frame_bounds(const dv3 ax[3], const float lo[3], const float hi[3], double b[3][2])
+{
+    for (int a = 0; a < 3; a++)
+        b[a][0] = INFINITY, b[a][1] = -INFINITY;
+    for (int k = 0; k < 8; k++) {
+        dv3 p = {k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]};
+        for (int a = 0; a < 3; a++) {
+            double v = d_dot(p, ax[a]);
+            b[a][0] = fmin(b[a][0], v), b[a][1] = fmax(b[a][1], v);
+        }
+    }
+    for (int a = 0; a < 3; a++) /* an empty or flat box: a metre, so nothing divides by zero */
+        if (!(b[a][1] - b[a][0] >= 1e-3)) {
+            double c = isfinite(b[a][0] + b[a][1]) ? 0.5 * (b[a][0] + b[a][1]) : 0;
+            b[a][0] = c - 0.5, b[a][1] = c + 0.5;
+        }
+}
+
+void r_lspsm_static_build(r_vec3 to_light, const float box[R_LSPSM_LAYERS][2][3], r_lspsm_static *out)
+{
+    dv3 L = d_unit(dv(to_light), (dv3){0, 1, 0});
+    /* map y: the world's up with the light's part removed (the vertical
+     * across the light), or any axis when the light is straight up */
+    dv3 y = d_perp((dv3){0, 1, 0}, L);
+    y = d_len(y) > 1e-3 ? d_unit(y, (dv3){0, 0, 1}) : d_any_perp(L);
+    dv3 x = d_cross(y, L);
+    const dv3 ax[3] = {x, y, L};
+    double b[R_LSPSM_LAYERS][3][2];
+    for (int l = 0; l < R_LSPSM_LAYERS; l++)
+        frame_bounds(ax, box[l][0], box[l][1], b[l]);
+    const double(*ob)[2] = b[R_LSPSM_LAYERS - 1];
+    /* depth 0 at the side towards the light, 1 away from it: every layer */
+    double z0 = ob[2][1], dz = ob[2][1] - ob[2][0];
+    double ow = ob[0][1] - ob[0][0], oh = ob[1][1] - ob[1][0];
+    for (int l = 0; l < R_LSPSM_LAYERS; l++) {
+        double w = b[l][0][1] - b[l][0][0], h = b[l][1][1] - b[l][1][0], sx = 1 / w, sy = 1 / h;
+        /* clip: x, y in -1..1 over the layer, z = 2 depth - 1 */
+        row4 rows[4] = {row_of(d_scale(x, 2 * sx), -2 * sx * b[l][0][0] - 1),
+                        row_of(d_scale(y, 2 * sy), -2 * sy * b[l][1][0] - 1),
+                        row_of(d_scale(L, -2 / dz), 2 * z0 / dz - 1), row_of((dv3){0, 0, 0}, 1)};
+        out->light_vp[l] = mat_of(rows);
+        out->extent[l][0] = (float)w, out->extent[l][1] = (float)h;
+        if (l < R_LSPSM_LAYERS - 1) { /* u = (p.x - b0) / w = (u_last ow + ob0 - b0) / w */
+            out->fit[l][0] = (float)(ow / w), out->fit[l][1] = (float)(oh / h);
+            out->fit[l][2] = (float)((ob[0][0] - b[l][0][0]) / w), out->fit[l][3] = (float)((ob[1][0] - b[l][1][0]) / h);
+        }
+    }
+    row4 tex[4] = {row_of(d_scale(x, 1 / ow), -ob[0][0] / ow), row_of(d_scale(y, 1 / oh), -ob[1][0] / oh),
+                   row_of(d_scale(L, -1 / dz), z0 / dz), row_of((dv3){0, 0, 0}, 1)};
+    out->shadow = mat_of(tex);
+    out->depth_m = (float)dz;
+    out->axis[0] = fv(x), out->axis[1] = fv(y), out->axis[2] = fv(L);
+}
+
 float r_lspsm_fade(const r_lspsm *s, r_vec3 p)
 {
     double dist = d_len(d_sub(dv(p), dv(s->eye))), a = s->fade[0], b = s->fade[1];

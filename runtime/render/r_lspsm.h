@@ -119,6 +119,34 @@ double r_lspsm_texels_per_metre(const r_lspsm *s, r_vec3 p, int map_size);
  * 90/60/30/10/0 deg between view and light.  csv may be NULL. */
 void r_lspsm_density_rows(FILE *out, FILE *csv);
 
+/* ---- static layers (r_quality.lspsm_static) ----
+ * Where neither the light nor the casters move for a whole look (plaza's
+ * sun and buildings), their shadows need not be drawn every frame:
+ * orthographic layers of one depth-map array are drawn once, each over a
+ * world box: the last covers every receiver within reach, the first a
+ * smaller box round the ring, where the camera is close, in finer
+ * texels.  All share the light frame and the depth range, so a receiver
+ * needs one affine map: c = shadow * p (w = 1, no divide) gives the last
+ * layer's (u, v, depth); layer l's (u, v) = c.xy * fit[l].xy + fit[l].zw,
+ * the finest whose (u, v) lies inside 0..1 taken.  Two layers: a third
+ * between them (40 m round the ring) bought nothing in `bench quality`.  Casters nearer the light
+ * than the range are clamped to it (GL_DEPTH_CLAMP), so they still cast. */
+#define R_LSPSM_LAYERS 2
+typedef struct r_lspsm_static {
+    r_mat4 light_vp[R_LSPSM_LAYERS];  /* world -> clip of each layer (OpenGL z) */
+    r_mat4 shadow;                    /* world -> the last layer's (u, v, depth, 1), 0..1 over its box */
+    float fit[R_LSPSM_LAYERS - 1][4]; /* layer l's (u, v) from the last's: scale u, v, offset u, v */
+    float depth_m;                    /* metres of light depth across the depth range 0..1 */
+    float extent[R_LSPSM_LAYERS][2];  /* each layer's width and height across the light, metres */
+    r_vec3 axis[3];                   /* light frame: map x, map y, to_light */
+} r_lspsm_static;
+
+/* The layers for a light (from the scene towards it; any direction, a zero
+ * one taken as straight up) and a world box per layer (box[l][0] lo,
+ * box[l][1] hi; each is fitted on its own, the last gives the depth
+ * range).  Always finite. */
+void r_lspsm_static_build(r_vec3 to_light, const float box[R_LSPSM_LAYERS][2][3], r_lspsm_static *out);
+
 /* ---- auto-focus ----
  * 20x16 samples of the previous frame's depth buffer in a tilted grid: every
  * sample has its own cell of the 20x16 grid, and its own column and row of
