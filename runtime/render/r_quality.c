@@ -7,7 +7,7 @@
 /* The table `ringside bench quality` chose (docs/accuracy.md has the
  * measurement).  Zero in a knob is its full-quality default. */
 const r_preset r_presets[R_PRESETS] = {
-    {"draft", 1.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128, .scene_pct = 60},
+    {"draft", 1.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .water_grid = 32, .snow_light = 128, .scene_pct = 60, .lspsm_static = 2048},
      34.0, "the scene at 60% size, the cheaper maps: previews"},
     {"standard", 1.0, {.mask_half = true, .shadow_size = 512, .lspsm_size = 1024, .lspsm_static = 2048, .water_grid = 32, .snow_light = 128, .stage_scene = true},
      38.0, "the stage's scene size, the cheaper maps: the default"},
