@@ -270,10 +270,30 @@ static bool make_layers(int n, GLuint *tex, GLuint fbo[R_LSPSM_LAYERS])
     return ok;
 }
 
+/* The fighters into dst: src's depth (n x n) copied, then the fighters
+ * drawn with the light's matrix vp (the casters' state is on). */
+static void copy_with_fighters(r_game *r, GLuint p, GLuint src, GLuint dst, int n, const r_mat4 *vp)
+{
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, src);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, dst);
+    gl.BlitFramebuffer(0, 0, n, n, 0, 0, n, n, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, dst);
+    gl.UseProgram(p);
+    gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, vp->m);
+    r_draw_fighters(r, p);
+}
+
 /* The casters' state of both kinds of map: depth, front faces (closed
  * proxies: the faces turned from the light lie behind the ones turned to
  * it), polygon offset, depth clamp (a tall building nearer the light than
  * the map's near plane still casts). */
+static void caster_state_end(void)
+{
+    gl.Disable(GL_CULL_FACE);
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.Disable(GL_DEPTH_CLAMP);
+}
+
 static void caster_state(void)
 {
     gl.Enable(GL_DEPTH_TEST);
@@ -316,9 +336,7 @@ static void draw_static(r_game *r, struct fx_lspsm_state *ls, r_vec3 L)
         gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->st.light_vp[l].m);
         gl.DrawElements(GL_TRIANGLES, (GLsizei)(ls->stats.proxy_triangles * 3), GL_UNSIGNED_INT, NULL);
     }
-    gl.Disable(GL_CULL_FACE);
-    gl.Disable(GL_POLYGON_OFFSET_FILL);
-    gl.Disable(GL_DEPTH_CLAMP);
+    caster_state_end();
     ls->stat_drawn = true;
     ls->stat_light = L;
     ls->stats.static_draws++;
@@ -353,19 +371,9 @@ static void run_static(r_game *r, struct fx_lspsm_state *ls, const frame *f)
     caster_state();
     gl.Disable(GL_CULL_FACE);
     gl.Viewport(0, 0, ls->stat_size, ls->stat_size);
-    GLuint p = ls->prog_map;
-    for (int l = 0; l < R_LSPSM_LAYERS; l++) {
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, ls->stat_fbo[l]);
-        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, ls->stat_cast_fbo[l]);
-        gl.BlitFramebuffer(0, 0, ls->stat_size, ls->stat_size, 0, 0, ls->stat_size, ls->stat_size, GL_DEPTH_BUFFER_BIT,
-                           GL_NEAREST);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, ls->stat_cast_fbo[l]);
-        gl.UseProgram(p);
-        gl.UniformMatrix4fv(r_loc(p, "u_view_proj"), 1, GL_FALSE, ls->st.light_vp[l].m);
-        r_draw_fighters(r, p);
-    }
-    gl.Disable(GL_POLYGON_OFFSET_FILL);
-    gl.Disable(GL_DEPTH_CLAMP);
+    for (int l = 0; l < R_LSPSM_LAYERS; l++)
+        copy_with_fighters(r, ls->prog_map, ls->stat_fbo[l], ls->stat_cast_fbo[l], ls->stat_size, &ls->st.light_vp[l]);
+    caster_state_end();
     ls->cast_drawn = true;
     ls->cast_all = !ssfsm;
     ls->stats.fighters_cast = ssfsm;
@@ -427,16 +435,10 @@ static void run_map(void *u)
     } else if (ls->nb > 0 && !ls->no_cast && fighters_reach_buildings(ls, box, to_light(r)) &&
                (ls->cast_fbo || make_map(ls->map, &ls->cast_tex, &ls->cast_fbo))) {
         /* the buildings' map: this one's depth, then the fighters */
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, ls->map_fbo);
-        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, ls->cast_fbo);
-        gl.BlitFramebuffer(0, 0, ls->map, ls->map, 0, 0, ls->map, ls->map, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, ls->cast_fbo);
-        gl.UseProgram(p);
-        r_draw_fighters(r, p);
+        copy_with_fighters(r, p, ls->map_fbo, ls->cast_fbo, ls->map, &ls->s.light_vp);
         ls->cast_drawn = ls->stats.fighters_cast = true;
     }
-    gl.Disable(GL_POLYGON_OFFSET_FILL);
-    gl.Disable(GL_DEPTH_CLAMP);
+    caster_state_end();
     ls->stats.casters_drawn = drawn;
     ls->stats.casters = ls->nb;
     ls->stats.range = d.far;
@@ -674,17 +676,9 @@ static bool lspsm_load(r_game *r, rs_err *err)
         return rs_fail(err, R_ERR_NOMEM, "stage '%s': out of memory for %d buildings", st->name, st->buildings);
     }
     if (static_mode(r)) { /* the look's programs were built for them (lspsm_define) */
+        /* the quality is the renderer's for its life: the size never changes */
         int n = r_fx_quality(r)->lspsm_static;
         n = n < 256 ? 256 : n > 4096 ? 4096 : n;
-        if (ls->stat_tex && ls->stat_size != n) {
-            GLuint tex[2] = {ls->stat_tex, ls->stat_cast_tex};
-            gl.DeleteTextures(2, tex);
-            gl.DeleteFramebuffers(R_LSPSM_LAYERS, ls->stat_fbo);
-            gl.DeleteFramebuffers(R_LSPSM_LAYERS, ls->stat_cast_fbo);
-            ls->stat_tex = ls->stat_cast_tex = 0;
-            memset(ls->stat_fbo, 0, sizeof ls->stat_fbo);
-            memset(ls->stat_cast_fbo, 0, sizeof ls->stat_cast_fbo);
-        }
         ls->stat_size = n;
         if (!ls->stat_tex && !make_layers(n, &ls->stat_tex, ls->stat_fbo))
             return rs_fail(err, R_ERR_TARGET, "lspsm: the static shadow layers (%dx%d, %d layers) are incomplete", n, n,
